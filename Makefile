@@ -1,0 +1,60 @@
+# Developer habits as targets. Everything builds into .venv; a fresh machine needs only
+# cargo, python3 (3.11+), pip and make.
+VENV ?= .venv
+PY := $(VENV)/bin/python
+PIP := $(VENV)/bin/pip
+export VIRTUAL_ENV := $(abspath $(VENV))
+export PATH := $(abspath $(VENV))/bin:$(PATH)
+# Non-interactive plotting everywhere (CI, headless machines).
+export MPLBACKEND ?= Agg
+
+.PHONY: help venv dev test test-rust test-python demo lint fmt bench clean
+
+help:
+	@echo "make demo   - simulated harvest with plots (no hardware)"
+	@echo "make test   - set up .venv, build, run cargo test and pytest"
+	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
+	@echo "make bench  - criterion and pytest-benchmark"
+
+$(VENV)/.stamp: pyproject.toml
+	python3 -m venv $(VENV)
+	$(PIP) install -q --upgrade pip
+	$(PIP) install -q "maturin>=1.9,<2"
+	touch $@
+
+venv: $(VENV)/.stamp
+
+# One optimised build of the extension, installed in place with the test extras.
+dev: venv
+	$(VENV)/bin/maturin develop --release --extras test -q
+
+test-rust:
+	cargo test --release -p softarm-core
+
+test-python: dev
+	$(PY) -m pytest -q
+
+test: dev test-rust
+	$(PY) -m pytest -q
+
+demo: dev
+	$(VENV)/bin/softarm demo
+
+lint: dev
+	cargo fmt --all -- --check
+	cargo clippy --release --workspace --all-targets -- -D warnings
+	$(VENV)/bin/ruff check python tests examples
+	$(VENV)/bin/ruff format --check python tests examples
+	$(PY) -m mypy.stubtest softarm._core --allowlist .stubtest-allowlist
+
+fmt:
+	cargo fmt --all
+	$(VENV)/bin/ruff format python tests examples
+	$(VENV)/bin/ruff check --fix python tests examples
+
+bench: dev
+	cargo bench -p softarm-core
+	$(PY) -m pytest tests/benchmarks --benchmark-only --benchmark-columns=min,median,mean,ops,rounds -q
+
+clean:
+	rm -rf $(VENV) target

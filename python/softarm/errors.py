@@ -1,0 +1,80 @@
+"""The softarm exception hierarchy.
+
+Every error softarm raises derives from :class:`SoftarmError`. Errors caused by bad
+input also derive from :class:`ValueError`, so ``except ValueError`` keeps working for
+callers that do not know softarm. The native module (``softarm._core``) raises these
+same classes: they are defined here once and imported by the Rust bindings.
+
+A message always names the offending argument and, where it helps, its value.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "SoftarmError",
+    "InputError",
+    "ShapeError",
+    "NonFiniteError",
+    "OutOfRangeError",
+    "ParameterError",
+    "PoseError",
+    "UnreachableError",
+    "VisionError",
+    "HardwareError",
+    "HardwareUnavailableError",
+    "SafetyError",
+    "ConfigError",
+]
+
+
+class SoftarmError(Exception):
+    """Base class of every error raised by softarm."""
+
+
+class InputError(SoftarmError, ValueError):
+    """An argument has a wrong shape, type or value."""
+
+
+class ShapeError(InputError):
+    """An array argument has the wrong shape or length."""
+
+
+class NonFiniteError(InputError):
+    """An argument contains NaN or an infinite value."""
+
+
+class OutOfRangeError(InputError):
+    """A value lies outside its allowed range (section index, fraction s, limits)."""
+
+
+class ParameterError(InputError):
+    """A model parameter is invalid (non-positive length or radius, lower >= upper, ...)."""
+
+
+class PoseError(InputError):
+    """A 4x4 pose is malformed: non-finite, last row not [0, 0, 0, 1], or a rotation
+    block that is not orthonormal with determinant +1."""
+
+
+class UnreachableError(SoftarmError):
+    """A target lies outside what the arm can reach."""
+
+
+class VisionError(SoftarmError):
+    """An image or camera model cannot be used (empty frame, wrong dtype, bad calibration)."""
+
+
+class HardwareError(SoftarmError):
+    """A hardware device failed or reported a fault."""
+
+
+class HardwareUnavailableError(HardwareError):
+    """A device, its driver or its port is absent."""
+
+
+class SafetyError(HardwareError):
+    """A command was refused or the system was stopped by the safety layer."""
+
+
+class ConfigError(SoftarmError, ValueError):
+    """A configuration file is missing, malformed or inconsistent."""
