@@ -1,0 +1,146 @@
+//! One constant-curvature arc, parametrised by its length and its *bending vector*.
+//!
+//! The papers write an arc as (length `L`, bending angle `Θ`, bending direction `φ`)
+//! (planning paper eq. 2–3, redundancy paper eq. 2). Polar coordinates (Θ, φ) are
+//! singular at the straight arc, so the kinematics here use the Cartesian bending vector
+//! `u = (ux, uy) = Θ (cos φ, sin φ)`. In `u` the arc is an analytic function everywhere:
+//! the point at fraction `s` is
+//!
+//! ```text
+//! p(s) = L s [ s f2(t²) ux,  s f2(t²) uy,  f1(t²) ]ᵀ,   t = s |u|,
+//! R(s) = exp([ω]×),  ω = s (−uy, ux, 0)
+//! ```
+//!
+//! which is eq. (3)/(5) of the planning paper rewritten with `f1 = sin t / t` and
+//! `f2 = (1 − cos t)/t²` (see [`crate::math::ArcFunctions`]). The straight arc is then an
+//! ordinary point: no perturbation, no special case, exact limits.
+
+use crate::math::{skew, ArcFunctions, Frame, Mat3, Vec3};
+
+/// Arc parameters in the smooth parametrisation: length and bending vector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcParams {
+    /// Arc length `L` (m).
+    pub length: f64,
+    /// `Θ cos φ`: bending angle times the x component of the bending direction (rad).
+    pub ux: f64,
+    /// `Θ sin φ` (rad).
+    pub uy: f64,
+}
+
+/// A point on an arc with its derivatives.
+#[derive(Debug, Clone, Copy)]
+pub struct ArcPoint {
+    /// Position in the arc's base frame.
+    pub pos: Vec3,
+    /// Columns: ∂p/∂L, ∂p/∂ux, ∂p/∂uy.
+    pub d_params: Mat3,
+    /// ∂p/∂s (the tangent times L).
+    pub d_s: Vec3,
+}
+
+impl ArcParams {
+    /// From (length, bending angle Θ, bending direction φ).
+    pub fn from_polar(length: f64, bend: f64, direction: f64) -> Self {
+        let (s, c) = direction.sin_cos();
+        ArcParams {
+            length,
+            ux: bend * c,
+            uy: bend * s,
+        }
+    }
+
+    /// Bending angle `Θ = |u|` of the whole arc.
+    pub fn bend(&self) -> f64 {
+        self.ux.hypot(self.uy)
+    }
+
+    /// Bending direction φ in (−π, π]; 0 for the straight arc (where it is undefined).
+    pub fn direction(&self) -> f64 {
+        self.uy.atan2(self.ux)
+    }
+
+    /// Curvature `Θ / L` (1/m).
+    pub fn curvature(&self) -> f64 {
+        self.bend() / self.length
+    }
+
+    /// Rotation vector of the frame at fraction `s` (the rotation axis is in the xy plane).
+    #[inline]
+    pub fn rotation_vector(&self, s: f64) -> Vec3 {
+        Vec3::new(-self.uy * s, self.ux * s, 0.0)
+    }
+
+    /// Position of the point at fraction `s` (planning paper eq. 5, smooth form).
+    #[inline]
+    pub fn point(&self, s: f64) -> Vec3 {
+        let x = s * s * (self.ux * self.ux + self.uy * self.uy);
+        let f = ArcFunctions::at(x);
+        let ls = self.length * s;
+        Vec3::new(ls * s * f.f2 * self.ux, ls * s * f.f2 * self.uy, ls * f.f1)
+    }
+
+    /// Position at fraction `s` with its derivatives with respect to (L, ux, uy) and s.
+    pub fn point_with_derivatives(&self, s: f64) -> ArcPoint {
+        let (ux, uy, l) = (self.ux, self.uy, self.length);
+        let u2 = ux * ux + uy * uy;
+        let s2 = s * s;
+        let f = ArcFunctions::at(s2 * u2);
+        let pos = Vec3::new(l * s2 * f.f2 * ux, l * s2 * f.f2 * uy, l * s * f.f1);
+        // ∂x/∂ux where x = s² u²  is 2 s² ux.
+        let (dxu, dxv) = (2.0 * s2 * ux, 2.0 * s2 * uy);
+        let ls2 = l * s2;
+        let d_l = Vec3::new(s2 * f.f2 * ux, s2 * f.f2 * uy, s * f.f1);
+        let d_ux = Vec3::new(
+            ls2 * (f.f2 + ux * f.g2 * dxu),
+            ls2 * uy * f.g2 * dxu,
+            l * s * f.g1 * dxu,
+        );
+        let d_uy = Vec3::new(
+            ls2 * ux * f.g2 * dxv,
+            ls2 * (f.f2 + uy * f.g2 * dxv),
+            l * s * f.g1 * dxv,
+        );
+        // ∂x/∂s = 2 s u²
+        let dxs = 2.0 * s * u2;
+        let d_s = Vec3::new(
+            l * (2.0 * s * f.f2 + s2 * f.g2 * dxs) * ux,
+            l * (2.0 * s * f.f2 + s2 * f.g2 * dxs) * uy,
+            l * (f.f1 + s * f.g1 * dxs),
+        );
+        ArcPoint {
+            pos,
+            d_params: Mat3::from_columns(&[d_l, d_ux, d_uy]),
+            d_s,
+        }
+    }
+
+    /// Frame (rotation and position) at fraction `s`: Rodrigues' formula on ω.
+    #[inline]
+    pub fn frame(&self, s: f64) -> Frame {
+        let w = self.rotation_vector(s);
+        let f = ArcFunctions::at(w.norm_squared());
+        let k = skew(&w);
+        let rot = Mat3::identity() + k * f.f1 + k * k * f.f2;
+        let ls = self.length * s;
+        let pos = Vec3::new(ls * f.f2 * w.y, -ls * f.f2 * w.x, ls * f.f1);
+        Frame { rot, pos }
+    }
+
+    /// Frame at fraction `s`, plus the derivatives of the frame with respect to
+    /// (L, ux, uy) as body-fixed-in-base twists: column k of `d_pos` is ∂p/∂param_k, and
+    /// column k of `d_rot` is the angular velocity `(∂R/∂param_k Rᵀ)^∨` (redundancy paper
+    /// eq. 5), computed as `J_l(ω) ∂ω/∂param_k` with the left Jacobian of SO(3).
+    pub fn frame_with_derivatives(&self, s: f64) -> (Frame, Mat3, Mat3) {
+        let w = self.rotation_vector(s);
+        let f = ArcFunctions::at(w.norm_squared());
+        let k = skew(&w);
+        let k2 = k * k;
+        let rot = Mat3::identity() + k * f.f1 + k2 * f.f2;
+        let jl = Mat3::identity() + k * f.f2 + k2 * f.f3;
+        // ω = s (−uy, ux, 0): ∂ω/∂L = 0, ∂ω/∂ux = (0, s, 0), ∂ω/∂uy = (−s, 0, 0).
+        let d_rot = Mat3::from_columns(&[Vec3::zeros(), jl.column(1) * s, -jl.column(0) * s]);
+        let pt = self.point_with_derivatives(s);
+        (Frame { rot, pos: pt.pos }, pt.d_params, d_rot)
+    }
+}

@@ -1,0 +1,279 @@
+//! The kinematics engine shared by every serial chain of constant-curvature sections.
+//!
+//! A model (see [`SectionModel`]) says, for each section `i`, how its own coordinates
+//! `q_i` map to arc parameters (length, bending vector) and which rigid transform follows
+//! the arc. The engine turns that into forward kinematics (redundancy paper eq. 3 /
+//! planning paper eq. 4), the end-effector Jacobian (eq. 4–6) and the Jacobian of any
+//! backbone point (planning paper eq. 5–6), all analytic.
+
+use nalgebra::{DMatrix, Matrix3xX};
+
+use crate::arc::ArcParams;
+use crate::error::{check_finite, check_len, check_range, Error, Result};
+use crate::math::{Frame, Mat3, Mat4, Vec3};
+
+/// What one section contributes, at one configuration.
+#[derive(Debug, Clone, Copy)]
+pub struct SectionState {
+    /// The arc.
+    pub arc: ArcParams,
+    /// ∂(L, ux, uy)/∂q_i: rows are arc parameters, columns the section's coordinates.
+    pub d_arc: Mat3,
+    /// Translation along the tip's z axis after the arc (plate or gripper offset `b_i`).
+    pub offset: f64,
+    /// Rotation about the tip's z axis after the arc (`β_i`, or `φ_i` for an arc chain).
+    pub twist: f64,
+    /// ∂twist/∂q_i.
+    pub d_twist: Vec3,
+}
+
+impl SectionState {
+    /// The rigid transform after the arc's tip.
+    #[inline]
+    fn tail(&self) -> Frame {
+        Frame::z_offset(self.offset, self.twist)
+    }
+}
+
+/// A serial chain of constant-curvature sections with three coordinates each.
+pub trait SectionModel {
+    /// Number of sections.
+    fn n_sections(&self) -> usize;
+
+    /// The state of section `i` given its three coordinates `qi`.
+    fn section_state(&self, i: usize, qi: &[f64]) -> SectionState;
+
+    /// Number of coordinates (3 per section).
+    fn n_dofs(&self) -> usize {
+        3 * self.n_sections()
+    }
+}
+
+/// Checks a configuration vector: length and finiteness.
+pub fn check_q<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<()> {
+    check_len("q", q, model.n_dofs())?;
+    check_finite("q", q)
+}
+
+/// Checks a (section, s) pair for backbone-point queries.
+pub fn check_point_args<M: SectionModel + ?Sized>(model: &M, section: usize, s: f64) -> Result<()> {
+    let n = model.n_sections();
+    if section >= n {
+        return Err(Error::OutOfRange {
+            arg: "section".into(),
+            value: section as f64,
+            min: 0.0,
+            max: (n as f64) - 1.0,
+        });
+    }
+    check_range("s", s, 0.0, 1.0)
+}
+
+#[inline]
+fn state<M: SectionModel + ?Sized>(model: &M, q: &[f64], i: usize) -> SectionState {
+    model.section_state(i, &q[3 * i..3 * i + 3])
+}
+
+/// Base frame of every section followed by the end-effector frame.
+/// `q` must already be checked.
+pub fn frames_unchecked<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Vec<Frame> {
+    let n = model.n_sections();
+    let mut out = Vec::with_capacity(n + 1);
+    let mut f = Frame::identity();
+    out.push(f);
+    for i in 0..n {
+        let st = state(model, q, i);
+        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+        out.push(f);
+    }
+    out
+}
+
+/// End-effector frame (eq. 3). `q` must already be checked.
+#[inline]
+pub fn forward_unchecked<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Frame {
+    let mut f = Frame::identity();
+    for i in 0..model.n_sections() {
+        let st = state(model, q, i);
+        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+    }
+    f
+}
+
+/// Walks the first `upto` sections, writing for each of their coordinates the twist it
+/// gives the rest of the chain into `jac` (6×n): rows 0–2 hold `v_tip − w × p_tip` (the
+/// velocity of the material point at the base origin), rows 3–5 the angular velocity `w`.
+/// Returns the frame after section `upto − 1` (the base of section `upto`, or the end
+/// effector when `upto` is the number of sections).
+///
+/// Each coordinate moves its section's tip frame with the twist (v_tip, w): ∂p/∂q from
+/// the arc, and `w = (∂R/∂q Rᵀ)^∨` (redundancy paper eq. 5). Everything after the tip is
+/// rigid, so a point `x` further along moves with `v_tip + w × (x − p_tip)`; storing the
+/// origin form lets the caller add `w × x` once `x` is known.
+fn sweep<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    upto: usize,
+    jac: &mut DMatrix<f64>,
+) -> Frame {
+    let mut f = Frame::identity();
+    for i in 0..upto {
+        let st = state(model, q, i);
+        let (tip, d_pos, d_rot) = st.arc.frame_with_derivatives(1.0);
+        let v_local = d_pos * st.d_arc;
+        let z_tip = tip.rot.column(2).into_owned();
+        let w_local = d_rot * st.d_arc + z_tip * st.d_twist.transpose();
+        let p_tip = f.pos + f.rot * tip.pos;
+        for k in 0..3 {
+            let w = f.rot * w_local.column(k);
+            let v = f.rot * v_local.column(k) - w.cross(&p_tip);
+            let col = 3 * i + k;
+            jac.fixed_view_mut::<3, 1>(0, col).copy_from(&v);
+            jac.fixed_view_mut::<3, 1>(3, col).copy_from(&w);
+        }
+        f = f.compose(&tip).compose(&st.tail());
+    }
+    f
+}
+
+/// Forward kinematics and the 6×n Jacobian (rows vx, vy, vz, wx, wy, wz in the base
+/// frame; eq. 4–6) written into `jac`, in one pass. `q` must already be checked and
+/// `jac` be 6×n.
+pub fn forward_jacobian_into<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    jac: &mut DMatrix<f64>,
+) -> Frame {
+    let f = sweep(model, q, model.n_sections(), jac);
+    for col in 0..jac.ncols() {
+        let w = jac.fixed_view::<3, 1>(3, col).into_owned();
+        let mut v = jac.fixed_view_mut::<3, 1>(0, col);
+        v += w.cross(&f.pos);
+    }
+    f
+}
+
+/// The backbone point at fraction `s` of `section` and its 3×n Jacobian (planning paper
+/// eq. 5–6). Columns of later sections are zero. Arguments must already be checked.
+pub fn point_unchecked<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    section: usize,
+    s: f64,
+) -> (Vec3, Matrix3xX<f64>) {
+    let n = model.n_dofs();
+    let mut twists = DMatrix::zeros(6, n);
+    let f = sweep(model, q, section, &mut twists);
+    let st = state(model, q, section);
+    let pt = st.arc.point_with_derivatives(s);
+    let point = f.pos + f.rot * pt.pos;
+    let mut jac = Matrix3xX::zeros(n);
+    for col in 0..3 * section {
+        let v = twists.fixed_view::<3, 1>(0, col);
+        let w = twists.fixed_view::<3, 1>(3, col);
+        jac.set_column(col, &(v + w.cross(&point)));
+    }
+    let own = f.rot * pt.d_params * st.d_arc;
+    jac.fixed_view_mut::<3, 3>(0, 3 * section).copy_from(&own);
+    (point, jac)
+}
+
+/// Backbone points: `samples` evenly spaced fractions (0 and 1 included) of each section.
+pub fn backbone_unchecked<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    samples: usize,
+) -> Vec<Vec3> {
+    let n = model.n_sections();
+    let mut out = Vec::with_capacity(n * samples);
+    let mut f = Frame::identity();
+    let denom = (samples.max(2) - 1) as f64;
+    for i in 0..n {
+        let st = state(model, q, i);
+        for j in 0..samples {
+            let s = if samples == 1 { 1.0 } else { j as f64 / denom };
+            out.push(f.pos + f.rot * st.arc.point(s));
+        }
+        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+    }
+    out
+}
+
+/// The arc of `section` expressed in the base frame: its base frame and parameters.
+/// Used by distance queries, which need the arc as a geometric object.
+pub fn section_arc_unchecked<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    section: usize,
+) -> (Frame, ArcParams) {
+    let mut f = Frame::identity();
+    for i in 0..section {
+        let st = state(model, q, i);
+        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+    }
+    (f, state(model, q, section).arc)
+}
+
+/// Allocating, checked forward kinematics as a 4×4 matrix.
+pub fn forward<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<Mat4> {
+    check_q(model, q)?;
+    Ok(forward_unchecked(model, q).to_matrix())
+}
+
+/// Allocating, checked 6×n Jacobian.
+pub fn jacobian<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<DMatrix<f64>> {
+    check_q(model, q)?;
+    let mut jac = DMatrix::zeros(6, model.n_dofs());
+    forward_jacobian_into(model, q, &mut jac);
+    Ok(jac)
+}
+
+/// Checked forward kinematics and Jacobian together.
+pub fn forward_jacobian<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+) -> Result<(Mat4, DMatrix<f64>)> {
+    check_q(model, q)?;
+    let mut jac = DMatrix::zeros(6, model.n_dofs());
+    let f = forward_jacobian_into(model, q, &mut jac);
+    Ok((f.to_matrix(), jac))
+}
+
+/// Checked backbone point and its Jacobian.
+pub fn point<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    section: usize,
+    s: f64,
+) -> Result<(Vec3, Matrix3xX<f64>)> {
+    check_q(model, q)?;
+    check_point_args(model, section, s)?;
+    Ok(point_unchecked(model, q, section, s))
+}
+
+/// Checked frames as 4×4 matrices.
+pub fn frames<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<Vec<Mat4>> {
+    check_q(model, q)?;
+    Ok(frames_unchecked(model, q)
+        .iter()
+        .map(Frame::to_matrix)
+        .collect())
+}
+
+/// Checked backbone sampling.
+pub fn backbone<M: SectionModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    samples: usize,
+) -> Result<Vec<Vec3>> {
+    check_q(model, q)?;
+    if samples < 2 {
+        return Err(Error::OutOfRange {
+            arg: "samples".into(),
+            value: samples as f64,
+            min: 2.0,
+            max: f64::INFINITY,
+        });
+    }
+    Ok(backbone_unchecked(model, q, samples))
+}

@@ -1,0 +1,187 @@
+//! Type aliases, the rigid frame type, and the even "sinc-like" functions that make the
+//! constant-curvature arc exact and smooth through zero bending.
+
+use nalgebra::{Matrix3, Matrix4, Vector3};
+
+/// 3-vector of f64.
+pub type Vec3 = Vector3<f64>;
+/// 3×3 matrix of f64.
+pub type Mat3 = Matrix3<f64>;
+/// 4×4 homogeneous matrix of f64.
+pub type Mat4 = Matrix4<f64>;
+
+/// A rigid transform kept as rotation + translation (cheaper to compose than a 4×4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Rotation block.
+    pub rot: Mat3,
+    /// Translation.
+    pub pos: Vec3,
+}
+
+impl Frame {
+    /// The identity transform.
+    pub fn identity() -> Self {
+        Frame {
+            rot: Mat3::identity(),
+            pos: Vec3::zeros(),
+        }
+    }
+
+    /// `self · other`.
+    #[inline]
+    pub fn compose(&self, other: &Frame) -> Frame {
+        Frame {
+            rot: self.rot * other.rot,
+            pos: self.pos + self.rot * other.pos,
+        }
+    }
+
+    /// The 4×4 homogeneous matrix.
+    pub fn to_matrix(&self) -> Mat4 {
+        let mut m = Mat4::identity();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.rot);
+        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&self.pos);
+        m
+    }
+
+    /// Translation along z by `dz` followed by rotation about z by `angle`
+    /// (the two commute), the plate offset of eq. (3).
+    #[inline]
+    pub fn z_offset(dz: f64, angle: f64) -> Frame {
+        Frame {
+            rot: rot_z(angle),
+            pos: Vec3::new(0.0, 0.0, dz),
+        }
+    }
+}
+
+/// Rotation about z by `angle`.
+#[inline]
+pub fn rot_z(angle: f64) -> Mat3 {
+    let (s, c) = angle.sin_cos();
+    Mat3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+/// The skew-symmetric matrix `[v]×` with `[v]× w = v × w`.
+#[inline]
+pub fn skew(v: &Vec3) -> Mat3 {
+    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// Below this value of `x = t²` the closed forms lose digits to cancellation, so the
+/// Taylor series (accurate to machine precision there) is used instead.
+const SERIES_BELOW: f64 = 0.25;
+
+/// Values of the even functions of `t` used by the arc, all as functions of `x = t²`:
+/// `f1 = sin t / t`, `f2 = (1 − cos t)/t²`, `f3 = (t − sin t)/t³`,
+/// and the derivatives `g1 = df1/dx`, `g2 = df2/dx`.
+#[derive(Debug, Clone, Copy)]
+pub struct ArcFunctions {
+    /// sin t / t
+    pub f1: f64,
+    /// (1 − cos t) / t²
+    pub f2: f64,
+    /// (t − sin t) / t³
+    pub f3: f64,
+    /// d f1 / d(t²)
+    pub g1: f64,
+    /// d f2 / d(t²)
+    pub g2: f64,
+}
+
+impl ArcFunctions {
+    /// Evaluates all functions at `x = t² ≥ 0`. Exact limits at `x = 0`, no NaN.
+    #[inline]
+    pub fn at(x: f64) -> Self {
+        if x < SERIES_BELOW {
+            // Horner forms of the Maclaurin series in x; at x < 0.25 the first omitted
+            // term is below 1e-17 relative.
+            let f1 = 1.0
+                + x * (-1.0 / 6.0
+                    + x * (1.0 / 120.0
+                        + x * (-1.0 / 5040.0 + x * (1.0 / 362_880.0 - x / 39_916_800.0))));
+            let f2 = 0.5
+                + x * (-1.0 / 24.0
+                    + x * (1.0 / 720.0
+                        + x * (-1.0 / 40_320.0 + x * (1.0 / 3_628_800.0 - x / 479_001_600.0))));
+            let f3 = 1.0 / 6.0
+                + x * (-1.0 / 120.0
+                    + x * (1.0 / 5040.0
+                        + x * (-1.0 / 362_880.0 + x * (1.0 / 39_916_800.0 - x / 6_227_020_800.0))));
+            let g1 = -1.0 / 6.0
+                + x * (2.0 / 120.0
+                    + x * (-3.0 / 5040.0
+                        + x * (4.0 / 362_880.0
+                            + x * (-5.0 / 39_916_800.0 + 6.0 * x / 6_227_020_800.0))));
+            let g2 = -1.0 / 24.0
+                + x * (2.0 / 720.0
+                    + x * (-3.0 / 40_320.0
+                        + x * (4.0 / 3_628_800.0
+                            + x * (-5.0 / 479_001_600.0 + 6.0 * x / 87_178_291_200.0))));
+            ArcFunctions { f1, f2, f3, g1, g2 }
+        } else {
+            let t = x.sqrt();
+            let (s, c) = t.sin_cos();
+            let f1 = s / t;
+            let f2 = (1.0 - c) / x;
+            let f3 = (t - s) / (x * t);
+            // d/dx = (1 / 2t) d/dt
+            let g1 = (t * c - s) / (2.0 * x * t);
+            let g2 = (t * s - 2.0 * (1.0 - c)) / (2.0 * x * x);
+            ArcFunctions { f1, f2, f3, g1, g2 }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn closed(x: f64) -> ArcFunctions {
+        let t = x.sqrt();
+        let (s, c) = t.sin_cos();
+        ArcFunctions {
+            f1: s / t,
+            f2: (1.0 - c) / x,
+            f3: (t - s) / (x * t),
+            g1: (t * c - s) / (2.0 * x * t),
+            g2: (t * s - 2.0 * (1.0 - c)) / (2.0 * x * x),
+        }
+    }
+
+    #[test]
+    fn series_matches_closed_form_at_the_switch() {
+        for &x in &[0.2, 0.249_999, 0.25] {
+            let a = ArcFunctions::at(x);
+            let b = closed(x);
+            assert_relative_eq!(a.f1, b.f1, max_relative = 1e-13);
+            assert_relative_eq!(a.f2, b.f2, max_relative = 1e-13);
+            assert_relative_eq!(a.f3, b.f3, max_relative = 1e-11);
+            assert_relative_eq!(a.g1, b.g1, max_relative = 1e-11);
+            assert_relative_eq!(a.g2, b.g2, max_relative = 1e-10);
+        }
+    }
+
+    #[test]
+    fn limits_at_zero_are_exact() {
+        let a = ArcFunctions::at(0.0);
+        assert_eq!(a.f1, 1.0);
+        assert_eq!(a.f2, 0.5);
+        assert_eq!(a.f3, 1.0 / 6.0);
+        assert_eq!(a.g1, -1.0 / 6.0);
+        assert_eq!(a.g2, -1.0 / 24.0);
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        for &x in &[0.01, 0.1, 0.3, 1.0, 2.5, 6.0] {
+            let h = 1e-6;
+            let (p, m) = (ArcFunctions::at(x + h), ArcFunctions::at(x - h));
+            let a = ArcFunctions::at(x);
+            assert_relative_eq!(a.g1, (p.f1 - m.f1) / (2.0 * h), epsilon = 1e-8);
+            assert_relative_eq!(a.g2, (p.f2 - m.f2) / (2.0 * h), epsilon = 1e-8);
+        }
+    }
+}
