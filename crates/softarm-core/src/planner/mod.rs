@@ -5,11 +5,13 @@
 //! ```
 //!
 //! The tip is attracted to the goal, `F_e(V_e) = k_a V_e` saturated at `max_tip_step`; the
-//! arm point closest to obstacle `j` is repelled, `F_sj = k_r (1/d − 1/ρ0) V̂_sj` for
-//! `d < ρ0` (Khatib's potential, the minus sign in eq. 9 pushes the point away from the
-//! obstacle), through the damped pseudo-inverse `Jᵀ (J Jᵀ + λ² I)⁻¹` of the 3×n point
-//! Jacobian (eq. 8). Each step is scaled so that no coordinate moves by more than
-//! `max_step_fraction` of its range, then clamped to the model's limits. The loop ends when
+//! arm point closest to obstacle `j` is repelled, `F_sj = k_r (1/d − 1/ρ0) V̂_sj / d²` for
+//! `d < ρ0` (the gradient of Khatib's potential; the minus sign in eq. 9 pushes the point
+//! away from the obstacle), through the damped pseudo-inverse `Jᵀ (J Jᵀ + λ² I)⁻¹` of the
+//! 3×n point Jacobian (eq. 8). Coordinates at a limit that the step would push further are
+//! frozen and the step recomputed without them; the step is then scaled so that no
+//! coordinate moves by more than `max_step_fraction` of its range, and clamped to the
+//! model's limits. The loop ends when
 //! the tip is within `goal_tolerance` of the goal, when it has moved less than
 //! `stall_tolerance` over `stall_window` iterations, or after `max_iterations`.
 //!
@@ -19,6 +21,7 @@
 //! the whole backbone (every arc) to every obstacle, at every configuration of the path.
 
 mod options;
+pub mod scenarios;
 
 pub use options::{PlannerOptions, Termination};
 
@@ -112,31 +115,28 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
         let mut jac = DMatrix::zeros(6, n);
         let mut path = vec![q.clone()];
         let mut arcs = placed_arcs(model, &q);
-        let mut min_clearance = clearance(&arcs, obstacles);
+        // Exact closest pairs at the current configuration: they give the clearance of the
+        // whole backbone and, for the proposed method, the repulsion points of the next step.
+        let mut hits: Vec<Closest> = obstacles.iter().map(|ob| closest_to_arcs(&arcs, ob)).collect();
+        let mut min_clearance = min_distance(&hits);
         let mut tip = forward_jacobian_into(model, &q, &mut jac).pos;
         let mut tip_path = vec![tip];
         let mut termination = Termination::IterationLimit;
         let mut iterations = 0;
         let mut dq = vec![0.0; n];
+        let mut free = vec![true; n];
+        let mut repulsions: Vec<(Matrix3xX<f64>, Vec3)> = Vec::with_capacity(obstacles.len());
         while iterations < o.max_iterations {
             let err = goal - tip;
             if err.norm() <= o.goal_tolerance {
                 termination = Termination::Reached;
                 break;
             }
-            // Attraction: J_e⁺ F_e(V_e).
-            let mut dx = err * o.attraction_gain;
-            let len = dx.norm();
-            if len > o.max_tip_step {
-                dx *= o.max_tip_step / len;
-            }
-            let je = jac.fixed_rows::<3>(0).into_owned();
-            dq.iter_mut().for_each(|v| *v = 0.0);
-            add_pinv(&je, &dx, o.damping, 1.0, &mut dq);
-            // Repulsion: − Σ_j J_sj⁺ F_sj(V_sj).
-            for ob in obstacles {
+            // Repulsion directions first: the closest arm point of each obstacle.
+            repulsions.clear();
+            for (ob, hit) in obstacles.iter().zip(&hits) {
                 let c = match o.arm_samples {
-                    None => closest_to_arcs(&arcs, ob),
+                    None => *hit,
                     Some(m) => closest_sampled(&arcs, m, ob),
                 };
                 if c.distance >= o.influence_distance {
@@ -147,10 +147,39 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
                 if d == 0.0 {
                     continue;
                 }
-                let mag = o.repulsion_gain * (1.0 / d.max(1e-6) - 1.0 / o.influence_distance);
-                let f = v * (mag / d);
+                let dd = d.max(1e-6);
+                let mag = o.repulsion_gain * (1.0 / dd - 1.0 / o.influence_distance) / (dd * dd);
                 let (_, js) = point_unchecked(model, &q, c.section, c.s);
-                add_pinv(&js, &f, o.damping, -1.0, &mut dq);
+                repulsions.push((js, v * (mag / d)));
+            }
+            let mut dx = err * o.attraction_gain;
+            let len = dx.norm();
+            if len > o.max_tip_step {
+                dx *= o.max_tip_step / len;
+            }
+            let je = jac.fixed_rows::<3>(0).into_owned();
+            // Coordinates at a limit that the step pushes further are frozen and the step is
+            // recomputed without them (projection onto the feasible set).
+            free.iter_mut().for_each(|f| *f = true);
+            for _ in 0..4 {
+                dq.iter_mut().for_each(|v| *v = 0.0);
+                // Attraction: J_e⁺ F_e(V_e).
+                add_pinv(&je, &free, &dx, o.damping, 1.0, &mut dq);
+                // Repulsion: − Σ_j J_sj⁺ F_sj(V_sj).
+                for (js, f) in &repulsions {
+                    add_pinv(js, &free, f, o.damping, -1.0, &mut dq);
+                }
+                let mut changed = false;
+                for i in 0..n {
+                    let blocked = (q[i] <= lo[i] && dq[i] < 0.0) || (q[i] >= hi[i] && dq[i] > 0.0);
+                    if free[i] && blocked {
+                        free[i] = false;
+                        changed = true;
+                    }
+                }
+                if !changed {
+                    break;
+                }
             }
             // Step limits, then the configuration limits.
             let mut scale: f64 = 1.0;
@@ -164,7 +193,10 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
             }
             iterations += 1;
             arcs = placed_arcs(model, &q);
-            min_clearance = min_clearance.min(clearance(&arcs, obstacles));
+            for (hit, ob) in hits.iter_mut().zip(obstacles) {
+                *hit = closest_to_arcs(&arcs, ob);
+            }
+            min_clearance = min_clearance.min(min_distance(&hits));
             tip = forward_jacobian_into(model, &q, &mut jac).pos;
             path.push(q.clone());
             tip_path.push(tip);
@@ -190,9 +222,22 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
     }
 }
 
-/// `dq += sign · Jᵀ (J Jᵀ + λ² I)⁻¹ f` (eq. 8, damped).
-fn add_pinv(j: &Matrix3xX<f64>, f: &Vec3, damping: f64, sign: f64, dq: &mut [f64]) {
-    let jjt: Matrix3<f64> = j * j.transpose() + Matrix3::identity() * (damping * damping);
+/// `dq += sign · Jᵀ (J Jᵀ + λ² I)⁻¹ f` (eq. 8, damped), using only the `free` columns.
+fn add_pinv(
+    j: &Matrix3xX<f64>,
+    free: &[bool],
+    f: &Vec3,
+    damping: f64,
+    sign: f64,
+    dq: &mut [f64],
+) {
+    let mut j = j.clone();
+    for (k, &ok) in free.iter().enumerate() {
+        if !ok {
+            j.column_mut(k).fill(0.0);
+        }
+    }
+    let jjt: Matrix3<f64> = &j * j.transpose() + Matrix3::identity() * (damping * damping);
     let Some(chol) = jjt.cholesky() else {
         return;
     };
@@ -201,6 +246,10 @@ fn add_pinv(j: &Matrix3xX<f64>, f: &Vec3, damping: f64, sign: f64, dq: &mut [f64
     for (d, s) in dq.iter_mut().zip(step.iter()) {
         *d += sign * s;
     }
+}
+
+fn min_distance(hits: &[Closest]) -> f64 {
+    hits.iter().map(|h| h.distance).fold(f64::INFINITY, f64::min)
 }
 
 /// Exact clearance of the whole backbone: the smallest distance of any arc to any obstacle.

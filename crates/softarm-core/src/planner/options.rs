@@ -31,7 +31,7 @@ pub struct PlannerOptions {
     pub attraction_gain: f64,
     /// Largest commanded tip displacement per iteration (m).
     pub max_tip_step: f64,
-    /// `k_r` in `F_s = k_r (1/d − 1/ρ0) V̂` (m²).
+    /// `k_r` in `F_s = k_r (1/d − 1/ρ0) V̂ / d²` (m⁴).
     pub repulsion_gain: f64,
     /// Influence distance `ρ0`: obstacles farther than this exert no force (m).
     pub influence_distance: f64,
@@ -57,10 +57,10 @@ impl Default for PlannerOptions {
     fn default() -> Self {
         PlannerOptions {
             attraction_gain: 0.5,
-            max_tip_step: 0.08,
-            repulsion_gain: 0.01,
-            influence_distance: 0.3,
-            max_step_fraction: 0.02,
+            max_tip_step: 0.15,
+            repulsion_gain: 3e-5,
+            influence_distance: 0.1,
+            max_step_fraction: 0.04,
             damping: 0.05,
             goal_tolerance: 0.01,
             max_iterations: 500,
