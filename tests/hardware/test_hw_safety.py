@@ -98,7 +98,7 @@ def test_watchdog_vents_when_commands_stop(clock: FakeClock, caplog) -> None:
 
 
 def test_late_command_is_preceded_by_a_watchdog_vent(clock: FakeClock) -> None:
-    safe, backend = make(clock)
+    safe, _ = make(clock)
     safe.set_pressures(np.zeros(9))
     ramp(safe, clock, np.full(9, 30.0), 5)
     clock.advance(2 * TIMEOUT)

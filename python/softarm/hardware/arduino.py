@@ -32,6 +32,16 @@ __all__ = ["ArduinoLink"]
 
 _log = logging.getLogger(__name__)
 
+# What a vanished port raises: pyserial wraps most OS errors, but tcflush on a hung-up
+# tty raises termios.error directly (POSIX only).
+_PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
+try:
+    import termios
+
+    _PORT_ERRORS = (*_PORT_ERRORS, termios.error)
+except ImportError:  # Windows
+    pass
+
 
 class ArduinoLink:
     """A request/reply session with the Arduino over a serial port.
@@ -99,7 +109,7 @@ class ArduinoLink:
                 _log.warning("%s on %s, attempt %d: %s", command, self.port, attempt + 1, exc)
                 last = exc
                 continue
-            except (serial.SerialException, OSError) as exc:
+            except _PORT_ERRORS as exc:
                 raise DisconnectedError(
                     f"serial port {self.port!r} disconnected during {command}: {exc}"
                 ) from exc
@@ -125,7 +135,7 @@ class ArduinoLink:
         """Close the port. Calling it twice is harmless."""
         try:
             self._serial.close()
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             _log.warning("closing %s: %s", self.port, exc)
 
     def __enter__(self) -> ArduinoLink:
