@@ -243,7 +243,7 @@ def _matrix(t: _Table, name: str, rows: int, cols: int | None = None) -> Any:
 
 
 def _pose(t: _Table, name: str) -> Matrix | None:
-    m = _matrix(t, name, 4, 4)
+    m: Matrix | None = _matrix(t, name, 4, 4)
     if m is None:
         return None
     if m[3] != (0.0, 0.0, 0.0, 1.0):

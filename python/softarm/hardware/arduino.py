@@ -23,6 +23,7 @@ from softarm.hardware.serial_protocol import (
     DeviceError,
     DisconnectedError,
     FrameError,
+    Reply,
     SerialTimeoutError,
     decode_reply,
     encode_frame,
@@ -154,7 +155,7 @@ class ArduinoLink:
         self._seq = (self._seq + 1) % SEQ_MODULUS
         return seq
 
-    def _await(self, seq: int, command: str) -> Any:
+    def _await(self, seq: int, command: str) -> Reply:
         deadline = time.monotonic() + self._timeout
         while (remaining := deadline - time.monotonic()) > 0.0:
             self._serial.timeout = remaining
