@@ -11,6 +11,8 @@ Framing (NMEA-like, one frame per line, ASCII, ``\\n``-terminated)::
 * ``<HH>``: two upper-case hex digits, the XOR of every byte between ``$`` and ``*``.
 * Fields never contain ``$``, ``*``, ``,`` or line breaks. ``\\r`` before ``\\n`` is ignored.
 
+Example: ``$0,PING*0C`` is answered by ``$0,OK,softarm-arduino,1*1E``.
+
 Commands (all idempotent — absolute set-points or reads — so a retry is always safe):
 
 ========== ================ ===========================================================
