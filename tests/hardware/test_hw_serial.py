@@ -60,6 +60,11 @@ def test_encode_rejects_reserved_characters_and_bad_seq() -> None:
         encode_frame(256, "PING")
 
 
+def test_documented_example_frames() -> None:
+    assert encode_frame(0, "PING") == b"$0,PING*0C\n"
+    assert decode_reply(b"$0,OK,softarm-arduino,1*1E\n").values == ["softarm-arduino", "1"]
+
+
 def test_reply_status() -> None:
     assert decode_reply(encode_frame(3, "OK", "1.5")).values == ["1.5"]
     assert not decode_reply(encode_frame(3, "ERR", "RANGE")).ok
