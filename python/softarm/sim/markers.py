@@ -94,3 +94,15 @@ def marker_texture(
     out = np.pad(big, pad, constant_values=1.0)
     out.setflags(write=False)
     return out
+
+
+def cube_scene_markers(
+    markers: dict[int, FloatArray],
+    marker_length: float,
+    dictionary: str,
+    T_camera_cube: npt.ArrayLike,
+    border: float | None = None,
+) -> list[SceneMarker]:
+    """Scene markers of a marker cube (``MarkerCube.markers``) posed at ``T_camera_cube``."""
+    pose = as_pose(T_camera_cube, "T_camera_cube")
+    return [SceneMarker(i, dictionary, marker_length, pose @ m, border) for i, m in markers.items()]

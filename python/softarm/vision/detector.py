@@ -40,7 +40,7 @@ class Detection:
 
 @dataclass(frozen=True)
 class MarkerPose:
-    """A solution of a single-marker PnP: ``T_camera_marker`` and its RMS reprojection error (px)."""
+    """One single-marker PnP solution: ``T_camera_marker`` and its RMS reprojection error (px)."""
 
     T_camera_marker: FloatArray
     rms: float
