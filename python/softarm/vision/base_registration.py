@@ -51,7 +51,7 @@ class BaseRegistration:
 
     def observe(self, image: npt.NDArray[Any] | None) -> FloatArray | None:
         """``T_base_camera`` from this frame alone, or None if the tag is not seen."""
-        for det in self.detector.detect(image):
+        for det in self.detector.detect(image, self.camera):
             if det.marker_id != self.tag_id:
                 continue
             sols = square_marker_poses(det.corners, self.camera, self.tag_length)

@@ -121,7 +121,7 @@ class MarkerCube:
 
         ``previous`` (a recent ``T_camera_cube``) resolves the single-face ambiguity.
         """
-        est = self.estimate(self.detector.detect(image), camera, previous)
+        est = self.estimate(self.detector.detect(image, camera), camera, previous)
         return None if est is None else est.T_camera_cube
 
     def estimate(

@@ -22,6 +22,7 @@ from softarm.vision._checks import FloatArray, as_gray, positive
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.poses import pose_from_rvec_tvec
+from softarm.vision.refine import refine_marker_corners
 
 
 def marker_object_points(marker_length: float) -> FloatArray:
@@ -59,29 +60,49 @@ def default_parameters() -> cv2.aruco.DetectorParameters:
 class MarkerDetector:
     """Finds markers of one ArUco ``dictionary`` (a name such as ``"DICT_4X4_50"``).
 
-    ``parameters`` defaults to :func:`default_parameters` (sub-pixel refinement).
+    ``parameters`` defaults to :func:`default_parameters` (sub-pixel refinement). With
+    ``refine_edges`` (default), corners are further refined from the marker's four sides
+    (:mod:`softarm.vision.refine`) when :meth:`detect` is given the camera model.
     """
 
-    def __init__(self, dictionary: str = "DICT_4X4_50", parameters: Any | None = None) -> None:
+    def __init__(
+        self,
+        dictionary: str = "DICT_4X4_50",
+        parameters: Any | None = None,
+        refine_edges: bool = True,
+    ) -> None:
         self.dictionary = dictionary
+        self.refine_edges = bool(refine_edges)
+        self._cells = int(get_dictionary(dictionary).markerSize) + 2
         self._detector = cv2.aruco.ArucoDetector(
             get_dictionary(dictionary),
             default_parameters() if parameters is None else parameters,
         )
 
-    def detect(self, image: npt.NDArray[Any] | None) -> list[Detection]:
+    def detect(
+        self, image: npt.NDArray[Any] | None, camera: CameraModel | None = None
+    ) -> list[Detection]:
         """Detect markers in a uint8 gray or BGR(A) ``image``; [] when there are none.
 
-        Raises :class:`~softarm.errors.VisionError` for None, empty or malformed frames.
+        ``camera`` enables the edge-based corner refinement (its distortion straightens
+        the sides). Raises :class:`~softarm.errors.VisionError` for None, empty or
+        malformed frames.
         """
         gray = as_gray(image)
         corners, ids, _ = self._detector.detectMarkers(gray)
         if ids is None or len(ids) == 0:
             return []
-        return [
+        out = [
             Detection(int(i), np.asarray(c, dtype=np.float64).reshape(4, 2))
             for c, i in zip(corners, np.ravel(ids), strict=True)
         ]
+        if self.refine_edges and camera is not None:
+            fimg = gray.astype(np.float32)
+            out = [
+                Detection(d.marker_id, refine_marker_corners(fimg, d.corners, camera, self._cells))
+                for d in out
+            ]
+        return out
 
 
 def square_marker_poses(
