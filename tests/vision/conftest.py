@@ -3,7 +3,6 @@ its synthetic renderer, built once per session (the undistortion table takes ~0.
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from softarm.sim.camera import SyntheticCamera
@@ -30,10 +29,3 @@ def clean_renderer(camera: CameraModel) -> SyntheticCamera:
 @pytest.fixture(scope="session")
 def cube() -> MarkerCube:
     return MarkerCube.standard()
-
-
-def facing(distance: float, x: float = 0.0, y: float = 0.0) -> np.ndarray:
-    """A marker pose facing the camera (marker z towards it, marker y up)."""
-    pose = np.diag([1.0, -1.0, -1.0, 1.0])
-    pose[:3, 3] = [x, y, distance]
-    return pose

@@ -78,5 +78,5 @@ def test_weights_ignore_an_outlier() -> None:
     ],
 )
 def test_bad_input(src: np.ndarray, dst: np.ndarray, err: type[Exception]) -> None:
-    with pytest.raises(err, match="source|target|collinear"):
+    with pytest.raises(err, match=r"source|target|collinear"):
         register_points(src, dst)

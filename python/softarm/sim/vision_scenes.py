@@ -46,3 +46,11 @@ def random_facing_pose(
     z = rng.uniform(*distance)
     pose[:3, 3] = [rng.uniform(-0.1, 0.1) * z, rng.uniform(-0.1, 0.1) * z, z]
     return pose
+
+
+def facing_pose(distance: float, x: float = 0.0, y: float = 0.0) -> FloatArray:
+    """``T_camera_marker`` of a tag facing the camera squarely (marker z towards it, marker
+    y up) at (x, y, distance) in the camera frame."""
+    pose = np.diag([1.0, -1.0, -1.0, 1.0])
+    pose[:3, 3] = [x, y, distance]
+    return pose

@@ -3,7 +3,7 @@
 ``cornerSubPix`` (OpenCV's ``CORNER_REFINE_SUBPIX``) is built for saddle corners; on the
 convex corner of a marker's black square it leaves a bias of about 0.1–0.2 px. Here each
 side of the square is located instead: along the side, the intensity profile across it is
-sampled (bilinear) and the edge is the centroid of the squared gradient, which for a
+sampled (bilinear) and the edge is the centroid of the (signed) gradient, which for a
 blurred, anti-aliased step is the step's position. The edge points are undistorted to
 normalised coordinates, where the sides are straight lines (pinhole projection of a
 straight edge), a line is fitted to each side (total least squares), and adjacent lines
@@ -59,16 +59,21 @@ def refine_marker_corners(
     ):
         return quad
     prof = cv2.remap(gray, pts[..., 0], pts[..., 1], cv2.INTER_LINEAR)  # (N, m)
-    grad = np.diff(prof, axis=1) ** 2  # squared gradient between samples
+    # Signed gradient: for a box-filtered step sampled bilinearly its centroid is exactly the
+    # step position (a squared or absolute gradient is biased by the sub-pixel phase or by
+    # noise), and pixel noise adds zero-mean terms only.
+    grad = np.diff(prof, axis=1)
     mid = 0.5 * (offsets[1:] + offsets[:-1])
     wsum = grad.sum(axis=1)
-    shift = (grad @ mid) / np.where(wsum > 0, wsum, 1.0)  # edge offset along the normal
+    contrast = np.abs(wsum)
+    ok_edge = contrast > 0.25 * np.median(contrast)
+    shift = (grad @ mid) / np.where(ok_edge, wsum, 1.0)  # edge offset along the normal
     start = 0
     for k in range(4):
         n = counts[k]
         base = pts[start : start + n, 0].astype(np.float64) + reach * normals[k]
         edge = base + shift[start : start + n, None] * normals[k]
-        good = wsum[start : start + n] > 0
+        good = ok_edge[start : start + n] & (np.abs(shift[start : start + n]) < reach)
         start += n
         if good.sum() < 4:
             return quad

@@ -1,0 +1,85 @@
+import numpy as np
+import pytest
+
+from softarm.errors import ParameterError, VisionError
+from softarm.sim.camera import SyntheticCamera
+from softarm.sim.markers import SceneMarker, cube_scene_markers
+from softarm.sim.vision_scenes import facing_pose as facing
+from softarm.sim.vision_scenes import random_cube_pose
+from softarm.vision import CameraModel, CubeTracker, MarkerCube, OpenCVBaseline
+from softarm.vision.poses import rotation_angle
+
+
+def _scene(cube: MarkerCube, pose: np.ndarray) -> list[SceneMarker]:
+    return cube_scene_markers(cube.markers, cube.marker_length, cube.dictionary, pose)
+
+
+def test_standard_cube_geometry() -> None:
+    cube = MarkerCube.standard(0.08)
+    assert sorted(cube.markers) == [0, 1, 2, 3]
+    for pose in cube.markers.values():
+        assert np.linalg.norm(pose[:3, 3]) == pytest.approx(0.05)
+        np.testing.assert_allclose(pose[:3, 2], pose[:3, 3] / 0.05)  # z out of the face
+        np.testing.assert_allclose(pose[:3, 1], [0, 0, 1])
+
+
+def test_pose_accuracy_and_better_than_opencv(
+    camera: CameraModel, renderer: SyntheticCamera, cube: MarkerCube
+) -> None:
+    rng = np.random.default_rng(3)
+    baseline = OpenCVBaseline(cube)
+    ours, theirs, angles = [], [], []
+    for _ in range(12):
+        pose = random_cube_pose(rng)
+        img = renderer.render(_scene(cube, pose))
+        est = cube.estimate_pose(img, camera)
+        ref = baseline.estimate_pose(img, camera)
+        assert est is not None and ref is not None
+        ours.append(np.linalg.norm(est[:3, 3] - pose[:3, 3]))
+        theirs.append(np.linalg.norm(ref[:3, 3] - pose[:3, 3]))
+        angles.append(np.degrees(rotation_angle(est, pose)))
+    assert np.median(ours) < 1e-3
+    assert np.median(angles) < 0.5
+    assert np.median(ours) < np.median(theirs)
+
+
+def test_single_face_ambiguity_resolved_by_previous_pose(
+    camera: CameraModel, clean_renderer: SyntheticCamera, cube: MarkerCube
+) -> None:
+    # One face nearly frontal and far: both IPPE solutions fit the corners.
+    pose = facing(2.5) @ np.linalg.inv(cube.markers[0])
+    tilt = np.eye(4)
+    c, s = np.cos(0.12), np.sin(0.12)
+    tilt[:3, :3] = [[c, 0, s], [0, 1, 0], [-s, 0, c]]
+    pose = tilt @ pose
+    img = clean_renderer.render(_scene(cube, pose))
+    dets = cube.detector.detect(img, camera)
+    assert [d.marker_id for d in dets] == [0]
+    est = cube.estimate_pose(img, camera, previous=pose)
+    assert est is not None
+    assert np.degrees(rotation_angle(est, pose)) < 1.0
+    tracker = CubeTracker(cube, camera)
+    tracker.last = pose
+    assert np.degrees(rotation_angle(tracker.update(img), pose)) < 1.0
+
+
+def test_no_cube_marker_gives_none(
+    camera: CameraModel, renderer: SyntheticCamera, cube: MarkerCube
+) -> None:
+    img = renderer.render([SceneMarker(30, "DICT_4X4_50", 0.08, facing(0.8))])
+    assert cube.estimate_pose(img, camera) is None
+    wrong = renderer.render([SceneMarker(0, "DICT_5X5_50", 0.08, facing(0.8))])
+    assert cube.estimate_pose(wrong, camera) is None
+    with pytest.raises(VisionError):
+        cube.estimate_pose(None, camera)
+
+
+def test_bad_cube_definitions() -> None:
+    with pytest.raises(ParameterError, match="markers"):
+        MarkerCube({}, 0.08)
+    with pytest.raises(ParameterError, match="marker id"):
+        MarkerCube({99: np.eye(4)}, 0.08)
+    with pytest.raises(ParameterError, match="cube_size"):
+        MarkerCube.standard(0.08, cube_size=0.05)
+    with pytest.raises(ParameterError, match="dictionary"):
+        MarkerCube.standard(dictionary="DICT_NOPE")
