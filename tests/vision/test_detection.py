@@ -7,7 +7,7 @@ from softarm.sim.markers import SceneMarker
 from softarm.sim.vision_scenes import facing_pose as facing
 from softarm.sim.vision_scenes import random_facing_pose
 from softarm.vision import CameraModel, MarkerDetector, estimate_marker_poses
-from softarm.vision.detector import marker_object_points
+from softarm.vision.detector import marker_object_points, square_marker_poses
 from softarm.vision.poses import rotation_angle, transform_points
 
 
@@ -70,3 +70,12 @@ def test_no_markers_and_wrong_dictionary(renderer: SyntheticCamera) -> None:
     img = renderer.render([SceneMarker(3, "DICT_6X6_50", 0.08, facing(0.6))])
     assert MarkerDetector("DICT_4X4_50").detect(img) == []
     assert [d.marker_id for d in MarkerDetector("DICT_6X6_50").detect(img)] == [3]
+
+
+def test_exactly_frontal_marker_pose(camera: CameraModel) -> None:
+    """IPPE degenerates for an exactly fronto-parallel square; the fallback must not."""
+    pose = facing(0.8, 0.08)
+    corners = camera.project(transform_points(pose, marker_object_points(0.08)))
+    best = square_marker_poses(corners, camera, 0.08)[0]
+    assert best.rms < 1e-3
+    assert np.degrees(rotation_angle(best.T_camera_marker, pose)) < 0.1

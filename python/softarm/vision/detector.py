@@ -24,6 +24,9 @@ from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.poses import pose_from_rvec_tvec
 from softarm.vision.refine import refine_marker_corners
 
+# A best IPPE solution worse than this (px RMS) triggers the SQPNP fallback.
+FALLBACK_RMS_PX = 1.0
+
 
 def marker_object_points(marker_length: float) -> FloatArray:
     """(4, 3) corners of a square marker in its own frame, in detection order."""
@@ -119,6 +122,16 @@ def square_marker_poses(
         MarkerPose(pose_from_rvec_tvec(rvecs[k], tvecs[k]), float(np.ravel(errs)[k]))
         for k in range(int(n))
     ]
+    if not out or min(p.rms for p in out) > FALLBACK_RMS_PX:
+        # IPPE degenerates for an exactly fronto-parallel square (it returns the pose
+        # turned 180° about the normal); SQPNP has no such case.
+        ok, rvec, tvec = cv2.solvePnP(
+            obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_SQPNP
+        )
+        if ok:
+            proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
+            rms = float(np.sqrt(np.mean(np.sum((proj - img).reshape(-1, 2) ** 2, axis=1))))
+            out.append(MarkerPose(pose_from_rvec_tvec(rvec, tvec), rms))
     return sorted(out, key=lambda p: p.rms)
 
 
