@@ -39,7 +39,7 @@ from softarm.vision.poses import (
 # A candidate whose RMS reprojection error is within this of the best one is "as good"
 # (planar ambiguity): then the previous pose decides. Errors are in pixels.
 AMBIGUITY_FACTOR = 2.0
-AMBIGUITY_MARGIN_PX = 0.2
+AMBIGUITY_MARGIN_PX = 0.05
 _LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
 
 

@@ -57,6 +57,11 @@ def default_parameters() -> cv2.aruco.DetectorParameters:
     params.cornerRefinementWinSize = 5
     params.cornerRefinementMaxIterations = 50
     params.cornerRefinementMinAccuracy = 0.001
+    # One adaptive-threshold pass (window 7 px) instead of three (3, 13, 23): a third of
+    # the detection time, and on synthetic 1280x720 frames it finds as many markers; the
+    # corners are re-measured from the edges afterwards anyway.
+    params.adaptiveThreshWinSizeMin = 7
+    params.adaptiveThreshWinSizeMax = 7
     return params
 
 
