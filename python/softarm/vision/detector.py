@@ -105,9 +105,8 @@ class MarkerDetector:
             for c, i in zip(corners, np.ravel(ids), strict=True)
         ]
         if self.refine_edges and camera is not None:
-            fimg = gray.astype(np.float32)
             out = [
-                Detection(d.marker_id, refine_marker_corners(fimg, d.corners, camera, self._cells))
+                Detection(d.marker_id, refine_marker_corners(gray, d.corners, camera, self._cells))
                 for d in out
             ]
         return out

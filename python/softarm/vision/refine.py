@@ -25,18 +25,18 @@ _MAX_SHIFT = 2.0  # px: a refined corner further than this from the detection is
 
 
 def refine_marker_corners(
-    gray: npt.NDArray[np.float32], corners: FloatArray, camera: CameraModel, cells: int
+    gray: npt.NDArray[np.uint8], corners: FloatArray, camera: CameraModel, cells: int
 ) -> FloatArray:
-    """Refined (4, 2) pixel corners of one marker (``cells`` = bits + 2 border cells);
-    returns ``corners`` unchanged if the edges cannot be measured."""
+    """Refined (4, 2) pixel corners of one marker in the 2-D ``gray`` image (``cells`` =
+    bits + 2 border cells); returns ``corners`` unchanged if the edges cannot be measured."""
     quad = np.asarray(corners, dtype=np.float64).reshape(4, 2)
     h, w = gray.shape
-    lines = []
     samples, normals, counts = [], [], []
     # Half-width of the profile: well inside the black border cell, whatever the view.
     widths = [np.linalg.norm(quad[k] - quad[(k + 1) % 4]) for k in range(4)]
     reach = float(np.clip(0.4 * min(widths) / cells, 1.0, 4.0))
-    offsets = np.arange(-reach, reach + 1e-9, _STEP)
+    reach = _STEP * round(reach / _STEP)  # so that the offsets are symmetric about 0
+    offsets = _STEP * np.arange(-round(reach / _STEP), round(reach / _STEP) + 1)
     for k in range(4):
         a, b = quad[k], quad[(k + 1) % 4]
         length = float(np.linalg.norm(b - a))
@@ -50,15 +50,15 @@ def refine_marker_corners(
         samples.append(base[:, None, :] + offsets[None, :, None] * normal)  # (n, m, 2)
         normals.append(normal)
         counts.append(len(fractions))
-    pts = np.concatenate(samples).astype(np.float32)  # (N, m, 2)
-    if (
-        pts[..., 0].min() < 0
-        or pts[..., 1].min() < 0
-        or pts[..., 0].max() > w - 1
-        or pts[..., 1].max() > h - 1
-    ):
+    pts64 = np.concatenate(samples)  # (N, m, 2) pixel positions of the profile samples
+    lo = np.floor(pts64.reshape(-1, 2).min(axis=0)).astype(int)
+    hi = np.ceil(pts64.reshape(-1, 2).max(axis=0)).astype(int)
+    if lo.min() < 0 or hi[0] > w - 1 or hi[1] > h - 1:
         return quad
-    prof = cv2.remap(gray, pts[..., 0], pts[..., 1], cv2.INTER_LINEAR)  # (N, m)
+    # Work on a float copy of the marker's neighbourhood only (a full-frame copy costs ~1 ms).
+    crop = gray[lo[1] : hi[1] + 1, lo[0] : hi[0] + 1].astype(np.float32)
+    pts = (pts64 - lo).astype(np.float32)
+    prof = cv2.remap(crop, pts[..., 0], pts[..., 1], cv2.INTER_LINEAR)  # (N, m)
     # Signed gradient: for a box-filtered step sampled bilinearly its centroid is exactly the
     # step position (a squared or absolute gradient is biased by the sub-pixel phase or by
     # noise), and pixel noise adds zero-mean terms only.
@@ -68,18 +68,19 @@ def refine_marker_corners(
     contrast = np.abs(wsum)
     ok_edge = contrast > 0.25 * np.median(contrast)
     shift = (grad @ mid) / np.where(ok_edge, wsum, 1.0)  # edge offset along the normal
-    start = 0
+    good = ok_edge & (np.abs(shift) < reach)
+    side = np.repeat(np.arange(4), counts)
+    centre_px = pts64[:, len(offsets) // 2]  # offsets is symmetric: its middle is 0
+    edge = centre_px + shift[:, None] * np.stack(normals)[side]
+    if np.any(np.bincount(side[good], minlength=4) < 4):
+        return quad
+    norm_pts = camera.normalize(edge[good])  # one call for all four sides
+    side = side[good]
+    lines = []
     for k in range(4):
-        n = counts[k]
-        base = pts[start : start + n, 0].astype(np.float64) + reach * normals[k]
-        edge = base + shift[start : start + n, None] * normals[k]
-        good = ok_edge[start : start + n] & (np.abs(shift[start : start + n]) < reach)
-        start += n
-        if good.sum() < 4:
-            return quad
-        norm_pts = camera.normalize(edge[good])
-        centre = norm_pts.mean(axis=0)
-        _, _, vt = np.linalg.svd(norm_pts - centre)
+        pts_k = norm_pts[side == k]
+        centre = pts_k.mean(axis=0)
+        _, _, vt = np.linalg.svd(pts_k - centre, full_matrices=False)
         lines.append((centre, vt[0]))  # point and direction of side k
     out = np.empty((4, 2))
     for k in range(4):
