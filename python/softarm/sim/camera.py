@@ -82,14 +82,16 @@ class SyntheticCamera:
         self.supersample = int(supersample)
         self.lighting = lighting or Lighting()
         self._rng = np.random.default_rng(seed)
+        self._bank: npt.NDArray[np.float32] | None = None
         # Normalised coordinates (x/z, y/z) of every pixel corner: pixel (r, c) spans
         # corners [r, r+1] x [c, c+1], i.e. pixel positions c - 0.5 .. c + 0.5.
         grid = np.stack(
             np.meshgrid(np.arange(self.width + 1) - 0.5, np.arange(self.height + 1) - 0.5), -1
         )
-        self._corners = model.normalize(grid.reshape(-1, 2)).reshape(grid.shape)
+        # float32 is ample: 6e-8 relative error is 5e-5 px at f = 900 px.
+        self._corners = model.normalize(grid.reshape(-1, 2)).reshape(grid.shape).astype(np.float32)
         s = self.supersample
-        self._offsets = (np.arange(s) + 0.5) / s  # sub-sample centres inside a pixel
+        self._offsets = ((np.arange(s) + 0.5) / s).astype(np.float32)  # sub-sample centres
 
     def render(
         self, scene: Scene | Sequence[SceneItem], background: float | None = None
@@ -109,8 +111,10 @@ class SyntheticCamera:
         if self.blur > 0:
             img = cv2.GaussianBlur(img, (0, 0), self.blur)
         if self.noise_std > 0:
-            img += self.noise_std * self._rng.standard_normal(img.shape, dtype=np.float32)
-        return np.clip(np.rint(img), 0, 255).astype(np.uint8)
+            img += np.float32(self.noise_std) * self._noise()
+        np.maximum(img, 0.0, out=img)
+        # Rounds to nearest and saturates at 255 (values are >= 0 here, so abs is a no-op).
+        return cv2.convertScaleAbs(img)
 
     def _draw(self, img: npt.NDArray[np.float32], item: SceneItem) -> None:
         pose = _pose_of(item)
@@ -140,18 +144,26 @@ class SyntheticCamera:
         rays = (top * (1 - b) + bot * b).reshape((y1 - y0) * s, (x1 - x0) * s, 2)
         # Ray-plane intersection as a homography: (u, v, 1) ∝ [r1 r2 t]⁻¹ (x, y, 1).
         hinv = np.linalg.inv(np.column_stack([rot[:, 0], rot[:, 1], t]))
-        x, y = rays[..., 0], rays[..., 1]
-        den = hinv[2, 0] * x + hinv[2, 1] * y + hinv[2, 2]
-        den = np.where(den > 1e-12, den, np.nan)  # rays that miss the plane (behind it)
-        u = (hinv[0, 0] * x + hinv[0, 1] * y + hinv[0, 2]) / den
-        v = (hinv[1, 0] * x + hinv[1, 1] * y + hinv[1, 2]) / den
         tex = item.texture
         th, tw = tex.shape
-        # Texel centres sit at integer map coordinates (cv2.remap convention).
-        mx = ((u / item.width + 0.5) * tw - 0.5).astype(np.float32)
-        my = ((0.5 - v / item.height) * th - 0.5).astype(np.float32)
-        np.nan_to_num(mx, copy=False, nan=-10.0)
-        np.nan_to_num(my, copy=False, nan=-10.0)
+        # Fold the metric-to-texel map (texel centres at integer map coordinates, the
+        # cv2.remap convention) into the homography: one projective map, float32.
+        to_tex = np.array(
+            [
+                [tw / item.width, 0.0, 0.5 * tw - 0.5],
+                [0.0, -th / item.height, 0.5 * th - 0.5],
+                [0, 0, 1],
+            ]
+        )
+        hom = (to_tex @ hinv).astype(np.float32)
+        x, y = rays[..., 0], rays[..., 1]
+        den = hom[2, 0] * x + hom[2, 1] * y + hom[2, 2]
+        behind = den <= 1e-12  # rays that miss the plane (it lies behind the camera)
+        den[behind] = 1.0
+        np.reciprocal(den, out=den)
+        mx = (hom[0, 0] * x + hom[0, 1] * y + hom[0, 2]) * den
+        my = (hom[1, 0] * x + hom[1, 1] * y + hom[1, 2]) * den
+        mx[behind] = -10.0
         rgba = _premultiplied(tex)
         sampled = cv2.remap(rgba, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
         small = cv2.resize(sampled, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA)
@@ -163,6 +175,21 @@ class SyntheticCamera:
         region = img[y0:y1, x0:x1]
         region *= 1.0 - alpha
         region += color
+
+    def _noise(self) -> npt.NDArray[np.float32]:
+        """A frame of N(0, 1) noise: a random window of a bank of two frames of normals,
+        with a random sign, an eighth of the bank redrawn each frame. Drawing a whole
+        frame of normals costs ~12 ms; this costs ~2 ms and each pixel is still N(0, 1),
+        nearly independent from frame to frame."""
+        n = self.width * self.height
+        if self._bank is None:
+            self._bank = self._rng.standard_normal(2 * n, dtype=np.float32)
+        chunk = n // 4
+        start = int(self._rng.integers(0, 2 * n - chunk))
+        self._bank[start : start + chunk] = self._rng.standard_normal(chunk, dtype=np.float32)
+        offset = int(self._rng.integers(0, n))
+        frame = self._bank[offset : offset + n].reshape(self.height, self.width)
+        return -frame if self._rng.integers(0, 2) else frame
 
     def _bbox(self, plane: TexturedPlane) -> tuple[int, int, int, int] | None:
         """Pixel bounding box [x0, x1) x [y0, y1) of the plane's projection, or None."""
