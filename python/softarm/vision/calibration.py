@@ -72,9 +72,10 @@ def calibrate_charuco(
         ch_corners, ch_ids, _, _ = detector.detectBoard(gray)
         if ch_ids is None or len(ch_ids) < 6:
             continue
-        o, i = board.matchImagePoints(ch_corners, ch_ids)
-        obj.append(o.astype(np.float32))
-        img.append(i.astype(np.float32))
+        # ChArUco corners are one (N, 1, 2) array; the stubs only know the marker form.
+        o, i = board.matchImagePoints(ch_corners, ch_ids)  # type: ignore[call-overload]
+        obj.append(np.asarray(o, dtype=np.float32))
+        img.append(np.asarray(i, dtype=np.float32))
     return _calibrate(obj, img, shape, flags)
 
 
@@ -94,4 +95,4 @@ def _calibrate(
         raise VisionError(f"calibration needs >= {_MIN_VIEWS} usable views, got {len(obj)}")
     h, w = shape
     rms, mat, dist, _, _ = cv2.calibrateCamera(obj, img, (w, h), None, None, flags=flags)
-    return CameraModel(mat, np.ravel(dist), (w, h)), float(rms)
+    return CameraModel(np.asarray(mat, dtype=np.float64), np.ravel(dist), (w, h)), float(rms)

@@ -156,12 +156,12 @@ class MarkerCube:
             return []
         corners = [d.corners.astype(np.float32).reshape(1, 4, 2) for d in mine]
         ids = np.array([d.marker_id for d in mine], dtype=np.int32)
-        obj, img = self.board.matchImagePoints(corners, ids)
-        if obj is None or len(obj) < 4:
+        obj_pts, _ = self.board.matchImagePoints(corners, ids)
+        if obj_pts is None or len(obj_pts) < 4:
             return []
         # matchImagePoints hands back float32; the refinement below works in float64
         # from the original (float64) corners, in the same marker order.
-        obj = obj.reshape(-1, 3).astype(np.float64)
+        obj = np.asarray(obj_pts, dtype=np.float64).reshape(-1, 3)
         img = np.concatenate([d.corners for d in mine]).reshape(-1, 2)
         used = tuple(int(i) for i in ids)
         out = []
@@ -178,9 +178,9 @@ class MarkerCube:
         start: FloatArray, obj: FloatArray, img: FloatArray, camera: CameraModel
     ) -> tuple[FloatArray, float]:
         """Levenberg–Marquardt over all matched corners from ``start``; (pose, RMS px)."""
-        rvec, tvec = rvec_tvec_from_pose(start)
+        rvec0, tvec0 = rvec_tvec_from_pose(start)
         rvec, tvec = cv2.solvePnPRefineLM(
-            obj, img, camera.matrix, camera.distortion, rvec, tvec, _LM_CRITERIA
+            obj, img, camera.matrix, camera.distortion, rvec0, tvec0, _LM_CRITERIA
         )
         proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
         rms = float(np.sqrt(np.mean(np.sum((proj.reshape(-1, 2) - img) ** 2, axis=1))))
