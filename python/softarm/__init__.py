@@ -12,7 +12,20 @@ np.float64(0.534)
 import importlib
 from types import ModuleType
 
-from softarm._core import ArcChain, Section, SoftArm, __version__
+from softarm._core import (
+    ArcChain,
+    Closest,
+    Plan,
+    PointCloud,
+    PolynomialCurve,
+    PotentialFieldPlanner,
+    Section,
+    Segment,
+    SoftArm,
+    TriangleMesh,
+    __version__,
+    closest,
+)
 from softarm.errors import (
     ConfigError,
     HardwareError,
@@ -31,6 +44,7 @@ from softarm.errors import (
 
 __all__ = [
     "ArcChain",
+    "Closest",
     "ConfigError",
     "HardwareError",
     "HardwareUnavailableError",
@@ -38,20 +52,27 @@ __all__ = [
     "NonFiniteError",
     "OutOfRangeError",
     "ParameterError",
+    "Plan",
+    "PointCloud",
+    "PolynomialCurve",
     "PoseError",
+    "PotentialFieldPlanner",
     "SafetyError",
     "Section",
+    "Segment",
     "ShapeError",
     "SoftArm",
     "SoftarmError",
+    "TriangleMesh",
     "UnreachableError",
     "VisionError",
     "__version__",
+    "closest",
 ]
 
 #: Subpackages imported on first attribute access: vision pulls in OpenCV, and the
 #: kinematics should not pay for that.
-_LAZY_SUBPACKAGES = frozenset({"vision", "sim", "hardware", "harvest", "config"})
+_LAZY_SUBPACKAGES = frozenset({"vision", "sim", "hardware", "harvest", "config", "planning"})
 
 
 def __getattr__(name: str) -> ModuleType:

@@ -3,8 +3,10 @@
 //! around batch work; all math lives in softarm-core.
 
 mod convert;
+mod distance;
 mod errors;
 mod kinematics;
+mod planner;
 
 use pyo3::prelude::*;
 
@@ -13,5 +15,7 @@ use pyo3::prelude::*;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kinematics::register(m)?;
+    distance::register(m)?;
+    planner::register(m)?;
     Ok(())
 }

@@ -125,6 +125,7 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
         let mut iterations = 0;
         let mut dq = vec![0.0; n];
         let mut free = vec![true; n];
+        let mut first = vec![0.0; n];
         let mut repulsions: Vec<(Matrix3xX<f64>, Vec3)> = Vec::with_capacity(obstacles.len());
         while iterations < o.max_iterations {
             let err = goal - tip;
@@ -161,13 +162,16 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
             // Coordinates at a limit that the step pushes further are frozen and the step is
             // recomputed without them (projection onto the feasible set).
             free.iter_mut().for_each(|f| *f = true);
-            for _ in 0..4 {
+            for pass in 0..4 {
                 dq.iter_mut().for_each(|v| *v = 0.0);
                 // Attraction: J_e⁺ F_e(V_e).
                 add_pinv(&je, &free, &dx, o.damping, 1.0, &mut dq);
                 // Repulsion: − Σ_j J_sj⁺ F_sj(V_sj).
                 for (js, f) in &repulsions {
                     add_pinv(js, &free, f, o.damping, -1.0, &mut dq);
+                }
+                if pass == 0 {
+                    first.copy_from_slice(&dq);
                 }
                 let mut changed = false;
                 for i in 0..n {
@@ -176,6 +180,11 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
                         free[i] = false;
                         changed = true;
                     }
+                }
+                if !free.iter().any(|&f| f) {
+                    // Everything would freeze: fall back to the unprojected step, clamped.
+                    dq.copy_from_slice(&first);
+                    break;
                 }
                 if !changed {
                     break;
