@@ -30,7 +30,10 @@
 //!   `(|g_b(a)| + |g_b(b)| − M (b − a)) / 2 > 0` with equal signs, where
 //!   `|g_b'| ≤ M = S² + S·|p_b'|_max + d_max·A` (`A` bounds `|F_o''|`, `p_b' = 0` for the
 //!   ends and `|p_c'| ≤ S r / ρ` for the circle, `ρ` the distance from its axis);
-//!   otherwise it is bisected and searched again (to depth 24, within a budget of 600
+//!   for an end branch, also when it is provably convex there
+//!   (`|F_o'|² > d_max A`, so its derivative cannot change sign without a − → + change at
+//!   the samples); for the circle branch, also when its foot provably stays off the arc (it moves along
+//!   the circle at most `S r / ρ` per unit of `u`); otherwise it is bisected and searched again (to depth 24, within a budget of 200
 //!   evaluations per pair).
 //!
 //! Every distance reported is evaluated exactly at the final `(s, u)`. The only case this
@@ -56,6 +59,8 @@ pub struct ArcCurveHit {
     pub arc_point: Vec3,
     /// Curve point (world).
     pub curve_point: Vec3,
+    /// Number of curve points evaluated (cost of the query).
+    pub evaluations: u32,
 }
 
 /// Branches: 0 the full circle (eq. 13–14), 1 the end s = 0 (eq. 17), 2 the end s = 1
@@ -70,6 +75,10 @@ struct Sample {
     g: [f64; BRANCHES],
     /// ρ / r of the curve point (distance from the circle's axis over the radius).
     ratio: f64,
+    /// |F_o'(u)|.
+    speed: f64,
+    /// How far (in s, around the circle) the circle foot lies outside the arc's [0, 1].
+    gap: f64,
 }
 
 /// Bounds of the curve on one grid interval.
@@ -81,15 +90,18 @@ struct Bounds {
     accel: f64,
     /// Θ / L: the Lipschitz constant of ρ / r in the point.
     inv_radius: f64,
+    /// Arc length L.
+    length: f64,
 }
 
 /// Most evaluations spent certifying one pair.
-const BUDGET: u32 = 600;
+const BUDGET: u32 = 200;
 
 impl Sample {
+    /// A sign change from − to + (a zero at either end counts: the minimum is there).
     #[inline]
     fn falls_then_rises(a: &Sample, b: &Sample, k: usize) -> bool {
-        a.g[k] < 0.0 && b.g[k] > 0.0
+        (a.g[k] < 0.0 && b.g[k] >= 0.0) || (a.g[k] <= 0.0 && b.g[k] > 0.0)
     }
 }
 
@@ -129,13 +141,38 @@ impl Query<'_> {
             self.best_u = u;
             self.best_s = ss;
         }
-        Sample { u, d, g, ratio }
+        let gap = if (0.0..=1.0).contains(&sc) {
+            0.0
+        } else {
+            let theta = local.theta();
+            let ahead = if sc > 1.0 { sc - 1.0 } else { -sc };
+            if theta > 0.0 {
+                // The other way round the circle (period 2π/Θ in s).
+                let period = std::f64::consts::TAU / theta;
+                let behind = if sc > 1.0 { period - sc } else { sc + period - 1.0 };
+                ahead.min(behind.max(0.0))
+            } else {
+                ahead
+            }
+        };
+        Sample {
+            u,
+            d,
+            g,
+            ratio,
+            speed: df.norm(),
+            gap,
+        }
     }
 
     /// Illinois regula falsi for the root of branch `k`'s derivative on [a, b],
     /// g(a) < 0 < g(b).
     fn refine(&mut self, k: usize, mut a: Sample, mut b: Sample) {
         let (mut ga, mut gb) = (a.g[k], b.g[k]);
+        if ga == 0.0 || gb == 0.0 {
+            // The minimum is the end sample, already counted.
+            return;
+        }
         let mut side = 0i8;
         let tol = 1e-14 * (1.0 + a.u.abs().max(b.u.abs()));
         for _ in 0..80 {
@@ -181,11 +218,20 @@ impl Query<'_> {
         0.5 * (a.ratio + b.ratio - bo.inv_radius * bo.speed * (b.u - a.u))
     }
 
+    /// Whether the circle branch's foot provably stays off the arc on [a, b]: the foot moves
+    /// along the circle at most `S r / ρ` per unit u, i.e. `S / (L ρ/r)` in s.
+    fn foot_off_arc(a: &Sample, b: &Sample, bo: &Bounds) -> bool {
+        let ratio_min = Self::ratio_min(a, b, bo);
+        ratio_min > 0.0 && a.gap + b.gap > bo.speed * (b.u - a.u) / (ratio_min * bo.length)
+    }
+
     /// A bracket [a, b] where branch `k`'s derivative goes from − to +. The circle branch
     /// has a concave kink where the curve crosses the circle's axis, with a minimum on
     /// either side; while the interval may contain such a crossing it is bisected.
     fn bracket(&mut self, k: usize, a: Sample, b: Sample, bo: &Bounds, depth: u32) {
-        if Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d {
+        if Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d
+            || (k == 0 && Self::foot_off_arc(&a, &b, bo))
+        {
             return;
         }
         if k == 0 && depth > 0 && self.evals < BUDGET && Self::ratio_min(&a, &b, bo) <= 0.0 {
@@ -200,6 +246,28 @@ impl Query<'_> {
         } else {
             self.refine(k, a, b);
         }
+    }
+
+    /// Whether an end branch (k = 1, 2) is provably convex on [a, b]: its
+    /// `g' = |F_o'|² + (F_o − p)·F_o'' ≥ v_min² − d_max A > 0`, so it has at most one
+    /// minimum there.
+    fn convex_end(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> bool {
+        if k == 0 {
+            return false;
+        }
+        let w = b.u - a.u;
+        let v_min = 0.5 * (a.speed + b.speed - bo.accel * w);
+        let d_max = a.d[k].min(b.d[k]) + bo.speed * w;
+        v_min > 0.0 && v_min * v_min > d_max * bo.accel
+    }
+
+    /// A branch that is flat at both ends at the level of the best distance (a curve
+    /// parallel to the arc or its circle): the distance there is already the best.
+    fn flat(a: &Sample, b: &Sample, k: usize) -> bool {
+        let tol = 1e-12 * (1.0 + a.d[k]);
+        (a.d[k] - b.d[k]).abs() <= tol
+            && a.g[k].abs() <= tol * (1.0 + a.speed)
+            && b.g[k].abs() <= tol * (1.0 + b.speed)
     }
 
     /// Whether branch `k`'s derivative provably keeps one sign on [a, b].
@@ -229,7 +297,10 @@ impl Query<'_> {
         if depth == 0
             || self.evals >= BUDGET
             || Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d
+            || (k == 0 && Self::foot_off_arc(&a, &b, bo))
             || Self::monotone(&a, &b, k, bo)
+            || (Self::convex_end(&a, &b, k, bo) && !Sample::falls_then_rises(&a, &b, k))
+            || Self::flat(&a, &b, k)
         {
             return;
         }
@@ -246,10 +317,33 @@ impl Query<'_> {
 
 /// Global closest pair between `arc` and `curve` (eq. 12–18); see the module docs.
 pub fn closest_arc_curve(arc: &PlacedArc, curve: &PolynomialCurve) -> ArcCurveHit {
+    closest_arc_curve_within(arc, curve, f64::INFINITY).unwrap_or(ArcCurveHit {
+        distance: f64::INFINITY,
+        s: 0.0,
+        u: curve.u_range().0,
+        arc_point: arc.point(0.0),
+        curve_point: curve.eval(curve.u_range().0),
+        evaluations: 0,
+    })
+}
+
+/// [`closest_arc_curve`] when closer than `cutoff`, else `None` (exact either way). A
+/// bounding-sphere test (the arc lies within `L/2` of its middle point) skips far pairs
+/// without sampling, and every bound prunes against `cutoff` from the start.
+pub fn closest_arc_curve_within(
+    arc: &PlacedArc,
+    curve: &PolynomialCurve,
+    cutoff: f64,
+) -> Option<ArcCurveHit> {
+    let (centre, radius) = curve.bounding_sphere();
+    let gap = (arc.point(0.5) - centre).norm() - radius - 0.5 * arc.arc.params.length;
+    if gap >= cutoff {
+        return None;
+    }
     let mut q = Query {
         arc,
         curve,
-        best_d: f64::INFINITY,
+        best_d: cutoff,
         best_u: 0.0,
         best_s: 0.0,
         evals: 0,
@@ -257,7 +351,8 @@ pub fn closest_arc_curve(arc: &PlacedArc, curve: &PolynomialCurve) -> ArcCurveHi
     let grid = curve.grid();
     let speed = curve.speed_bounds();
     let accel = curve.accel_bounds();
-    let inv_radius = arc.arc.theta() / arc.arc.params.length;
+    let length = arc.arc.params.length;
+    let inv_radius = arc.arc.theta() / length;
     let n = grid.len().min(MAX_INTERVALS + 1);
     let mut samples = [Sample::default(); MAX_INTERVALS + 1];
     for (smp, &u) in samples.iter_mut().zip(grid).take(n) {
@@ -280,6 +375,7 @@ pub fn closest_arc_curve(arc: &PlacedArc, curve: &PolynomialCurve) -> ArcCurveHi
         speed: speed[i],
         accel: accel[i],
         inv_radius,
+        length,
     };
     for &(_, i, k) in brackets.iter() {
         q.bracket(k, samples[i], samples[i + 1], &bounds(i), 24);
@@ -291,12 +387,16 @@ pub fn closest_arc_curve(arc: &PlacedArc, curve: &PolynomialCurve) -> ArcCurveHi
             }
         }
     }
+    if q.best_d >= cutoff {
+        return None;
+    }
     let (u, s) = (q.best_u, q.best_s);
-    ArcCurveHit {
+    Some(ArcCurveHit {
         distance: q.best_d,
         s,
         u,
         arc_point: arc.point(s),
         curve_point: curve.eval(u),
-    }
+        evaluations: q.evals,
+    })
 }

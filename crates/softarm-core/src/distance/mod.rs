@@ -12,8 +12,10 @@ pub mod obstacle;
 pub mod polynomial;
 
 pub use arc_cloud::PointCloud;
-pub use arc_curve::{closest_arc_curve, ArcCurveHit};
+pub use arc_curve::{closest_arc_curve, closest_arc_curve_within, ArcCurveHit};
 pub use arc_mesh::TriangleMesh;
 pub use arc_point::{LocalArc, PlacedArc};
-pub use obstacle::{closest, closest_to_arc, closest_to_arcs, placed_arcs, Closest, Obstacle};
+pub use obstacle::{
+    closest, closest_to_arc, closest_to_arcs, closest_to_arcs_within, placed_arcs, Closest, Obstacle,
+};
 pub use polynomial::{PolynomialCurve, Segment};

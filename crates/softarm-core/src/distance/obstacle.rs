@@ -1,7 +1,7 @@
 //! Obstacles of every kind, and the closest pair between an arm and one obstacle.
 
 use super::arc_cloud::PointCloud;
-use super::arc_curve::closest_arc_curve;
+use super::arc_curve::{closest_arc_curve, closest_arc_curve_within};
 use super::arc_mesh::TriangleMesh;
 use super::arc_point::PlacedArc;
 use super::polynomial::{PolynomialCurve, Segment};
@@ -169,6 +169,54 @@ pub fn closest_to_arcs(arcs: &[PlacedArc], obstacle: &Obstacle) -> Closest {
         arm_point: Vec3::zeros(),
         obstacle_point: Vec3::zeros(),
     })
+}
+
+/// [`closest_to_arcs`] when the distance is below `cutoff`, else `None`. Exact; curves and
+/// segments skip far arcs by bounding spheres and prune against the best so far.
+pub fn closest_to_arcs_within(arcs: &[PlacedArc], obstacle: &Obstacle, cutoff: f64) -> Option<Closest> {
+    let curve = match obstacle {
+        Obstacle::Curve(c) => c,
+        Obstacle::Segment(s) => s.as_curve(),
+        Obstacle::Cloud(cloud) => {
+            // The hierarchy prunes against the cutoff, then against the best so far.
+            let mut best: Option<Closest> = None;
+            let mut limit = cutoff;
+            for (i, arc) in arcs.iter().enumerate() {
+                if let Some((d, s, k)) = cloud.closest_to_arc(arc, limit) {
+                    limit = d;
+                    best = Some(Closest {
+                        distance: d,
+                        section: i,
+                        s,
+                        u: k as f64,
+                        arm_point: arc.point(s),
+                        obstacle_point: cloud.points()[k],
+                    });
+                }
+            }
+            return best;
+        }
+        _ => {
+            let c = closest_to_arcs(arcs, obstacle);
+            return (c.distance < cutoff).then_some(c);
+        }
+    };
+    let mut best: Option<Closest> = None;
+    let mut limit = cutoff;
+    for (i, arc) in arcs.iter().enumerate() {
+        if let Some(h) = closest_arc_curve_within(arc, curve, limit) {
+            limit = h.distance;
+            best = Some(Closest {
+                distance: h.distance,
+                section: i,
+                s: h.s,
+                u: h.u,
+                arm_point: h.arc_point,
+                obstacle_point: h.curve_point,
+            });
+        }
+    }
+    best
 }
 
 /// The closest pair between the arm `model` at configuration `q` and `obstacle`, over

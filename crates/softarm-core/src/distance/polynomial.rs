@@ -19,6 +19,8 @@ pub struct PolynomialCurve {
     grid: Vec<f64>,
     speed: Vec<f64>,
     accel: Vec<f64>,
+    /// Bounding sphere of the whole curve: centre and radius.
+    sphere: (Vec3, f64),
 }
 
 impl PolynomialCurve {
@@ -107,6 +109,7 @@ impl PolynomialCurve {
             .windows(2)
             .map(|w| speed_bound(&deriv2, w[0], w[1]))
             .collect();
+        let sphere = bounding_sphere(&coeffs, u_min, u_max);
         Ok(PolynomialCurve {
             coeffs,
             u_min,
@@ -114,6 +117,7 @@ impl PolynomialCurve {
             grid,
             speed,
             accel,
+            sphere,
         })
     }
 
@@ -169,6 +173,11 @@ impl PolynomialCurve {
         &self.speed
     }
 
+    /// A sphere (centre, radius) holding the whole curve.
+    pub fn bounding_sphere(&self) -> (Vec3, f64) {
+        self.sphere
+    }
+
     /// Upper bound of `|F_o''|` on each grid interval.
     pub(crate) fn accel_bounds(&self) -> &[f64] {
         &self.accel
@@ -212,15 +221,8 @@ impl PolynomialCurve {
     }
 }
 
-/// An upper bound of `|P(u)|` for `u ∈ [a, b]`, `P` given by ascending vector
-/// coefficients: Taylor-shift `P` to the midpoint `m` and sum `|e_j| h^j`, `h = (b − a)/2`.
-fn speed_bound(p: &[Vec3], a: f64, b: f64) -> f64 {
-    if p.is_empty() {
-        return 0.0;
-    }
-    let m = 0.5 * (a + b);
-    let h = 0.5 * (b - a);
-    // Repeated synthetic division by (u − m) gives the Taylor coefficients about m.
+/// Taylor coefficients of `P(m + h t)` in `t`, for `P` in ascending vector coefficients.
+fn taylor(p: &[Vec3], m: f64, h: f64) -> Vec<Vec3> {
     let mut e = p.to_vec();
     let n = e.len();
     for i in 0..n {
@@ -229,12 +231,31 @@ fn speed_bound(p: &[Vec3], a: f64, b: f64) -> f64 {
             e[j] += next * m;
         }
     }
-    let mut bound = 0.0;
     let mut hj = 1.0;
-    for c in &e {
-        bound += c.norm() * hj;
+    for c in e.iter_mut() {
+        *c *= hj;
         hj *= h;
     }
+    e
+}
+
+/// A sphere holding `P([a, b])`: centre `P(m)`, radius `Σ_{j≥1} |e_j|`.
+fn bounding_sphere(p: &[Vec3], a: f64, b: f64) -> (Vec3, f64) {
+    let e = taylor(p, 0.5 * (a + b), 0.5 * (b - a));
+    let r: f64 = e.iter().skip(1).map(|c| c.norm()).sum();
+    (e[0], r * (1.0 + 1e-12) + f64::EPSILON)
+}
+
+/// An upper bound of `|P(u)|` for `u ∈ [a, b]`, `P` given by ascending vector
+/// coefficients: Taylor-shift `P` to the midpoint `m` and sum `|e_j| h^j`, `h = (b − a)/2`.
+fn speed_bound(p: &[Vec3], a: f64, b: f64) -> f64 {
+    if p.is_empty() {
+        return 0.0;
+    }
+    let bound: f64 = taylor(p, 0.5 * (a + b), 0.5 * (b - a))
+        .iter()
+        .map(|c| c.norm())
+        .sum();
     // Guard against rounding in the shift.
     bound * (1.0 + 1e-12) + f64::EPSILON
 }

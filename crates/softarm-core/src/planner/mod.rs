@@ -28,7 +28,9 @@ pub use options::{PlannerOptions, Termination};
 use nalgebra::{DMatrix, Matrix3, Matrix3xX};
 
 use crate::chain::{check_q, forward_jacobian_into, point_unchecked};
-use crate::distance::{closest_to_arcs, placed_arcs, Closest, Obstacle, PlacedArc};
+use crate::distance::{
+    closest_to_arcs, closest_to_arcs_within, placed_arcs, Closest, Obstacle, PlacedArc,
+};
 use crate::error::{check_finite, Error, Result};
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
@@ -117,7 +119,10 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
         let mut arcs = placed_arcs(model, &q);
         // Exact closest pairs at the current configuration: they give the clearance of the
         // whole backbone and, for the proposed method, the repulsion points of the next step.
-        let mut hits: Vec<Closest> = obstacles.iter().map(|ob| closest_to_arcs(&arcs, ob)).collect();
+        // Pairs farther than both the influence distance and the clearance so far can
+        // change neither, so they are skipped by exact lower bounds (`None`).
+        let mut hits: Vec<Option<Closest>> =
+            obstacles.iter().map(|ob| Some(closest_to_arcs(&arcs, ob))).collect();
         let mut min_clearance = min_distance(&hits);
         let mut tip = forward_jacobian_into(model, &q, &mut jac).pos;
         let mut tip_path = vec![tip];
@@ -136,9 +141,10 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
             // Repulsion directions first: the closest arm point of each obstacle.
             repulsions.clear();
             for (ob, hit) in obstacles.iter().zip(&hits) {
-                let c = match o.arm_samples {
-                    None => *hit,
-                    Some(m) => closest_sampled(&arcs, m, ob),
+                let c = match (o.arm_samples, hit) {
+                    (None, Some(h)) => *h,
+                    (None, None) => continue,
+                    (Some(m), _) => closest_sampled(&arcs, m, ob),
                 };
                 if c.distance >= o.influence_distance {
                     continue;
@@ -202,8 +208,9 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
             }
             iterations += 1;
             arcs = placed_arcs(model, &q);
+            let cutoff = o.influence_distance.max(min_clearance);
             for (hit, ob) in hits.iter_mut().zip(obstacles) {
-                *hit = closest_to_arcs(&arcs, ob);
+                *hit = closest_to_arcs_within(&arcs, ob, cutoff);
             }
             min_clearance = min_clearance.min(min_distance(&hits));
             tip = forward_jacobian_into(model, &q, &mut jac).pos;
@@ -257,8 +264,11 @@ fn add_pinv(
     }
 }
 
-fn min_distance(hits: &[Closest]) -> f64 {
-    hits.iter().map(|h| h.distance).fold(f64::INFINITY, f64::min)
+fn min_distance(hits: &[Option<Closest>]) -> f64 {
+    hits.iter()
+        .flatten()
+        .map(|h| h.distance)
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Exact clearance of the whole backbone: the smallest distance of any arc to any obstacle.
