@@ -14,7 +14,10 @@ fn bench(c: &mut Criterion) {
     let exact = PotentialFieldPlanner::new(chain.clone(), PlannerOptions::default()).unwrap();
     let points = PotentialFieldPlanner::new(
         chain,
-        PlannerOptions { arm_samples: Some(ARM_POINTS_PER_SEGMENT), ..PlannerOptions::default() },
+        PlannerOptions {
+            arm_samples: Some(ARM_POINTS_PER_SEGMENT),
+            ..PlannerOptions::default()
+        },
     )
     .unwrap();
     for name in NAMES {

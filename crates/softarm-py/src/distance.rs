@@ -4,8 +4,8 @@
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use softarm_core::distance::{self as dist, Obstacle};
 use softarm_core::chain::SectionModel;
+use softarm_core::distance::{self as dist, Obstacle};
 use softarm_core::{self as core, Vec3};
 
 use crate::convert::{array, points_out, reshape, vec3_out, vector};
@@ -51,7 +51,10 @@ fn vec3_arg(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec3> {
 
 fn points_arg(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<Vec3>> {
     let (flat, _) = array(obj, arg, &[None, Some(3)])?;
-    Ok(flat.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
+    Ok(flat
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
 }
 
 /// A polynomial space curve F(u) = Σ c_k u^k over [u_min, u_max] (planning paper eq. 10).
@@ -131,7 +134,10 @@ impl PolynomialCurve {
 
     fn __repr__(&self) -> String {
         let (a, b) = self.curve().u_range();
-        format!("PolynomialCurve(degree={}, u_range=({a}, {b}))", self.curve().degree())
+        format!(
+            "PolynomialCurve(degree={}, u_range=({a}, {b}))",
+            self.curve().degree()
+        )
     }
 }
 
@@ -169,7 +175,11 @@ impl Segment {
     }
 
     fn __repr__(&self) -> String {
-        format!("Segment(a={:?}, b={:?})", self.a.as_slice(), self.b.as_slice())
+        format!(
+            "Segment(a={:?}, b={:?})",
+            self.a.as_slice(),
+            self.b.as_slice()
+        )
     }
 }
 

@@ -30,9 +30,10 @@
 //!   `(|g_b(a)| + |g_b(b)| − M (b − a)) / 2 > 0` with equal signs, where
 //!   `|g_b'| ≤ M = S² + S·|p_b'|_max + d_max·A` (`A` bounds `|F_o''|`, `p_b' = 0` for the
 //!   ends and `|p_c'| ≤ S r / ρ` for the circle, `ρ` the distance from its axis);
-//!   for an end branch, also when it is provably convex there
-//!   (`|F_o'|² > d_max A`, so its derivative cannot change sign without a − → + change at
-//!   the samples); for the circle branch, also when its foot provably stays off the arc (it moves along
+//!   when the branch is provably convex there (`g_b' > 0`: `|F_o'|² > d_max A` for the
+//!   ends, `|F_o'|² − (r/ρ)(F_o'·t)² > d_max A` for the circle, `t` its tangent at the
+//!   foot), so its derivative cannot change sign without a − → + change at the samples;
+//!   for the circle branch, also when its foot provably stays off the arc (it moves along
 //!   the circle at most `S r / ρ` per unit of `u`); otherwise it is bisected and searched again (to depth 24, within a budget of 200
 //!   evaluations per pair).
 //!
@@ -77,6 +78,8 @@ struct Sample {
     ratio: f64,
     /// |F_o'(u)|.
     speed: f64,
+    /// F_o'(u) · t, t the circle's unit tangent at the foot.
+    along: f64,
     /// How far (in s, around the circle) the circle foot lies outside the arc's [0, 1].
     gap: f64,
 }
@@ -122,7 +125,7 @@ impl Query<'_> {
         let dx = self.arc.dir_to_local(&df);
         let local = &self.arc.arc;
         self.evals += 1;
-        let (sc, ratio) = local.circle_fraction_and_ratio(&x);
+        let (sc, ratio, tangent) = local.circle_foot(&x);
         let vs = [x - local.params.point(sc), x, x - local.tip()];
         let d = [vs[0].norm(), vs[1].norm(), vs[2].norm()];
         let g = [vs[0].dot(&dx), vs[1].dot(&dx), vs[2].dot(&dx)];
@@ -149,7 +152,11 @@ impl Query<'_> {
             if theta > 0.0 {
                 // The other way round the circle (period 2π/Θ in s).
                 let period = std::f64::consts::TAU / theta;
-                let behind = if sc > 1.0 { period - sc } else { sc + period - 1.0 };
+                let behind = if sc > 1.0 {
+                    period - sc
+                } else {
+                    sc + period - 1.0
+                };
                 ahead.min(behind.max(0.0))
             } else {
                 ahead
@@ -161,6 +168,7 @@ impl Query<'_> {
             g,
             ratio,
             speed: df.norm(),
+            along: dx.dot(&tangent),
             gap,
         }
     }
@@ -174,7 +182,10 @@ impl Query<'_> {
             return;
         }
         let mut side = 0i8;
-        let tol = 1e-14 * (1.0 + a.u.abs().max(b.u.abs()));
+        // The distance is stationary at the root, so an error δu in u costs ~κ δu² in the
+        // distance: 1e-11 relative in u is far below 1e-9 m.
+        let tol = 1e-11 * (1.0 + a.u.abs().max(b.u.abs()));
+        let mut prev = f64::NAN;
         for _ in 0..80 {
             if b.u - a.u <= tol {
                 break;
@@ -185,9 +196,10 @@ impl Query<'_> {
             }
             let c = self.eval(u);
             let gc = c.g[k];
-            if gc == 0.0 || c.d[k] == 0.0 {
+            if gc == 0.0 || c.d[k] == 0.0 || (u - prev).abs() <= tol {
                 break;
             }
+            prev = u;
             if gc > 0.0 {
                 b = c;
                 gb = gc;
@@ -234,7 +246,16 @@ impl Query<'_> {
         {
             return;
         }
-        if k == 0 && depth > 0 && self.evals < BUDGET && Self::ratio_min(&a, &b, bo) <= 0.0 {
+        let convex = Self::convex(&a, &b, k, bo);
+        if convex && Self::tangent_bound(&a, &b, k) >= self.best_d {
+            return;
+        }
+        if !convex
+            && k == 0
+            && depth > 0
+            && self.evals < BUDGET
+            && Self::ratio_min(&a, &b, bo) <= 0.0
+        {
             let m = self.eval(0.5 * (a.u + b.u));
             for (l, r) in [(a, m), (m, b)] {
                 if Sample::falls_then_rises(&l, &r, k) {
@@ -251,14 +272,29 @@ impl Query<'_> {
     /// Whether an end branch (k = 1, 2) is provably convex on [a, b]: its
     /// `g' = |F_o'|² + (F_o − p)·F_o'' ≥ v_min² − d_max A > 0`, so it has at most one
     /// minimum there.
-    fn convex_end(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> bool {
-        if k == 0 {
-            return false;
-        }
+    ///
+    /// For the circle branch `g' = |F_o'|² − (r/ρ)(F_o'·t)² + (F_o − p)·F_o''` (the Hessian
+    /// of the squared distance to a circle has eigenvalue `2(1 − r/ρ)` along its tangent
+    /// `t`), bounded below with `F_o'·t` being `(A + S²/ρ_min)`-Lipschitz in u.
+    fn convex(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> bool {
         let w = b.u - a.u;
         let v_min = 0.5 * (a.speed + b.speed - bo.accel * w);
+        if v_min <= 0.0 {
+            return false;
+        }
         let d_max = a.d[k].min(b.d[k]) + bo.speed * w;
-        v_min > 0.0 && v_min * v_min > d_max * bo.accel
+        let mut lower = v_min * v_min - d_max * bo.accel;
+        if k == 0 {
+            let ratio_min = Self::ratio_min(a, b, bo);
+            if ratio_min <= 0.0 {
+                return false;
+            }
+            let rho_min = ratio_min * bo.length / bo.inv_radius.max(f64::MIN_POSITIVE);
+            let lip = bo.accel + bo.speed * bo.speed / rho_min;
+            let along = 0.5 * (a.along.abs() + b.along.abs() + lip * w);
+            lower -= along.min(bo.speed).powi(2) / ratio_min;
+        }
+        lower > 0.0
     }
 
     /// A branch that is flat at both ends at the level of the best distance (a curve
@@ -268,6 +304,19 @@ impl Query<'_> {
         (a.d[k] - b.d[k]).abs() <= tol
             && a.g[k].abs() <= tol * (1.0 + a.speed)
             && b.g[k].abs() <= tol * (1.0 + b.speed)
+    }
+
+    /// Lower bound of branch `k` on a bracket where it is convex: `d_k²` lies above its
+    /// tangents at both ends (slopes `2 g`), so above their intersection.
+    fn tangent_bound(a: &Sample, b: &Sample, k: usize) -> f64 {
+        let (da, db) = (a.d[k] * a.d[k], b.d[k] * b.d[k]);
+        let (ga, gb) = (a.g[k], b.g[k]);
+        if ga >= gb {
+            return 0.0;
+        }
+        let u = (db - da + 2.0 * ga * a.u - 2.0 * gb * b.u) / (2.0 * (ga - gb));
+        let u = u.clamp(a.u, b.u);
+        (da + 2.0 * ga * (u - a.u)).max(0.0).sqrt()
     }
 
     /// Whether branch `k`'s derivative provably keeps one sign on [a, b].
@@ -299,7 +348,7 @@ impl Query<'_> {
             || Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d
             || (k == 0 && Self::foot_off_arc(&a, &b, bo))
             || Self::monotone(&a, &b, k, bo)
-            || (Self::convex_end(&a, &b, k, bo) && !Sample::falls_then_rises(&a, &b, k))
+            || (Self::convex(&a, &b, k, bo) && !Sample::falls_then_rises(&a, &b, k))
             || Self::flat(&a, &b, k)
         {
             return;

@@ -87,6 +87,14 @@ impl LocalArc {
     /// `r / ρ` times as fast as `x`.
     #[inline]
     pub fn circle_fraction_and_ratio(&self, x: &Vec3) -> (f64, f64) {
+        let (s, ratio, _) = self.circle_foot(x);
+        (s, ratio)
+    }
+
+    /// [`LocalArc::circle_fraction_and_ratio`] and the unit tangent of the circle at the
+    /// foot (z for a straight arc, or for a point on the axis).
+    #[inline]
+    pub fn circle_foot(&self, x: &Vec3) -> (f64, f64, Vec3) {
         let l = self.params.length;
         let xd = x.x * self.dir.0 + x.y * self.dir.1;
         let a = l - self.theta * xd; // Θ · (r − x_d)
@@ -98,12 +106,19 @@ impl LocalArc {
             // Here Θ > 0 (Θ = 0 gives a = L > 0, b = 0).
             b.atan2(a) / self.theta
         };
-        let ratio = a.hypot(b) / l;
+        let h = a.hypot(b);
+        let ratio = h / l;
+        let tangent = if h > 0.0 {
+            let (sa, ca) = (b / h, a / h);
+            Vec3::new(sa * self.dir.0, sa * self.dir.1, ca)
+        } else {
+            Vec3::z()
+        };
         if s < 0.0 && self.theta > 0.0 && s * self.theta + std::f64::consts::TAU <= self.theta {
             // Arcs bent beyond 2π − |α| (only for Θ > π): the same angle one turn later.
-            (s + std::f64::consts::TAU / self.theta, ratio)
+            (s + std::f64::consts::TAU / self.theta, ratio, tangent)
         } else {
-            (s, ratio)
+            (s, ratio, tangent)
         }
     }
 

@@ -173,7 +173,11 @@ pub fn closest_to_arcs(arcs: &[PlacedArc], obstacle: &Obstacle) -> Closest {
 
 /// [`closest_to_arcs`] when the distance is below `cutoff`, else `None`. Exact; curves and
 /// segments skip far arcs by bounding spheres and prune against the best so far.
-pub fn closest_to_arcs_within(arcs: &[PlacedArc], obstacle: &Obstacle, cutoff: f64) -> Option<Closest> {
+pub fn closest_to_arcs_within(
+    arcs: &[PlacedArc],
+    obstacle: &Obstacle,
+    cutoff: f64,
+) -> Option<Closest> {
     let curve = match obstacle {
         Obstacle::Curve(c) => c,
         Obstacle::Segment(s) => s.as_curve(),

@@ -121,8 +121,10 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
         // whole backbone and, for the proposed method, the repulsion points of the next step.
         // Pairs farther than both the influence distance and the clearance so far can
         // change neither, so they are skipped by exact lower bounds (`None`).
-        let mut hits: Vec<Option<Closest>> =
-            obstacles.iter().map(|ob| Some(closest_to_arcs(&arcs, ob))).collect();
+        let mut hits: Vec<Option<Closest>> = obstacles
+            .iter()
+            .map(|ob| Some(closest_to_arcs(&arcs, ob)))
+            .collect();
         let mut min_clearance = min_distance(&hits);
         let mut tip = forward_jacobian_into(model, &q, &mut jac).pos;
         let mut tip_path = vec![tip];
@@ -239,14 +241,7 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
 }
 
 /// `dq += sign · Jᵀ (J Jᵀ + λ² I)⁻¹ f` (eq. 8, damped), using only the `free` columns.
-fn add_pinv(
-    j: &Matrix3xX<f64>,
-    free: &[bool],
-    f: &Vec3,
-    damping: f64,
-    sign: f64,
-    dq: &mut [f64],
-) {
+fn add_pinv(j: &Matrix3xX<f64>, free: &[bool], f: &Vec3, damping: f64, sign: f64, dq: &mut [f64]) {
     let mut j = j.clone();
     for (k, &ok) in free.iter().enumerate() {
         if !ok {
