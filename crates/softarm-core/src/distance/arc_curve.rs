@@ -125,8 +125,8 @@ impl Query<'_> {
         let dx = self.arc.dir_to_local(&df);
         let local = &self.arc.arc;
         self.evals += 1;
-        let (sc, ratio, tangent) = local.circle_foot(&x);
-        let vs = [x - local.params.point(sc), x, x - local.tip()];
+        let (sc, ratio, tangent, foot) = local.circle_foot(&x);
+        let vs = [x - foot, x, x - local.tip()];
         let d = [vs[0].norm(), vs[1].norm(), vs[2].norm()];
         let g = [vs[0].dot(&dx), vs[1].dot(&dx), vs[2].dot(&dx)];
         // The true distance: the smallest valid branch.
@@ -175,7 +175,7 @@ impl Query<'_> {
 
     /// Illinois regula falsi for the root of branch `k`'s derivative on [a, b],
     /// g(a) < 0 < g(b).
-    fn refine(&mut self, k: usize, mut a: Sample, mut b: Sample) {
+    fn refine(&mut self, k: usize, mut a: Sample, mut b: Sample, speed: f64) {
         let (mut ga, mut gb) = (a.g[k], b.g[k]);
         if ga == 0.0 || gb == 0.0 {
             // The minimum is the end sample, already counted.
@@ -200,6 +200,11 @@ impl Query<'_> {
                 break;
             }
             prev = u;
+            // Stop as soon as the shrinking bracket cannot beat the best any more.
+            let (l, r) = if gc > 0.0 { (&a, &c) } else { (&c, &b) };
+            if Self::lower_bound(l, r, k, speed) >= self.best_d {
+                break;
+            }
             if gc > 0.0 {
                 b = c;
                 gb = gc;
@@ -265,7 +270,7 @@ impl Query<'_> {
                 }
             }
         } else {
-            self.refine(k, a, b);
+            self.refine(k, a, b, bo.speed);
         }
     }
 

@@ -87,14 +87,16 @@ impl LocalArc {
     /// `r / ρ` times as fast as `x`.
     #[inline]
     pub fn circle_fraction_and_ratio(&self, x: &Vec3) -> (f64, f64) {
-        let (s, ratio, _) = self.circle_foot(x);
+        let (s, ratio, _, _) = self.circle_foot(x);
         (s, ratio)
     }
 
-    /// [`LocalArc::circle_fraction_and_ratio`] and the unit tangent of the circle at the
-    /// foot (z for a straight arc, or for a point on the axis).
+    /// [`LocalArc::circle_fraction_and_ratio`], the unit tangent of the circle at the foot
+    /// (z for a straight arc, or for a point on the axis) and the foot itself, computed
+    /// without trigonometry: `r sin α = L x_z / h`, `r (1 − cos α) = L Θ x_z² / (h (h + a))`
+    /// (no cancellation as Θ → 0), with `(a, b) = Θ (r − x_d, x_z)`, `h = |(a, b)|`.
     #[inline]
-    pub fn circle_foot(&self, x: &Vec3) -> (f64, f64, Vec3) {
+    pub fn circle_foot(&self, x: &Vec3) -> (f64, f64, Vec3, Vec3) {
         let l = self.params.length;
         let xd = x.x * self.dir.0 + x.y * self.dir.1;
         let a = l - self.theta * xd; // Θ · (r − x_d)
@@ -106,19 +108,28 @@ impl LocalArc {
             // Here Θ > 0 (Θ = 0 gives a = L > 0, b = 0).
             b.atan2(a) / self.theta
         };
-        let h = a.hypot(b);
+        let h = (a * a + b * b).sqrt();
         let ratio = h / l;
-        let tangent = if h > 0.0 {
+        let (tangent, foot) = if h > 0.0 {
             let (sa, ca) = (b / h, a / h);
-            Vec3::new(sa * self.dir.0, sa * self.dir.1, ca)
+            let along = l * x.z / h;
+            let across = if a > 0.0 {
+                l * self.theta * x.z * x.z / (h * (h + a))
+            } else {
+                (l / self.theta) * (1.0 - ca)
+            };
+            (
+                Vec3::new(sa * self.dir.0, sa * self.dir.1, ca),
+                Vec3::new(across * self.dir.0, across * self.dir.1, along),
+            )
         } else {
-            Vec3::z()
+            (Vec3::z(), self.params.point(s))
         };
         if s < 0.0 && self.theta > 0.0 && s * self.theta + std::f64::consts::TAU <= self.theta {
             // Arcs bent beyond 2π − |α| (only for Θ > π): the same angle one turn later.
-            (s + std::f64::consts::TAU / self.theta, ratio, tangent)
+            (s + std::f64::consts::TAU / self.theta, ratio, tangent, foot)
         } else {
-            (s, ratio, tangent)
+            (s, ratio, tangent, foot)
         }
     }
 
