@@ -55,7 +55,7 @@ def test_segment_point_cloud_and_mesh() -> None:
     assert c.distance == pytest.approx(0.5) and c.section == 1
     assert softarm.closest(CHAIN, q, [0.0, 0.3, 2.5]).distance == pytest.approx(0.3)
     rng = np.random.default_rng(2)
-    pts = rng.uniform(-1.0, 1.0, (5000, 3)) + [1.2, 0.0, 1.5]
+    pts = rng.uniform(-1.0, 1.0, (5000, 3)) + np.array([1.2, 0.0, 1.5])
     cloud = softarm.PointCloud(pts)
     assert len(cloud) == 5000
     c = softarm.closest(CHAIN, Q, cloud)

@@ -39,8 +39,12 @@ def test_mixed_obstacles_and_soft_arm_limits() -> None:
     arm = softarm.SoftArm.blackberry()
     goal = arm.forward([0.03, 0.0, 0.01, 0.0, 0.03, 0.01, 0.01, 0.0, 0.03])[:3, 3]
     planner = softarm.PotentialFieldPlanner(
-        arm, max_tip_step=0.01, goal_tolerance=0.002, influence_distance=0.03,
-        repulsion_gain=1e-8, stall_tolerance=1e-5,
+        arm,
+        max_tip_step=0.01,
+        goal_tolerance=0.002,
+        influence_distance=0.03,
+        repulsion_gain=1e-8,
+        stall_tolerance=1e-5,
     )
     obstacles = [
         softarm.Segment([0.1, -0.2, 0.3], [0.1, 0.2, 0.3]),

@@ -29,15 +29,19 @@ def run(args: argparse.Namespace) -> int:
 
     results = compare(args.scenario, args.repeats)
     print(f"scenario {args.scenario}")
-    print(f"{'method':<12} {'iter':>5} {'time/plan':>11} {'reached':>8} {'clearance':>10} collision")
+    print(
+        f"{'method':<12} {'iter':>5} {'time/plan':>11} {'reached':>8} {'clearance':>10} collision"
+    )
     for r in results:
         print(
-            f"{r.method:<12} {r.iterations:>5} {r.seconds * 1e6:>8.0f} µs {str(r.reached):>8} "
+            f"{r.method:<12} {r.iterations:>5} {r.seconds * 1e6:>8.0f} µs {r.reached!s:>8} "
             f"{r.min_clearance:>10.4f} {r.collision}"
         )
     print(verdict(results))
     if args.plot:
-        out = plot_plan(load(args.scenario), results[0].plan, args.plot, f"scenario {args.scenario}")
+        out = plot_plan(
+            load(args.scenario), results[0].plan, args.plot, f"scenario {args.scenario}"
+        )
         print(f"wrote {out}")
     proposed = results[0]
     return 0 if proposed.reached and not proposed.collision else 1

@@ -13,7 +13,7 @@ from softarm.planning.scenarios import Scenario
 def snapshot_iterations(plan: _core.Plan, count: int = 3) -> list[int]:
     """Iterations to draw: the first, evenly spaced ones, and the last."""
     last = plan.iterations
-    return sorted({int(round(v)) for v in np.linspace(0, last, count)})
+    return sorted({round(float(v)) for v in np.linspace(0, last, count)})
 
 
 def plot_plan(scenario: Scenario, plan: _core.Plan, out: str | Path, title: str = "") -> Path:

@@ -90,7 +90,7 @@ def load(name: str) -> Scenario:
 
 
 def method_name(points: int | None) -> str:
-    """"proposed" for the exact curves, else "N point(s)"."""
+    """ "proposed" for the exact curves, else "N point(s)"."""
     if points is None:
         return "proposed"
     return f"{points} point" if points == 1 else f"{points} points"

@@ -97,6 +97,9 @@ struct Bounds {
     length: f64,
 }
 
+/// How many times a bracket not proven convex is bisected.
+const SPLIT_LEVELS: u32 = 4;
+
 /// Most evaluations spent certifying one pair.
 const BUDGET: u32 = 200;
 
@@ -242,9 +245,11 @@ impl Query<'_> {
         ratio_min > 0.0 && a.gap + b.gap > bo.speed * (b.u - a.u) / (ratio_min * bo.length)
     }
 
-    /// A bracket [a, b] where branch `k`'s derivative goes from − to +. The circle branch
-    /// has a concave kink where the curve crosses the circle's axis, with a minimum on
-    /// either side; while the interval may contain such a crossing it is bisected.
+    /// A bracket [a, b] where branch `k`'s derivative goes from − to +. Unless the branch
+    /// is proven convex there it may hold two minima, so it is bisected a few times; the
+    /// circle branch has a concave kink where the curve crosses the circle's axis, with a
+    /// minimum on either side, so while the interval may contain such a crossing it is
+    /// bisected further.
     fn bracket(&mut self, k: usize, a: Sample, b: Sample, bo: &Bounds, depth: u32) {
         if Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d
             || (k == 0 && Self::foot_off_arc(&a, &b, bo))
@@ -255,12 +260,10 @@ impl Query<'_> {
         if convex && Self::tangent_bound(&a, &b, k) >= self.best_d {
             return;
         }
-        if !convex
-            && k == 0
-            && depth > 0
-            && self.evals < BUDGET
-            && Self::ratio_min(&a, &b, bo) <= 0.0
-        {
+        // A bracket not proven convex may hold two minima (with a maximum between them):
+        // it is bisected up to SPLIT_LEVELS times, and without limit near the circle's axis.
+        let near_axis = k == 0 && Self::ratio_min(&a, &b, bo) <= 0.0;
+        if !convex && depth > 0 && self.evals < BUDGET && (near_axis || depth > 24 - SPLIT_LEVELS) {
             let m = self.eval(0.5 * (a.u + b.u));
             for (l, r) in [(a, m), (m, b)] {
                 if Sample::falls_then_rises(&l, &r, k) {
