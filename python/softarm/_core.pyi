@@ -193,7 +193,7 @@ class PotentialFieldPlanner:
         cls,
         arm: SoftArm | ArcChain,
         *,
-        attraction_gain: float = 0.5,
+        attraction_gain: float = 1.0,
         max_tip_step: float = 0.15,
         repulsion_gain: float = 3e-5,
         influence_distance: float = 0.1,

@@ -36,7 +36,7 @@ fn obstacles_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<core::Obstacle>> {
 impl PotentialFieldPlanner {
     #[new]
     #[pyo3(signature = (
-        arm, *, attraction_gain = 0.5, max_tip_step = 0.15, repulsion_gain = 3e-5,
+        arm, *, attraction_gain = 1.0, max_tip_step = 0.15, repulsion_gain = 3e-5,
         influence_distance = 0.1, max_step_fraction = 0.04, damping = 0.05,
         goal_tolerance = 0.01, max_iterations = 500, stall_window = 20,
         stall_tolerance = 1e-3, arm_samples = None

@@ -56,7 +56,7 @@ impl Default for PlannerOptions {
     /// Tuned for the planning paper's arm (three segments of length 1).
     fn default() -> Self {
         PlannerOptions {
-            attraction_gain: 0.5,
+            attraction_gain: 1.0,
             max_tip_step: 0.15,
             repulsion_gain: 3e-5,
             influence_distance: 0.1,
