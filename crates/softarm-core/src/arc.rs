@@ -15,7 +15,7 @@
 //! `f2 = (1 − cos t)/t²` (see [`crate::math::ArcFunctions`]). The straight arc is then an
 //! ordinary point: no perturbation, no special case, exact limits.
 
-use crate::math::{skew, ArcFunctions, Frame, Mat3, Vec3};
+use crate::math::{ArcFunctions, Frame, Mat3, Vec3};
 
 /// Arc parameters in the smooth parametrisation: length and bending vector.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,32 +115,60 @@ impl ArcParams {
         }
     }
 
-    /// Frame (rotation and position) at fraction `s`: Rodrigues' formula on ω.
+    /// Frame (rotation and position) at fraction `s`: Rodrigues' formula
+    /// `R = I + f1 [ω]× + f2 [ω]×²` written out for ω = (wx, wy, 0), using
+    /// `[ω]×² = ω ωᵀ − |ω|² I`.
     #[inline]
     pub fn frame(&self, s: f64) -> Frame {
-        let w = self.rotation_vector(s);
-        let f = ArcFunctions::at(w.norm_squared());
-        let k = skew(&w);
-        let rot = Mat3::identity() + k * f.f1 + k * k * f.f2;
+        let (wx, wy) = (-self.uy * s, self.ux * s);
+        let f = ArcFunctions::at(wx * wx + wy * wy);
+        Frame {
+            rot: rodrigues(wx, wy, f.f1, f.f2),
+            pos: self.position_from(s, wx, wy, &f),
+        }
+    }
+
+    /// Position at fraction `s` given ω = (wx, wy, 0) = s (−uy, ux, 0) and the functions
+    /// at |ω|² (shared with the rotation to evaluate them once).
+    #[inline]
+    fn position_from(&self, s: f64, wx: f64, wy: f64, f: &ArcFunctions) -> Vec3 {
         let ls = self.length * s;
-        let pos = Vec3::new(ls * f.f2 * w.y, -ls * f.f2 * w.x, ls * f.f1);
-        Frame { rot, pos }
+        Vec3::new(ls * f.f2 * wy, -ls * f.f2 * wx, ls * f.f1)
     }
 
     /// Frame at fraction `s`, plus the derivatives of the frame with respect to
-    /// (L, ux, uy) as body-fixed-in-base twists: column k of `d_pos` is ∂p/∂param_k, and
-    /// column k of `d_rot` is the angular velocity `(∂R/∂param_k Rᵀ)^∨` (redundancy paper
-    /// eq. 5), computed as `J_l(ω) ∂ω/∂param_k` with the left Jacobian of SO(3).
+    /// (L, ux, uy): column k of the first matrix is ∂p/∂param_k, and column k of the
+    /// second the angular velocity `(∂R/∂param_k Rᵀ)^∨` (redundancy paper eq. 5),
+    /// computed as `J_l(ω) ∂ω/∂param_k` with the left Jacobian of SO(3)
+    /// `J_l = I + f2 [ω]× + f3 [ω]×²`.
+    #[inline]
     pub fn frame_with_derivatives(&self, s: f64) -> (Frame, Mat3, Mat3) {
-        let w = self.rotation_vector(s);
-        let f = ArcFunctions::at(w.norm_squared());
-        let k = skew(&w);
-        let k2 = k * k;
-        let rot = Mat3::identity() + k * f.f1 + k2 * f.f2;
-        let jl = Mat3::identity() + k * f.f2 + k2 * f.f3;
-        // ω = s (−uy, ux, 0): ∂ω/∂L = 0, ∂ω/∂ux = (0, s, 0), ∂ω/∂uy = (−s, 0, 0).
-        let d_rot = Mat3::from_columns(&[Vec3::zeros(), jl.column(1) * s, -jl.column(0) * s]);
         let pt = self.point_with_derivatives(s);
+        let (wx, wy) = (-self.uy * s, self.ux * s);
+        let f = ArcFunctions::at(wx * wx + wy * wy);
+        let rot = rodrigues(wx, wy, f.f1, f.f2);
+        // Columns 0 and 1 of J_l (ω_z = 0).
+        let jl0 = Vec3::new(1.0 - f.f3 * wy * wy, f.f3 * wx * wy, -f.f2 * wy);
+        let jl1 = Vec3::new(f.f3 * wx * wy, 1.0 - f.f3 * wx * wx, f.f2 * wx);
+        // ω = s (−uy, ux, 0): ∂ω/∂L = 0, ∂ω/∂ux = (0, s, 0), ∂ω/∂uy = (−s, 0, 0).
+        let d_rot = Mat3::from_columns(&[Vec3::zeros(), jl1 * s, -jl0 * s]);
         (Frame { rot, pos: pt.pos }, pt.d_params, d_rot)
     }
+}
+
+/// `I + a [ω]× + b [ω]×²` for ω = (wx, wy, 0).
+#[inline]
+fn rodrigues(wx: f64, wy: f64, a: f64, b: f64) -> Mat3 {
+    let bxy = b * wx * wy;
+    Mat3::new(
+        1.0 - b * wy * wy,
+        bxy,
+        a * wy,
+        bxy,
+        1.0 - b * wx * wx,
+        -a * wx,
+        -a * wy,
+        a * wx,
+        1.0 - b * (wx * wx + wy * wy),
+    )
 }

@@ -118,7 +118,7 @@ impl SectionModel for ArcChain {
             d_arc: Mat3::new(1.0, 0.0, 0.0, 0.0, c, -bend * s, 0.0, s, bend * c),
             offset: 0.0,
             // Rz(φ) Ry(Θ) = [Rz(φ) Ry(Θ) Rz(−φ)] · Rz(φ): the arc, then a twist by φ.
-            twist: dir,
+            twist: (c, s),
             d_twist: Vec3::new(0.0, 0.0, 1.0),
         }
     }

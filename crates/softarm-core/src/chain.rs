@@ -21,17 +21,24 @@ pub struct SectionState {
     pub d_arc: Mat3,
     /// Translation along the tip's z axis after the arc (plate or gripper offset `b_i`).
     pub offset: f64,
-    /// Rotation about the tip's z axis after the arc (`β_i`, or `φ_i` for an arc chain).
-    pub twist: f64,
+    /// (cos, sin) of the rotation about the tip's z axis after the arc (`β_i`, or `φ_i`
+    /// for an arc chain); kept as a pair so that constant twists cost no trigonometry.
+    pub twist: (f64, f64),
     /// ∂twist/∂q_i.
     pub d_twist: Vec3,
 }
 
 impl SectionState {
-    /// The rigid transform after the arc's tip.
+    /// `tip · tail` with the z rotation applied by mixing two columns instead of a full
+    /// 3×3 product.
     #[inline]
-    fn tail(&self) -> Frame {
-        Frame::z_offset(self.offset, self.twist)
+    fn tip_then_tail(&self, tip: &Frame) -> Frame {
+        let (c, s) = self.twist;
+        let (r0, r1, r2) = (tip.rot.column(0), tip.rot.column(1), tip.rot.column(2));
+        Frame {
+            rot: Mat3::from_columns(&[r0 * c + r1 * s, r1 * c - r0 * s, r2.into_owned()]),
+            pos: tip.pos + r2 * self.offset,
+        }
     }
 }
 
@@ -83,7 +90,7 @@ pub fn frames_unchecked<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Vec<F
     out.push(f);
     for i in 0..n {
         let st = state(model, q, i);
-        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
         out.push(f);
     }
     out
@@ -95,7 +102,7 @@ pub fn forward_unchecked<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Fram
     let mut f = Frame::identity();
     for i in 0..model.n_sections() {
         let st = state(model, q, i);
-        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
     }
     f
 }
@@ -131,7 +138,7 @@ fn sweep<M: SectionModel + ?Sized>(
             jac.fixed_view_mut::<3, 1>(0, col).copy_from(&v);
             jac.fixed_view_mut::<3, 1>(3, col).copy_from(&w);
         }
-        f = f.compose(&tip).compose(&st.tail());
+        f = f.compose(&st.tip_then_tail(&tip));
     }
     f
 }
@@ -194,7 +201,7 @@ pub fn backbone_unchecked<M: SectionModel + ?Sized>(
             let s = if samples == 1 { 1.0 } else { j as f64 / denom };
             out.push(f.pos + f.rot * st.arc.point(s));
         }
-        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
     }
     out
 }
@@ -209,7 +216,7 @@ pub fn section_arc_unchecked<M: SectionModel + ?Sized>(
     let mut f = Frame::identity();
     for i in 0..section {
         let st = state(model, q, i);
-        f = f.compose(&st.arc.frame(1.0)).compose(&st.tail());
+        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
     }
     (f, state(model, q, section).arc)
 }

@@ -96,6 +96,7 @@ impl Section {
 pub struct SoftArm {
     sections: Vec<Section>,
     d_arc: Vec<Mat3>,
+    twist_cs: Vec<(f64, f64)>,
     lower: Vec<f64>,
     upper: Vec<f64>,
 }
@@ -113,11 +114,16 @@ impl SoftArm {
             .iter()
             .map(|s| arc_params_jacobian(s.radius))
             .collect();
+        let twist_cs = sections
+            .iter()
+            .map(|s| (s.twist.cos(), s.twist.sin()))
+            .collect();
         let lower = sections.iter().flat_map(|s| [s.lower; 3]).collect();
         let upper = sections.iter().flat_map(|s| [s.upper; 3]).collect();
         Ok(SoftArm {
             sections,
             d_arc,
+            twist_cs,
             lower,
             upper,
         })
@@ -232,7 +238,7 @@ impl SectionModel for SoftArm {
             arc: arc_params(s.radius, s.rest_length, qi),
             d_arc: self.d_arc[i],
             offset: s.offset,
-            twist: s.twist,
+            twist: self.twist_cs[i],
             d_twist: Vec3::zeros(),
         }
     }

@@ -1,1 +1,17 @@
+//! `softarm._core`: thin pyo3 bindings over softarm-core. This crate only converts
+//! (numpy ↔ nalgebra, core errors → `softarm.errors` exceptions) and releases the GIL
+//! around batch work; all math lives in softarm-core.
 
+mod convert;
+mod errors;
+mod kinematics;
+
+use pyo3::prelude::*;
+
+/// The native module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    kinematics::register(m)?;
+    Ok(())
+}

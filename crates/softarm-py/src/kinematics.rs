@@ -1,0 +1,349 @@
+//! `SoftArm`, `Section` and `ArcChain` for Python. Both arm classes get the same
+//! kinematic methods from one macro, so the two can never drift apart.
+
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use pyo3::prelude::*;
+use softarm_core::chain::{forward_jacobian_into, forward_unchecked, SectionModel};
+use softarm_core::{self as core, Kinematics};
+
+use crate::convert::{
+    array, dmatrix_out, mat4_out, matrix3x_out, points_out, vec3_out, vector, write_dmatrix,
+    write_mat4,
+};
+use crate::errors::{IntoPyResult, OutOfRangeError};
+
+/// Converts a Python section index, rejecting negative and too large values by name.
+fn section_index<M: SectionModel>(model: &M, section: i64) -> PyResult<usize> {
+    let n = model.n_sections();
+    usize::try_from(section)
+        .ok()
+        .filter(|&s| s < n)
+        .ok_or_else(|| {
+            OutOfRangeError::new_err(format!(
+                "section = {section} is out of range [0, {}]",
+                n.saturating_sub(1)
+            ))
+        })
+}
+
+/// Reads an (N, n) batch of configurations, checking every value is finite.
+fn batch_input<M: SectionModel>(model: &M, qs: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, usize)> {
+    let n = model.n_dofs();
+    let (flat, shape) = array(qs, "qs", &[None, Some(n)])?;
+    core::error::check_finite("qs", &flat).py()?;
+    Ok((flat, shape[0]))
+}
+
+macro_rules! kinematic_methods {
+    ($ty:ident, { $($extra:tt)* }) => {
+        #[pymethods]
+        impl $ty {
+            $($extra)*
+
+            /// Number of sections.
+            #[getter]
+            fn n_sections(&self) -> usize {
+                self.inner.n_sections()
+            }
+
+            /// Number of coordinates (3 per section).
+            #[getter]
+            fn n_dofs(&self) -> usize {
+                self.inner.n_dofs()
+            }
+
+            /// Lower limit of every coordinate, shape (n,).
+            #[getter]
+            fn lower<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+                PyArray1::from_slice(py, self.inner.lower())
+            }
+
+            /// Upper limit of every coordinate, shape (n,).
+            #[getter]
+            fn upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+                PyArray1::from_slice(py, self.inner.upper())
+            }
+
+            /// End-effector pose (4, 4) in the base frame.
+            fn forward<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let q = vector(q, "q", self.inner.n_dofs())?;
+                let t = self.inner.forward(&q).py()?;
+                Ok(mat4_out(py, &t))
+            }
+
+            /// Jacobian (6, n): rows vx, vy, vz, wx, wy, wz in the base frame.
+            fn jacobian<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let q = vector(q, "q", self.inner.n_dofs())?;
+                let j = self.inner.jacobian(&q).py()?;
+                Ok(dmatrix_out(py, &j))
+            }
+
+            /// Pose (4, 4) and Jacobian (6, n) from one pass.
+            fn forward_jacobian<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+            ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+                let q = vector(q, "q", self.inner.n_dofs())?;
+                let (t, j) = self.inner.forward_jacobian(&q).py()?;
+                Ok((mat4_out(py, &t), dmatrix_out(py, &j)))
+            }
+
+            /// Backbone point at fraction s of a section (0 = proximal), shape (3,), and
+            /// its Jacobian, shape (3, n).
+            fn point<'py>(
+                &self,
+                py: Python<'py>,
+                q: &Bound<'py, PyAny>,
+                section: i64,
+                s: f64,
+            ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+                let q = vector(q, "q", self.inner.n_dofs())?;
+                let section = section_index(&self.inner, section)?;
+                let (p, j) = self.inner.point(&q, section, s).py()?;
+                Ok((vec3_out(py, &p), matrix3x_out(py, &j)?))
+            }
+
+            /// Base frame of every section, then the end effector: (n_sections + 1, 4, 4).
+            fn frames<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+                let q = vector(q, "q", self.inner.n_dofs())?;
+                let frames = self.inner.frames(&q).py()?;
+                let out = PyArray3::<f64>::zeros(py, [frames.len(), 4, 4], false);
+                {
+                    let mut rw = out.readwrite();
+                    let o = rw.as_slice_mut()?;
+                    for (k, f) in frames.iter().enumerate() {
+                        write_mat4(f, &mut o[16 * k..16 * k + 16]);
+                    }
+                }
+                Ok(out)
+            }
+
+            /// `samples` points per section along the backbone, ends included:
+            /// (n_sections * samples, 3).
+            #[pyo3(signature = (q, samples = 20))]
+            fn backbone<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, samples: i64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+                let q = vector(q, "q", self.inner.n_dofs())?;
+                let samples = usize::try_from(samples).unwrap_or(0);
+                let pts = self.inner.backbone(&q, samples).py()?;
+                points_out(py, &pts)
+            }
+
+            /// Poses of a batch of configurations: (N, n) → (N, 4, 4). Releases the GIL.
+            fn forward_batch<'py>(&self, py: Python<'py>, qs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+                let (flat, rows) = batch_input(&self.inner, qs)?;
+                let n = self.inner.n_dofs();
+                let out = PyArray3::<f64>::zeros(py, [rows, 4, 4], false);
+                {
+                    let mut rw = out.readwrite();
+                    let o = rw.as_slice_mut()?;
+                    let model = &self.inner;
+                    py.detach(|| {
+                        for (q, dst) in flat.chunks_exact(n).zip(o.chunks_exact_mut(16)) {
+                            write_mat4(&forward_unchecked(model, q).to_matrix(), dst);
+                        }
+                    });
+                }
+                Ok(out)
+            }
+
+            /// Jacobians of a batch of configurations: (N, n) → (N, 6, n). Releases the GIL.
+            fn jacobian_batch<'py>(&self, py: Python<'py>, qs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+                let (flat, rows) = batch_input(&self.inner, qs)?;
+                let n = self.inner.n_dofs();
+                let out = PyArray3::<f64>::zeros(py, [rows, 6, n], false);
+                {
+                    let mut rw = out.readwrite();
+                    let o = rw.as_slice_mut()?;
+                    let model = &self.inner;
+                    py.detach(|| {
+                        let mut jac = nalgebra::DMatrix::zeros(6, n);
+                        for (q, dst) in flat.chunks_exact(n).zip(o.chunks_exact_mut(6 * n)) {
+                            forward_jacobian_into(model, q, &mut jac);
+                            write_dmatrix(&jac, dst);
+                        }
+                    });
+                }
+                Ok(out)
+            }
+        }
+    };
+}
+
+/// Geometry and limits of one pneumatic section.
+#[pyclass(module = "softarm._core", frozen, eq, from_py_object)]
+#[derive(Clone, PartialEq)]
+pub struct Section {
+    pub(crate) inner: core::Section,
+}
+
+#[pymethods]
+impl Section {
+    #[new]
+    #[pyo3(signature = (radius, rest_length, lower, upper, offset = 0.0, twist = 0.0))]
+    fn new(
+        radius: f64,
+        rest_length: f64,
+        lower: f64,
+        upper: f64,
+        offset: f64,
+        twist: f64,
+    ) -> PyResult<Self> {
+        let inner = core::Section::new(radius, rest_length, lower, upper, offset, twist).py()?;
+        Ok(Section { inner })
+    }
+
+    /// Actuator distance from the centre line (m).
+    #[getter]
+    fn radius(&self) -> f64 {
+        self.inner.radius
+    }
+    /// Actuator rest length L0 (m).
+    #[getter]
+    fn rest_length(&self) -> f64 {
+        self.inner.rest_length
+    }
+    /// Smallest elongation (m).
+    #[getter]
+    fn lower(&self) -> f64 {
+        self.inner.lower
+    }
+    /// Largest elongation (m).
+    #[getter]
+    fn upper(&self) -> f64 {
+        self.inner.upper
+    }
+    /// Offset b along z after the section (m).
+    #[getter]
+    fn offset(&self) -> f64 {
+        self.inner.offset
+    }
+    /// Twist β about z after the section (rad).
+    #[getter]
+    fn twist(&self) -> f64 {
+        self.inner.twist
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.inner;
+        format!(
+            "Section(radius={}, rest_length={}, lower={}, upper={}, offset={}, twist={})",
+            s.radius, s.rest_length, s.lower, s.upper, s.offset, s.twist
+        )
+    }
+}
+
+/// A pneumatic continuum arm in actuator space (redundancy paper eq. 1–6).
+#[pyclass(module = "softarm._core", frozen)]
+pub struct SoftArm {
+    pub(crate) inner: core::SoftArm,
+}
+
+kinematic_methods!(SoftArm, {
+    #[new]
+    fn new(sections: Vec<PyRef<'_, Section>>) -> PyResult<Self> {
+        let secs = sections.iter().map(|s| s.inner).collect();
+        Ok(SoftArm {
+            inner: core::SoftArm::new(secs).py()?,
+        })
+    }
+
+    /// The default three-section blackberry arm (dimensions in the class docs).
+    #[staticmethod]
+    fn blackberry() -> Self {
+        SoftArm {
+            inner: core::SoftArm::blackberry(),
+        }
+    }
+
+    /// Number of actuators (3 per section).
+    #[getter]
+    fn n_actuators(&self) -> usize {
+        self.inner.n_actuators()
+    }
+
+    /// The sections, proximal first.
+    #[getter]
+    fn sections(&self) -> Vec<Section> {
+        self.inner
+            .sections()
+            .iter()
+            .map(|&inner| Section { inner })
+            .collect()
+    }
+
+    /// Eq. (1) per section: rows of (arc length, bending angle, bending direction),
+    /// shape (n_sections, 3). The direction is 0 for a straight section.
+    fn configuration<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let q = vector(q, "q", self.inner.n_dofs())?;
+        let cfg = self.inner.polar_configs(&q).py()?;
+        let flat: Vec<f64> = cfg
+            .iter()
+            .flat_map(|c| [c.length, c.bend, c.direction])
+            .collect();
+        crate::convert::reshape(py, flat, [cfg.len(), 3])
+    }
+
+    fn __repr__(&self) -> String {
+        format!("SoftArm(n_sections={})", self.inner.n_sections())
+    }
+});
+
+/// An arc chain in configuration space, q_i = [L_i, Θ_i, φ_i] (planning paper eq. 1–5).
+#[pyclass(module = "softarm._core", frozen)]
+pub struct ArcChain {
+    pub(crate) inner: core::ArcChain,
+}
+
+kinematic_methods!(ArcChain, {
+    #[new]
+    #[pyo3(signature = (lengths, lower = None, upper = None))]
+    fn new(
+        lengths: &Bound<'_, PyAny>,
+        lower: Option<&Bound<'_, PyAny>>,
+        upper: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let (lengths, _) = array(lengths, "lengths", &[None])?;
+        let mut inner = core::ArcChain::new(&lengths).py()?;
+        if lower.is_some() || upper.is_some() {
+            let n = inner.n_dofs();
+            let lo = match lower {
+                Some(l) => vector(l, "lower", n)?,
+                None => inner.lower().to_vec(),
+            };
+            let hi = match upper {
+                Some(u) => vector(u, "upper", n)?,
+                None => inner.upper().to_vec(),
+            };
+            inner = inner.with_limits(&lo, &hi).py()?;
+        }
+        Ok(ArcChain { inner })
+    }
+
+    /// Static segment lengths, shape (n_sections,).
+    #[getter]
+    fn lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.lengths())
+    }
+
+    /// The straight configuration at the static lengths, shape (n,).
+    fn straight<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.straight())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ArcChain(lengths={:?})", self.inner.lengths())
+    }
+});
+
+/// Registers the kinematics classes.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Section>()?;
+    m.add_class::<SoftArm>()?;
+    m.add_class::<ArcChain>()?;
+    Ok(())
+}

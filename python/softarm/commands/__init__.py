@@ -1,0 +1,1 @@
+"""Subcommands of the ``softarm`` command line, one module each."""

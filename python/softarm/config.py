@@ -1,0 +1,396 @@
+"""Configuration of a softarm installation in one TOML file: geometry, gains, camera
+calibration, pressure channels and the serial port.
+
+``load_config(path)`` parses and validates (every error is a
+:class:`~softarm.errors.ConfigError` naming the key path, e.g. ``arm.sections[1].radius``);
+``save_config(config, path)`` writes it back; ``default_config()`` is the blackberry arm
+shipped as ``softarm/data/blackberry.toml``. Units are SI, except the pressure channels,
+which are the hardware boundary (psi, volts). Unknown keys are errors: a typo must not
+silently fall back to a default.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from softarm.errors import ConfigError
+
+__all__ = [
+    "ArmConfig",
+    "CalibrationConfig",
+    "CameraConfig",
+    "ChannelsConfig",
+    "Config",
+    "GainsConfig",
+    "SectionConfig",
+    "SerialConfig",
+    "default_config",
+    "dump_config",
+    "load_config",
+    "parse_config",
+    "save_config",
+]
+
+Matrix = tuple[tuple[float, ...], ...]
+
+
+@dataclass(frozen=True)
+class SectionConfig:
+    """One constant-curvature section (fields as ``softarm.Section``; metres, radians)."""
+
+    radius: float
+    rest_length: float
+    lower: float
+    upper: float
+    offset: float
+    twist: float
+
+
+@dataclass(frozen=True)
+class ArmConfig:
+    """The arm: its sections, proximal first."""
+
+    sections: tuple[SectionConfig, ...]
+
+
+@dataclass(frozen=True)
+class GainsConfig:
+    """Free-form resolver gain keywords (passed to ``softarm.Gains(**values)``)."""
+
+    values: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    """One camera: its OpenCV source and intrinsics, inline or in a file (a path
+    relative to the config file; the vision code reads it)."""
+
+    source: int | str = 0
+    matrix: Matrix | None = None
+    distortion: tuple[float, ...] | None = None
+    file: str | None = None
+
+
+@dataclass(frozen=True)
+class CalibrationConfig:
+    """Cameras and extrinsics: ``T_C1_base`` (base in the eye-to-hand camera C1) and
+    ``T_C2_EE`` (end effector in the eye-in-hand camera C2), 4×4, or ``None`` if unknown."""
+
+    c1: CameraConfig = field(default_factory=CameraConfig)
+    c2: CameraConfig = field(default_factory=lambda: CameraConfig(source=1))
+    T_C1_base: Matrix | None = None
+    T_C2_EE: Matrix | None = None
+
+
+@dataclass(frozen=True)
+class ChannelsConfig:
+    """Pressure channels: DAQ analog outputs in actuator order and the safety limits."""
+
+    names: tuple[str, ...] = tuple(f"Dev1/ao{i}" for i in range(9))
+    voltage_range: tuple[float, float] = (0.0, 5.0)
+    full_scale_psi: float = 0.5e6 / 6894.757293168361  # ITV1031: 0.5 MPa (assumed)
+    p_max: float = 70.0
+    max_rate_psi_per_s: float = 100.0
+    watchdog_timeout_s: float = 0.5
+    metres_per_psi: float = 1.0 / 2100.0
+
+
+@dataclass(frozen=True)
+class SerialConfig:
+    """The Arduino's serial port."""
+
+    port: str = "/dev/ttyACM0"
+    baud: int = 115200
+    timeout_s: float = 0.5
+    retries: int = 2
+    startup_delay_s: float = 2.0
+
+
+@dataclass(frozen=True)
+class Config:
+    """A whole installation."""
+
+    arm: ArmConfig
+    gains: GainsConfig = field(default_factory=GainsConfig)
+    calibration: CalibrationConfig = field(default_factory=CalibrationConfig)
+    channels: ChannelsConfig = field(default_factory=ChannelsConfig)
+    serial: SerialConfig = field(default_factory=SerialConfig)
+
+
+def load_config(path: str | Path) -> Config:
+    """Read and validate a TOML configuration file.
+
+    Raises:
+        ConfigError: the file is missing, not TOML, or a value is invalid (the message
+            names the key path and the value).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"cannot read config file {str(path)!r}: {exc}") from exc
+    return parse_config(text, source=str(path))
+
+
+def parse_config(text: str, source: str = "<string>") -> Config:
+    """Validate TOML text (see :func:`load_config`)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source} is not valid TOML: {exc}") from exc
+    return _build(_Table(data, "", source))
+
+
+def default_config() -> Config:
+    """The shipped blackberry-arm configuration (``softarm/data/blackberry.toml``)."""
+    text = resources.files("softarm.data").joinpath("blackberry.toml").read_text("utf-8")
+    return parse_config(text, source="softarm/data/blackberry.toml")
+
+
+def save_config(config: Config, path: str | Path) -> None:
+    """Write ``config`` as TOML that :func:`load_config` reads back to an equal Config."""
+    Path(path).write_text(dump_config(config), encoding="utf-8")
+
+
+# --- validation -------------------------------------------------------------------------
+
+
+class _Table:
+    """A TOML table plus its key path, so every error can name ``a.b[2].c``."""
+
+    def __init__(self, data: dict[str, Any], path: str, source: str) -> None:
+        self.data, self.path, self.source = data, path, source
+        self.used: set[str] = set()
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def error(self, name: str, message: str) -> ConfigError:
+        value = self.data.get(name, "<missing>")
+        return ConfigError(f"{self.source}: {self.key(name)} {message}, got {value!r}")
+
+    def get(self, name: str, default: Any = ...) -> Any:
+        self.used.add(name)
+        if name not in self.data:
+            if default is ...:
+                raise ConfigError(f"{self.source}: {self.key(name)} is required but missing")
+            return default
+        return self.data[name]
+
+    def number(
+        self, name: str, default: Any = ..., *, lo: float = -math.inf, positive: bool = False
+    ) -> float:
+        value = self.get(name, default)
+        if not (
+            isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+        ):
+            raise self.error(name, "must be a finite number")
+        if value < lo or (positive and value <= 0.0):
+            raise self.error(name, "must be > 0" if positive else f"must be >= {lo}")
+        return float(value)
+
+    def table(self, name: str, required: bool = False) -> _Table:
+        value = self.get(name, ... if required else {})
+        if not isinstance(value, dict):
+            raise self.error(name, "must be a table")
+        return _Table(value, self.key(name), self.source)
+
+    def done(self) -> None:
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            raise ConfigError(f"{self.source}: unknown key {self.key(unknown[0])!r}")
+
+
+def _section(t: _Table) -> SectionConfig:
+    s = SectionConfig(
+        radius=t.number("radius", positive=True),
+        rest_length=t.number("rest_length", positive=True),
+        lower=t.number("lower"),
+        upper=t.number("upper"),
+        offset=t.number("offset", lo=0.0),
+        twist=t.number("twist"),
+    )
+    if s.lower >= s.upper:
+        raise t.error("upper", f"must be greater than lower = {s.lower!r}")
+    t.done()
+    return s
+
+
+def _matrix(t: _Table, name: str, rows: int, cols: int | None = None) -> Any:
+    value = t.get(name, None)
+    if value is None:
+        return None
+    shape_ok = isinstance(value, list) and (
+        len(value) == rows if cols is not None else len(value) > 0
+    )
+    if cols is not None:
+        shape_ok = shape_ok and all(isinstance(r, list) and len(r) == cols for r in value)
+    flat = [x for r in value for x in r] if cols is not None and shape_ok else value
+    if not shape_ok or not all(
+        isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x) for x in flat
+    ):
+        shape = f"{rows}x{cols}" if cols is not None else "non-empty"
+        raise t.error(name, f"must be a {shape} array of finite numbers")
+    if cols is None:
+        return tuple(float(x) for x in value)
+    return tuple(tuple(float(x) for x in r) for r in value)
+
+
+def _pose(t: _Table, name: str) -> Matrix | None:
+    m: Matrix | None = _matrix(t, name, 4, 4)
+    if m is None:
+        return None
+    if m[3] != (0.0, 0.0, 0.0, 1.0):
+        raise t.error(name, "must have last row [0, 0, 0, 1]")
+    r = [row[:3] for row in m[:3]]
+    for i in range(3):
+        for j in range(3):
+            dot = sum(r[k][i] * r[k][j] for k in range(3))
+            if abs(dot - (1.0 if i == j else 0.0)) > 1e-6:
+                raise t.error(name, "must have an orthonormal rotation block")
+    det = (
+        r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0])
+    )
+    if det < 0.0:
+        raise t.error(name, "must have a rotation block with determinant +1")
+    return m
+
+
+def _camera(t: _Table, default_source: int) -> CameraConfig:
+    source = t.get("source", default_source)
+    if isinstance(source, bool) or not isinstance(source, int | str):
+        raise t.error("source", "must be a device index or a path/URL string")
+    file = t.get("file", None)
+    if file is not None and not isinstance(file, str):
+        raise t.error("file", "must be a path string")
+    cam = CameraConfig(source, _matrix(t, "matrix", 3, 3), _matrix(t, "distortion", 0), file)
+    t.done()
+    return cam
+
+
+def _build(root: _Table) -> Config:
+    arm_t = root.table("arm", required=True)
+    raw = arm_t.get("sections")
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, dict) for s in raw):
+        raise arm_t.error("sections", "must be a non-empty array of tables")
+    key = arm_t.key("sections")
+    arm = ArmConfig(
+        tuple(_section(_Table(s, f"{key}[{i}]", root.source)) for i, s in enumerate(raw))
+    )
+    arm_t.done()
+
+    gains_t = root.table("gains")
+    for name, value in gains_t.data.items():
+        items = value if isinstance(value, list) else [value]
+        if not all(isinstance(x, int | float | str) for x in items) or (
+            any(isinstance(x, float) and not math.isfinite(x) for x in items)
+        ):
+            raise gains_t.error(name, "must be a finite number, bool, string or a list of them")
+    gains = GainsConfig(dict(gains_t.data))
+
+    cal_t = root.table("calibration")
+    c1_t, c2_t = cal_t.table("c1"), cal_t.table("c2")
+    calibration = CalibrationConfig(
+        _camera(c1_t, 0), _camera(c2_t, 1), _pose(cal_t, "T_C1_base"), _pose(cal_t, "T_C2_EE")
+    )
+    cal_t.done()
+
+    ch = root.table("channels")
+    d = ChannelsConfig()
+    names = ch.get("names", list(d.names))
+    if not isinstance(names, list) or not all(isinstance(n, str) and n for n in names):
+        raise ch.error("names", "must be an array of channel-name strings")
+    if len(names) != 3 * len(arm.sections):
+        raise ch.error("names", f"must name {3 * len(arm.sections)} channels (3 per section)")
+    if len(set(names)) != len(names):
+        raise ch.error("names", "must not repeat a channel")
+    vr = _matrix(ch, "voltage_range", 2) or d.voltage_range
+    if len(vr) != 2 or not vr[0] < vr[1]:
+        raise ch.error("voltage_range", "must be [v_min, v_max] with v_min < v_max")
+    channels = ChannelsConfig(
+        names=tuple(names),
+        voltage_range=(vr[0], vr[1]),
+        full_scale_psi=ch.number("full_scale_psi", d.full_scale_psi, positive=True),
+        p_max=ch.number("p_max", d.p_max, positive=True),
+        max_rate_psi_per_s=ch.number("max_rate_psi_per_s", d.max_rate_psi_per_s, positive=True),
+        watchdog_timeout_s=ch.number("watchdog_timeout_s", d.watchdog_timeout_s, positive=True),
+        metres_per_psi=ch.number("metres_per_psi", d.metres_per_psi, positive=True),
+    )
+    if channels.p_max > channels.full_scale_psi:
+        raise ch.error("p_max", f"must not exceed full_scale_psi = {channels.full_scale_psi!r}")
+    reach = channels.p_max * channels.metres_per_psi
+    for i, s in enumerate(arm.sections):
+        if s.upper > reach * (1.0 + 1e-9) or s.lower < 0.0:
+            raise ConfigError(
+                f"{root.source}: arm.sections[{i}] elongation range [{s.lower!r}, {s.upper!r}]"
+                f" m is outside what channels.p_max = {channels.p_max!r} psi can produce "
+                f"([0, {reach!r}] m at {channels.metres_per_psi!r} m/psi)"
+            )
+    ch.done()
+
+    se = root.table("serial")
+    d2 = SerialConfig()
+    port = se.get("port", d2.port)
+    if not isinstance(port, str) or not port:
+        raise se.error("port", "must be a non-empty string")
+    baud, retries = se.get("baud", d2.baud), se.get("retries", d2.retries)
+    if isinstance(baud, bool) or not isinstance(baud, int) or baud <= 0:
+        raise se.error("baud", "must be a positive integer")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise se.error("retries", "must be a non-negative integer")
+    serial = SerialConfig(
+        port,
+        baud,
+        se.number("timeout_s", d2.timeout_s, positive=True),
+        retries,
+        se.number("startup_delay_s", d2.startup_delay_s, lo=0.0),
+    )
+    se.done()
+    root.done()
+    return Config(arm, gains, calibration, channels, serial)
+
+
+# --- writing ----------------------------------------------------------------------------
+
+
+def _toml(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value)  # a JSON string is a valid TOML basic string
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    raise ConfigError(f"cannot write {value!r} ({type(value).__name__}) to TOML")
+
+
+def _key(name: str) -> str:
+    return name if name and all(c.isalnum() or c in "_-" for c in name) else json.dumps(name)
+
+
+def _lines(values: dict[str, Any]) -> list[str]:
+    return [f"{_key(k)} = {_toml(v)}" for k, v in values.items() if v is not None]
+
+
+def dump_config(config: Config) -> str:
+    """The TOML text of ``config`` (what :func:`save_config` writes)."""
+    out = ["# softarm configuration (SI units; pressures in psi, voltages in V).", ""]
+    for s in config.arm.sections:
+        out += ["[[arm.sections]]", *_lines(asdict(s)), ""]
+    out += ["[gains]", *_lines(config.gains.values), ""]
+    cal = config.calibration
+    out += ["[calibration]", *_lines({"T_C1_base": cal.T_C1_base, "T_C2_EE": cal.T_C2_EE}), ""]
+    for name, cam in (("c1", cal.c1), ("c2", cal.c2)):
+        out += [f"[calibration.{name}]", *_lines(asdict(cam)), ""]
+    out += ["[channels]", *_lines(asdict(config.channels)), ""]
+    out += ["[serial]", *_lines(asdict(config.serial))]
+    return "\n".join(out) + "\n"

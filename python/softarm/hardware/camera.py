@@ -1,0 +1,73 @@
+"""OpenCV ``VideoCapture`` cameras (the eye-to-hand C1 and the eye-in-hand C2).
+
+``cv2`` is imported when a camera is opened, not when softarm is imported, so a broken
+or missing OpenCV only affects code that actually uses a camera.
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import HardwareError, HardwareUnavailableError
+
+__all__ = ["OpenCVCamera", "import_cv2"]
+
+Image = npt.NDArray[np.uint8]
+
+
+def import_cv2() -> ModuleType:
+    """Import OpenCV or raise :class:`HardwareUnavailableError` saying how to get it."""
+    try:
+        return importlib.import_module("cv2")
+    except ImportError as exc:
+        raise HardwareUnavailableError(
+            "cameras need OpenCV ('cv2'), which cannot be imported: "
+            "pip install 'opencv-python-headless>=5.0,<5.1'"
+        ) from exc
+
+
+class OpenCVCamera:
+    """A :class:`~softarm.hardware.protocols.Camera` on ``cv2.VideoCapture``.
+
+    Args:
+        source: device index (``0``), device path or stream URL.
+        width, height: requested frame size, or ``None`` for the driver's default.
+
+    Raises:
+        HardwareUnavailableError: OpenCV is missing or the device cannot be opened.
+    """
+
+    def __init__(
+        self, source: int | str = 0, width: int | None = None, height: int | None = None
+    ) -> None:
+        cv2 = import_cv2()
+        self.source = source
+        self._cap: Any = cv2.VideoCapture(source)
+        if not self._cap.isOpened():
+            self._cap.release()
+            self._cap = None
+            raise HardwareUnavailableError(f"cannot open camera {source!r} with OpenCV")
+        if width is not None:
+            self._cap.set(cv2.CAP_PROP_FRAME_WIDTH, width)
+        if height is not None:
+            self._cap.set(cv2.CAP_PROP_FRAME_HEIGHT, height)
+
+    def read(self) -> Image | None:
+        """One BGR frame ``(h, w, 3)``, or ``None`` when the driver dropped it."""
+        if self._cap is None:
+            raise HardwareError(f"camera {self.source!r} is closed")
+        ok, frame = self._cap.read()
+        if not ok or frame is None or getattr(frame, "size", 0) == 0:
+            return None
+        return np.asarray(frame, dtype=np.uint8)
+
+    def close(self) -> None:
+        """Release the device. Calling it twice is harmless."""
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None

@@ -1,0 +1,292 @@
+"""The safety layer that stands in front of every pressure backend.
+
+:class:`SafePressureBank` wraps any :class:`~softarm.hardware.protocols.PressureBank`
+and guarantees that nothing outside ``[0, p_max]`` psi, nothing non-finite and nothing of
+the wrong shape ever reaches it. It also limits how fast each channel may change, vents
+every channel when commands stop arriving (watchdog), latches an emergency stop, and
+vents on exit and on exception when used as a context manager. Every vent is logged
+with its reason and kept in :attr:`SafePressureBank.vent_log`.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import TracebackType
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import (
+    HardwareError,
+    NonFiniteError,
+    ParameterError,
+    SafetyError,
+    ShapeError,
+)
+from softarm.hardware.protocols import PressureBank
+from softarm.hardware.watchdog import WatchdogThread
+
+__all__ = ["CommandResult", "SafePressureBank", "VentEvent"]
+
+FloatArray = npt.NDArray[np.float64]
+BoolArray = npt.NDArray[np.bool_]
+
+_log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class CommandResult:
+    """What :meth:`SafePressureBank.set_pressures` did with one command.
+
+    Attributes:
+        requested: the command as given (psi).
+        sent: what was forwarded to the backend (psi), always within ``[0, p_max]``.
+        clamped: per channel, whether the request lay outside ``[0, p_max]``.
+        rate_limited: per channel, whether the rate limit shortened the step.
+    """
+
+    requested: FloatArray
+    sent: FloatArray
+    clamped: BoolArray
+    rate_limited: BoolArray
+
+    @property
+    def modified(self) -> bool:
+        """Whether ``sent`` differs from ``requested`` on any channel."""
+        return bool(self.clamped.any() or self.rate_limited.any())
+
+
+@dataclass(frozen=True)
+class VentEvent:
+    """One vent: the clock time and why."""
+
+    time: float
+    reason: str
+
+
+class SafePressureBank:
+    """Clamp, rate-limit and watch the commands sent to a pressure backend.
+
+    The backend is vented when the wrapper is created, so the rate limit starts from a
+    known state (0 psi everywhere). After startup, a vent or :meth:`reset`, the first
+    command forwards the current pressures unchanged and starts the ramp: pressures then
+    rise by at most ``max_rate_psi_per_s`` times the time between commands (that time
+    capped at ``watchdog_timeout_s``).
+
+    Args:
+        backend: the pressure bank to protect.
+        p_max: highest pressure (psi) ever forwarded; must not exceed
+            ``backend.max_pressure``.
+        max_rate_psi_per_s: largest change per channel per second, both directions
+            (a sudden drop whips the arm as much as a sudden rise). Venting is exempt.
+        watchdog_timeout_s: vent when no command has arrived for this long.
+        clock: monotonic time source in seconds; inject a fake one in tests.
+        watchdog_thread: run a daemon thread that checks the watchdog every
+            ``watchdog_timeout_s / 4`` s. Without it the watchdog is checked only on
+            each call and by :meth:`check_watchdog`.
+    """
+
+    def __init__(
+        self,
+        backend: PressureBank,
+        p_max: float,
+        max_rate_psi_per_s: float,
+        watchdog_timeout_s: float,
+        clock: Callable[[], float] = time.monotonic,
+        *,
+        watchdog_thread: bool = True,
+    ) -> None:
+        for name, value in (
+            ("p_max", p_max),
+            ("max_rate_psi_per_s", max_rate_psi_per_s),
+            ("watchdog_timeout_s", watchdog_timeout_s),
+        ):
+            if not (np.isfinite(value) and value > 0.0):
+                raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
+        if p_max > backend.max_pressure:
+            raise ParameterError(
+                f"p_max={p_max!r} psi exceeds the backend's max_pressure="
+                f"{backend.max_pressure!r} psi"
+            )
+        self._backend = backend
+        self._p_max = float(p_max)
+        self._rate = float(max_rate_psi_per_s)
+        self._timeout = float(watchdog_timeout_s)
+        self._clock = clock
+        self._lock = threading.RLock()
+        self._n = int(backend.channels)
+        self._last = np.zeros(self._n)
+        self._last_time = clock()
+        self._armed = False  # a command is live: the watchdog may fire
+        self._latched = False
+        self._closed = False
+        self.vent_log: list[VentEvent] = []
+        self.vent("startup")
+        self._thread: WatchdogThread | None = None
+        if watchdog_thread:
+            self._thread = WatchdogThread(
+                self.check_watchdog, self._timeout / 4.0, name="softarm-pressure-watchdog"
+            )
+            self._thread.start()
+
+    @property
+    def channels(self) -> int:
+        """Number of channels of the backend."""
+        return self._n
+
+    @property
+    def max_pressure(self) -> float:
+        """The safety limit ``p_max`` (psi)."""
+        return self._p_max
+
+    @property
+    def stopped(self) -> bool:
+        """Whether the emergency stop is latched."""
+        return self._latched
+
+    @property
+    def last_sent(self) -> FloatArray:
+        """The last pressures forwarded to the backend (psi), a copy."""
+        with self._lock:
+            return self._last.copy()
+
+    def set_pressures(self, psi: npt.ArrayLike) -> CommandResult:
+        """Validate, clamp and rate-limit ``psi`` (shape ``(channels,)``), then forward it.
+
+        Raises:
+            SafetyError: the emergency stop is latched or the bank is closed.
+            ShapeError: ``psi`` does not have shape ``(channels,)``.
+            NonFiniteError: ``psi`` contains NaN or inf. Nothing is forwarded.
+        """
+        requested = np.array(psi, dtype=np.float64)
+        if requested.shape != (self._n,):
+            raise ShapeError(f"psi must have shape ({self._n},), got {requested.shape}")
+        if not np.all(np.isfinite(requested)):
+            bad = np.flatnonzero(~np.isfinite(requested)).tolist()
+            raise NonFiniteError(f"psi must be finite, channels {bad} are {requested[bad]}")
+        with self._lock:
+            self._refuse_if_stopped()
+            self.check_watchdog()
+            now = self._clock()
+            target = np.clip(requested, 0.0, self._p_max)
+            clamped = target != requested
+            # After a vent, startup or reset the first command only starts the ramp clock:
+            # time spent idle must not buy a large jump.
+            dt = min(max(now - self._last_time, 0.0), self._timeout) if self._armed else 0.0
+            max_step = self._rate * dt
+            step = np.clip(target - self._last, -max_step, max_step)
+            rate_limited = step != target - self._last
+            # The clip is redundant (last and target are in range) but makes the bound local.
+            sent = np.clip(self._last + step, 0.0, self._p_max)
+            try:
+                self._backend.set_pressures(sent)
+            except Exception as exc:
+                self.vent(f"backend error on set_pressures: {exc!r}")
+                if isinstance(exc, HardwareError):
+                    raise
+                raise HardwareError(f"pressure backend failed: {exc!r}") from exc
+            self._last = sent
+            self._last_time = now
+            self._armed = True
+        result = CommandResult(requested, sent.copy(), clamped, rate_limited)
+        if clamped.any():
+            _log.warning(
+                "clamped channels %s to [0, %g] psi: requested %s",
+                np.flatnonzero(clamped).tolist(),
+                self._p_max,
+                requested[clamped].tolist(),
+            )
+        return result
+
+    def read_pressures(self) -> FloatArray:
+        """The backend's pressures (psi)."""
+        with self._lock:
+            return self._backend.read_pressures()
+
+    def check_watchdog(self) -> bool:
+        """Vent if a command is live and none has arrived for ``watchdog_timeout_s``.
+
+        Returns whether it vented. Called by the watchdog thread and on every command.
+        """
+        with self._lock:
+            if not self._armed or self._closed:
+                return False
+            idle = self._clock() - self._last_time
+            if idle <= self._timeout:
+                return False
+            self.vent(f"watchdog: no command for {idle:.3f} s (timeout {self._timeout} s)")
+            return True
+
+    def vent(self, reason: str = "requested") -> None:
+        """Vent every channel now (no rate limit) and log ``reason``.
+
+        If the backend's ``vent`` fails, zero pressures are commanded instead; if that
+        fails too, :class:`HardwareError` is raised.
+        """
+        with self._lock:
+            now = self._clock()
+            self.vent_log.append(VentEvent(now, reason))
+            _log.warning("venting all %d channels: %s", self._n, reason)
+            try:
+                self._backend.vent()
+            except Exception as exc:
+                _log.error("backend vent failed (%r); commanding 0 psi instead", exc)
+                try:
+                    self._backend.set_pressures(np.zeros(self._n))
+                except Exception as exc2:
+                    raise HardwareError(
+                        f"could not vent: vent() raised {exc!r}, set_pressures(0) raised {exc2!r}"
+                    ) from exc2
+            self._last = np.zeros(self._n)
+            self._last_time = now
+            self._armed = False
+
+    def emergency_stop(self, reason: str = "emergency stop") -> None:
+        """Vent and latch: every further command raises :class:`SafetyError` until
+        :meth:`reset`."""
+        with self._lock:
+            self._latched = True
+            self.vent(f"emergency stop: {reason}")
+
+    def reset(self) -> None:
+        """Clear the emergency-stop latch. Pressures restart from 0 under the rate limit."""
+        with self._lock:
+            if self._closed:
+                raise SafetyError("cannot reset: the pressure bank is closed")
+            self._latched = False
+            self._last_time = self._clock()
+            _log.warning("emergency stop reset")
+
+    def close(self, reason: str = "close") -> None:
+        """Stop the watchdog, vent and close the backend. Calling it twice is harmless."""
+        if self._thread is not None:
+            self._thread.stop()
+        with self._lock:
+            if self._closed:
+                return
+            try:
+                self.vent(reason)
+            finally:
+                self._closed = True
+                self._backend.close()
+
+    def __enter__(self) -> SafePressureBank:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close("exit" if exc is None else f"exception: {exc!r}")
+
+    def _refuse_if_stopped(self) -> None:
+        if self._closed:
+            raise SafetyError("pressure bank is closed; command refused")
+        if self._latched:
+            raise SafetyError("emergency stop is latched; call reset() before commanding")

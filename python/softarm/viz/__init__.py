@@ -1,0 +1,1 @@
+"""Plotting helpers (matplotlib, imported lazily by the callers)."""
