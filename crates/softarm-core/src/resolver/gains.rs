@@ -109,8 +109,9 @@ pub struct Gains {
     /// Fraction of each actuator range next to a limit where ∇H is frozen at its value
     /// at the band's edge, so that it stays finite at and beyond the limits.
     pub limit_margin: f64,
-    /// Largest Euclidean norm of one increment Δq (m); a longer step is shortened
-    /// along its direction. `f64::INFINITY` disables it.
+    /// Largest Euclidean norm of the task part of one increment Δq (m); a longer one is
+    /// shortened along its direction. The joint-limit part is capped at half of it.
+    /// `f64::INFINITY` disables both caps.
     pub max_step: f64,
 }
 

@@ -88,7 +88,8 @@ pub fn normal_inverse3(gram: &Mat3, active: [bool; 3], threshold: f64, damping: 
 
 /// Damped pseudo-inverse of any matrix through its SVD, with the same adaptive damping
 /// as [`normal_inverse3`] (σ_min is the smallest of the min(rows, cols) singular
-/// values): each σ is inverted as σ / (σ² + λ²), and 0 when both are 0.
+/// values): each σ is inverted as σ / (σ² + λ²), and singular values below the
+/// numerical rank tolerance `max(rows, cols)·ε·σ_max` count as zero.
 pub fn pinv_general(j: &DMatrix<f64>, threshold: f64, damping: f64) -> DMatrix<f64> {
     let (r, c) = j.shape();
     if r == 0 || c == 0 || j.iter().any(|v| !v.is_finite()) {
@@ -101,10 +102,17 @@ pub fn pinv_general(j: &DMatrix<f64>, threshold: f64, damping: f64) -> DMatrix<f
     let s = &svd.singular_values;
     let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
     let lambda2 = damping_squared(smin * smin, threshold, damping);
+    // Singular values below the numerical rank tolerance are zero.
+    let smax = s.iter().cloned().fold(0.0, f64::max);
+    let rank_tol = (r.max(c) as f64) * f64::EPSILON * smax;
     let mut inv_s = s.clone();
     for x in inv_s.iter_mut() {
         let den = *x * *x + lambda2;
-        *x = if den > 0.0 { *x / den } else { 0.0 };
+        *x = if *x > rank_tol && den > 0.0 {
+            *x / den
+        } else {
+            0.0
+        };
     }
     v_t.transpose() * DMatrix::from_diagonal(&inv_s) * u.transpose()
 }

@@ -26,6 +26,7 @@ pub struct Workspace {
     x1: Vec<f64>,
     eta: Vec<f64>,
     dq: Vec<f64>,
+    null: Vec<f64>,
     unclamped: Vec<f64>,
 }
 
@@ -40,6 +41,7 @@ impl Workspace {
             x1: vec![0.0; n],
             eta: vec![0.0; n],
             dq: vec![0.0; n],
+            null: vec![0.0; n],
             unclamped: vec![0.0; n],
         }
     }
@@ -187,6 +189,7 @@ impl<K: Kinematics> Resolver<K> {
         let lower = self.arm.lower();
         let upper = self.arm.upper();
         ws.dq.iter_mut().for_each(|v| *v = 0.0);
+        ws.null.iter_mut().for_each(|v| *v = 0.0);
 
         match self.mode {
             Mode::Position => {
@@ -264,12 +267,24 @@ impl<K: Kinematics> Resolver<K> {
             },
         }
 
-        // Step-length cap, then the limits: the command never leaves [lower, upper].
-        let len = ws.dq.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let scale = if len > g.max_step { g.max_step / len } else { 1.0 };
+        // Step-length caps: the task part at `max_step`, the joint-limit part at half of
+        // it, so that ∇H, large next to a limit, can never starve the tasks.
+        let cap = |v: &[f64], max: f64| {
+            let len = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if len > max {
+                max / len
+            } else {
+                1.0
+            }
+        };
+        let s_task = cap(&ws.dq, g.max_step);
+        let s_null = cap(&ws.null, 0.5 * g.max_step);
+        for (d, v) in ws.dq.iter_mut().zip(&ws.null) {
+            *d = s_task * *d + s_null * v;
+        }
         let mut saturated = false;
         for k in 0..n {
-            let raw = q[k] + scale * ws.dq[k];
+            let raw = q[k] + ws.dq[k];
             ws.unclamped[k] = raw;
             let c = raw.clamp(lower[k], upper[k]);
             saturated |= c != raw;
@@ -282,7 +297,7 @@ impl<K: Kinematics> Resolver<K> {
         })
     }
 
-    /// dq += s · (I − A⁺A − T⁺T) ∇H with `A⁺ = Aᵀ pa` (A = `ws.a`) and, if given,
+    /// null = s · (I − A⁺A − T⁺T) ∇H with `A⁺ = Aᵀ pa` (A = `ws.a`) and, if given,
     /// `T⁺ = Tᵀ pt` (T = `ws.t`): the null-space term of eq. (13) / (20).
     fn add_projected_gradient(
         &self,
@@ -299,14 +314,14 @@ impl<K: Kinematics> Resolver<K> {
             self.gains.limit_margin,
             &mut ws.eta,
         );
-        for (d, e) in ws.dq.iter_mut().zip(&ws.eta) {
-            *d += s * e;
+        for (d, e) in ws.null.iter_mut().zip(&ws.eta) {
+            *d = s * e;
         }
         let u = pa * mul(&ws.a, &ws.eta);
-        add_tr_mul(&mut ws.dq, -s, &ws.a, &u);
+        add_tr_mul(&mut ws.null, -s, &ws.a, &u);
         if let Some(pt) = pt {
             let v = pt * mul(&ws.t, &ws.eta);
-            add_tr_mul(&mut ws.dq, -s, &ws.t, &v);
+            add_tr_mul(&mut ws.null, -s, &ws.t, &v);
         }
     }
 }
