@@ -87,7 +87,10 @@ fn joint_limit_term_is_in_the_null_space_of_the_higher_tasks() {
                 .zip(step_dq(&off, &q, &target))
                 .map(|(a, b)| a - b)
                 .collect();
-            assert!(d.iter().map(|v| v.abs()).sum::<f64>() > 1e-12, "term is inactive");
+            assert!(
+                d.iter().map(|v| v.abs()).sum::<f64>() > 1e-12,
+                "term is inactive"
+            );
             let r = rel_residual(&j, &rows, &d);
             assert!(r < 1e-9, "{mode:?}: residual {r}");
         }
@@ -240,7 +243,12 @@ fn commands_never_leave_the_limits_and_saturation_is_reported() {
                 let mut t = arm.forward(&random_q(&mut rng, &arm, 0.0)).unwrap();
                 t[(1, 3)] += rng.random_range(-0.5..0.5);
                 let s = res.step(&q, &Target::Pose(t), None).unwrap();
-                let outside = s.unclamped.iter().zip(&lo).zip(&hi).any(|((v, l), h)| v < l || v > h);
+                let outside = s
+                    .unclamped
+                    .iter()
+                    .zip(&lo)
+                    .zip(&hi)
+                    .any(|((v, l), h)| v < l || v > h);
                 assert_eq!(s.info.saturated, outside);
                 seen_saturation |= s.info.saturated;
                 for k in 0..9 {
@@ -270,7 +278,10 @@ fn unreachable_target_ends_unconverged_with_the_best_error() {
     assert!(!sol.converged);
     assert!(sol.position_error.is_finite() && sol.position_error > 1.0);
     assert!(sol.position_error < 2.0, "no better than the start");
-    assert!(sol.q.iter().all(|v| v.is_finite() && *v >= 0.0 && *v <= 70.0 / 2100.0));
+    assert!(sol
+        .q
+        .iter()
+        .all(|v| v.is_finite() && *v >= 0.0 && *v <= 70.0 / 2100.0));
     let p = Resolver::new(arm, Mode::Position, Gains::blackberry()).unwrap();
     let far = Target::Position(nalgebra::Vector3::new(0.0, 0.0, -1.0));
     let sol = p.solve(&[0.01; 9], &far, &opts).unwrap();
@@ -280,7 +291,9 @@ fn unreachable_target_ends_unconverged_with_the_best_error() {
 #[test]
 fn straight_configuration_is_regular_no_nan_no_jump() {
     let arm = SoftArm::blackberry();
-    let mut t = arm.forward(&[0.01, 0.02, 0.0, 0.0, 0.01, 0.03, 0.02, 0.0, 0.01]).unwrap();
+    let mut t = arm
+        .forward(&[0.01, 0.02, 0.0, 0.0, 0.01, 0.03, 0.02, 0.0, 0.01])
+        .unwrap();
     t[(0, 3)] += 0.01;
     for mode in [
         Mode::Conventional,
@@ -292,7 +305,10 @@ fn straight_configuration_is_regular_no_nan_no_jump() {
         for base in [0.0, 0.0166, 70.0 / 2100.0] {
             let q = vec![base; 9];
             let a = res.step(&q, &Target::Pose(t), None).unwrap();
-            assert!(a.unclamped.iter().all(|v| v.is_finite()), "{mode:?} at {base}");
+            assert!(
+                a.unclamped.iter().all(|v| v.is_finite()),
+                "{mode:?} at {base}"
+            );
             let mut qp = q.clone();
             qp[4] += 1e-9;
             let b = res.step(&qp, &Target::Pose(t), None).unwrap();
@@ -357,7 +373,10 @@ fn every_error_path_is_typed_and_named() {
     assert!(matches!(e, Error::Shape { .. }) && arg(e) == "q");
     let mut q = [0.0; 9];
     q[2] = f64::NAN;
-    assert!(matches!(res.step(&q, &good, None), Err(Error::NonFinite { .. })));
+    assert!(matches!(
+        res.step(&q, &good, None),
+        Err(Error::NonFinite { .. })
+    ));
     let mut bad = Matrix4::identity();
     bad[(0, 0)] = 2.0;
     let e = res.step(&[0.0; 9], &Target::Pose(bad), None).unwrap_err();
@@ -375,16 +394,24 @@ fn every_error_path_is_typed_and_named() {
     assert!(matches!(e, Error::Shape { .. }) && arg(e) == "target");
     let p = Resolver::new(arm.clone(), Mode::Position, Gains::blackberry()).unwrap();
     let nanp = Target::Position(nalgebra::Vector3::new(0.0, f64::NAN, 0.5));
-    assert!(matches!(p.step(&[0.0; 9], &nanp, None), Err(Error::NonFinite { .. })));
+    assert!(matches!(
+        p.step(&[0.0; 9], &nanp, None),
+        Err(Error::NonFinite { .. })
+    ));
     let mut ws = softarm_core::resolver::Workspace::new(6);
     let mut out = [0.0; 9];
-    let e = res.step_into(&mut ws, &[0.0; 9], &good, None, &mut out).unwrap_err();
+    let e = res
+        .step_into(&mut ws, &[0.0; 9], &good, None, &mut out)
+        .unwrap_err();
     assert_eq!(arg(e), "workspace");
     let opts = SolveOptions {
         position_tolerance: 0.0,
         ..SolveOptions::default()
     };
-    assert_eq!(arg(res.solve(&[0.0; 9], &good, &opts).unwrap_err()), "position_tolerance");
+    assert_eq!(
+        arg(res.solve(&[0.0; 9], &good, &opts).unwrap_err()),
+        "position_tolerance"
+    );
     let g = Gains {
         hybrid_alpha: f64::NAN,
         ..Gains::blackberry()
