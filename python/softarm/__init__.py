@@ -9,7 +9,16 @@ and adds vision, hardware drivers, simulation, the harvest state machine and the
 np.float64(0.534)
 """
 
-from softarm._core import ArcChain, Section, SoftArm, __version__
+from softarm._core import (
+    ArcChain,
+    Gains,
+    Resolver,
+    Section,
+    SoftArm,
+    Solution,
+    StepResult,
+    __version__,
+)
 from softarm.errors import (
     ConfigError,
     HardwareError,
@@ -28,6 +37,10 @@ from softarm.errors import (
 
 __all__ = [
     "ArcChain",
+    "Gains",
+    "Resolver",
+    "Solution",
+    "StepResult",
     "ConfigError",
     "HardwareError",
     "HardwareUnavailableError",
