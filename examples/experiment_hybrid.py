@@ -1,4 +1,5 @@
-"""IV-D: hybrid position and orientation control at 7 poses, with and without limit avoidance, on the simulated arm.
+"""IV-D: hybrid position and orientation control at 7 poses, with and without joint-limit
+avoidance, on the simulated arm.
 
 Writes CSV, JSON and PNG files into the folder given as the first argument (default
 `experiments-out`) and prints the summary. Add `--quick` for a short run.

@@ -1,4 +1,5 @@
-"""IV-B: position control at 35 set-points along +Y, proposed (eq. 13) vs conventional (eq. 7), on the simulated arm.
+"""IV-B: position control at 35 set-points along +Y, proposed (eq. 13) against
+conventional resolved rate (eq. 7), on the simulated arm.
 
 Writes CSV, JSON and PNG files into the folder given as the first argument (default
 `experiments-out`) and prints the summary. Add `--quick` for a short run.

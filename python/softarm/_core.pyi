@@ -232,7 +232,9 @@ class Resolver:
     "hybrid" (eq. 20). ``gains=None`` uses ``Gains.default_for(arm)``.
     """
 
-    def __new__(cls, arm: SoftArm, mode: str = "hybrid", gains: Gains | None = None) -> Resolver: ...
+    def __new__(
+        cls, arm: SoftArm, mode: str = "hybrid", gains: Gains | None = None
+    ) -> Resolver: ...
     @property
     def mode(self) -> str: ...
     @property

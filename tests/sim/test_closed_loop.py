@@ -52,7 +52,9 @@ def test_experiment_command_line(tmp_path, capsys) -> None:
     from softarm.cli import main
 
     report = tmp_path / "experiments.md"
-    assert main(["experiment", "schedule", "--quick", "--out", str(tmp_path), "--report",
-                 str(report)]) == 0
+    assert (
+        main(["experiment", "schedule", "--quick", "--out", str(tmp_path), "--report", str(report)])
+        == 0
+    )
     assert "position_smooth" in capsys.readouterr().out
     assert "step (eq. 23–25)" in report.read_text()

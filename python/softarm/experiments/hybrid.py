@@ -16,7 +16,9 @@ from softarm.experiments.output import mean_std, plot_comparison, write_csv, wri
 from softarm.sim.arm import SimulatedArm
 
 
-def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None) -> dict[str, Any]:
+def run(
+    out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None
+) -> dict[str, Any]:
     """Runs the experiment, writes ``hybrid.{csv,json,png}``; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
     plant = SimulatedArm(seed=seed)

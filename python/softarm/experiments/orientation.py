@@ -34,7 +34,9 @@ def rot_x(angle: float, home: np.ndarray) -> np.ndarray:
     return t
 
 
-def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None) -> dict[str, Any]:
+def run(
+    out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None
+) -> dict[str, Any]:
     """Runs the experiment, writes ``orientation.{csv,json,png}``; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
     plant = SimulatedArm(seed=seed)
@@ -55,16 +57,32 @@ def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = Non
         ea, eb = math.degrees(a.final()[1]), math.degrees(b.final()[1])
         finals["proposed"].append(ea)
         finals["conventional"].append(eb)
-        settle = [next((t for t, e in zip(tr.time, tr.orientation_error, strict=True)
-                        if e < math.radians(0.57)), math.inf) for tr in (a, b)]
+        settle = [
+            next(
+                (
+                    t
+                    for t, e in zip(tr.time, tr.orientation_error, strict=True)
+                    if e < math.radians(0.57)
+                ),
+                math.inf,
+            )
+            for tr in (a, b)
+        ]
         rows.append([i, round(float(deg), 2), ea, eb, a.infeasible, b.infeasible, *settle])
         if example is None or b.infeasible > example[2].infeasible:
             example = (i, a, b)
     write_csv(
         out / "orientation.csv",
-        ["target", "angle_x_deg", "proposed_deg", "conventional_deg", "proposed_infeasible",
-         "conventional_infeasible", "proposed_first_below_0.57deg_s",
-         "conventional_first_below_0.57deg_s"],
+        [
+            "target",
+            "angle_x_deg",
+            "proposed_deg",
+            "conventional_deg",
+            "proposed_infeasible",
+            "conventional_infeasible",
+            "proposed_first_below_0.57deg_s",
+            "conventional_first_below_0.57deg_s",
+        ],
         rows,
     )
     if example is not None:
@@ -74,8 +92,13 @@ def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = Non
             {"proposed (eq. 13)": example[1], "conventional (eq. 7)": example[2]},
             orientation=True,
         )
-    plot_final_errors(out / "orientation_final.png", "IV-C final orientation error (X, Z)",
-                      [str(r[1]) for r in rows], finals, "deg")
+    plot_final_errors(
+        out / "orientation_final.png",
+        "IV-C final orientation error (X, Z)",
+        [str(r[1]) for r in rows],
+        finals,
+        "deg",
+    )
     summary = {
         "experiment": "orientation",
         "orientations": count,

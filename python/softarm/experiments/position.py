@@ -21,7 +21,9 @@ from softarm.experiments.output import (
 from softarm.sim.arm import SimulatedArm
 
 
-def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None) -> dict[str, Any]:
+def run(
+    out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None
+) -> dict[str, Any]:
     """Runs the experiment, writes ``position.{csv,json,png}`` into ``out``; returns the
     summary."""
     out.mkdir(parents=True, exist_ok=True)
@@ -44,14 +46,34 @@ def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = Non
         finals["proposed"].append(ea * 1e3)
         finals["conventional"].append(eb * 1e3)
         infeasible += b.infeasible
-        rows.append([i, *np.round(target, 5), ea * 1e3, eb * 1e3, a.infeasible, b.infeasible,
-                     a.settle_time(1e-3), b.settle_time(1e-3)])
+        rows.append(
+            [
+                i,
+                *np.round(target, 5),
+                ea * 1e3,
+                eb * 1e3,
+                a.infeasible,
+                b.infeasible,
+                a.settle_time(1e-3),
+                b.settle_time(1e-3),
+            ]
+        )
         if example is None or b.infeasible > example[2].infeasible:
             example = (i, a, b)
     write_csv(
         out / "position.csv",
-        ["target", "x", "y", "z", "proposed_mm", "conventional_mm", "proposed_infeasible",
-         "conventional_infeasible", "proposed_settle_1mm_s", "conventional_settle_1mm_s"],
+        [
+            "target",
+            "x",
+            "y",
+            "z",
+            "proposed_mm",
+            "conventional_mm",
+            "proposed_infeasible",
+            "conventional_infeasible",
+            "proposed_settle_1mm_s",
+            "conventional_settle_1mm_s",
+        ],
         rows,
     )
     if example is not None:
@@ -60,8 +82,13 @@ def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = Non
             f"IV-B position control, set-point {example[0]} (cf. Fig. 7)",
             {"proposed (eq. 13)": example[1], "conventional (eq. 7)": example[2]},
         )
-    plot_final_errors(out / "position_final.png", "IV-B final position error (cf. Fig. 6)",
-                      [str(r[0]) for r in rows], finals, "mm")
+    plot_final_errors(
+        out / "position_final.png",
+        "IV-B final position error (cf. Fig. 6)",
+        [str(r[0]) for r in rows],
+        finals,
+        "mm",
+    )
     summary = {
         "experiment": "position",
         "set_points": count,
@@ -69,7 +96,7 @@ def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = Non
         "proposed_mm": mean_std(finals["proposed"]),
         "conventional_mm": mean_std(finals["conventional"]),
         "conventional_infeasible_commands": infeasible,
-        "conventional_steps": count * int(round(duration / 0.05)),
+        "conventional_steps": count * round(duration / 0.05),
         "proposed_infeasible_commands": int(sum(r[6] for r in rows)),
         "conventional_set_points_with_infeasible": int(sum(1 for r in rows if r[7] > 0)),
         "paper_mm": {"mean": 0.84, "std": 0.38},

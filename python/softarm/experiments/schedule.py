@@ -18,7 +18,9 @@ from softarm.experiments.output import write_csv, write_json
 from softarm.sim.arm import SimulatedArm
 
 
-def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None) -> dict[str, Any]:
+def run(
+    out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None
+) -> dict[str, Any]:
     """Runs the comparison, writes ``schedule.{csv,json}``; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
     plant = SimulatedArm(seed=seed)
@@ -58,7 +60,10 @@ def run(out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = Non
                 "saturated_steps": int(np.sum(sats)),
             }
             rows.append([key, *summary[key].values()])
-    write_csv(out / "schedule.csv", ["run", *next(iter(
-        v for k, v in summary.items() if isinstance(v, dict))).keys()], rows)
+    write_csv(
+        out / "schedule.csv",
+        ["run", *next(iter(v for k, v in summary.items() if isinstance(v, dict))).keys()],
+        rows,
+    )
     write_json(out / "schedule.json", summary)
     return summary
