@@ -65,7 +65,16 @@ pub fn normal_inverse3(gram: &Mat3, active: [bool; 3], threshold: f64, damping: 
             g[(i, i)] = big;
         }
     }
-    let lambda2 = damping_squared(min_eigenvalue_sym3(&g), threshold, damping);
+    // For a positive definite 3×3 matrix λ_min ≥ det / (λ₂λ₃) ≥ 4·det / trace²: when that
+    // bound already clears the threshold the damping is zero and the eigenvalue is not
+    // needed (the common, well-conditioned case).
+    let tr = g.trace();
+    let bound = 4.0 * g.determinant() / (tr * tr);
+    let lambda2 = if tr > 0.0 && bound >= threshold * threshold {
+        0.0
+    } else {
+        damping_squared(min_eigenvalue_sym3(&g), threshold, damping)
+    };
     for i in 0..3 {
         if active[i] {
             g[(i, i)] += lambda2;
