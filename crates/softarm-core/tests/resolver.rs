@@ -447,3 +447,46 @@ fn every_error_path_is_typed_and_named() {
     assert_eq!(arg(e), "hybrid_alpha");
     assert_eq!(arg(Mode::parse("fast").unwrap_err()), "mode");
 }
+
+#[test]
+fn saturated_coordinates_are_held_and_the_others_still_meet_the_task() {
+    // Saturation in the null space: with coordinates held at a limit, the command still
+    // moves the end effector by exactly α·e_p (first order) when the free ones can.
+    let arm = SoftArm::blackberry();
+    let g = Gains {
+        position_gamma: 0.0,
+        position_alpha: 0.5,
+        ..exact_gains()
+    };
+    let res = Resolver::new(arm.clone(), Mode::Position, g).unwrap();
+    let mut rng = StdRng::seed_from_u64(9);
+    let mut tested = 0;
+    for _ in 0..50 {
+        let q: Vec<f64> = (0..9).map(|_| rng.random_range(0.0..0.004)).collect();
+        let mut p = arm
+            .forward(&q)
+            .unwrap()
+            .fixed_view::<3, 1>(0, 3)
+            .into_owned();
+        p += nalgebra::Vector3::new(
+            rng.random_range(-0.01..0.01),
+            rng.random_range(-0.01..0.01),
+            rng.random_range(-0.01..0.0),
+        );
+        let s = res.step(&q, &Target::Position(p), None).unwrap();
+        if !s.info.saturated {
+            continue;
+        }
+        let held = (0..9).filter(|&k| s.q[k] == 0.0).count();
+        if held > 5 {
+            continue; // fewer than 4 free coordinates: the task may be infeasible
+        }
+        tested += 1;
+        let d = DVector::from_iterator(9, s.q.iter().zip(&q).map(|(a, b)| a - b));
+        let moved = jac(&arm, &q).rows(0, 3) * d;
+        let want = (p - arm.forward(&q).unwrap().fixed_view::<3, 1>(0, 3)) * 0.5;
+        let err = (moved - want).norm();
+        assert!(err < 1e-9, "{err}");
+    }
+    assert!(tested >= 10, "only {tested} saturated cases");
+}
