@@ -23,20 +23,29 @@ def run(
 ) -> dict[str, Any]:
     """Runs the comparison, writes ``schedule.{csv,json}``; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
-    plant = SimulatedArm(seed=seed)
-    rng = np.random.default_rng(seed + 4)
-    count, duration = (3, 20.0) if quick else (10, 30.0)
-    base = gains if gains is not None else Gains.default_for(plant.model)
+    count, duration, plants = (3, 20.0, 1) if quick else (10, 30.0, 3)
     rows = []
-    summary: dict[str, Any] = {"experiment": "schedule", "targets": count, "duration_s": duration}
-    pressures = bush_pressures(plant, rng, count)
-    starts = [start_configuration(rng, plant.n) for _ in pressures]
+    summary: dict[str, Any] = {
+        "experiment": "schedule",
+        "targets": count * plants,
+        "plants": plants,
+        "duration_s": duration,
+    }
+    # Several plants (seeds), the same targets and starts for both schedules.
+    cases = []
+    for k in range(plants):
+        plant = SimulatedArm(seed=seed + k)
+        rng = np.random.default_rng(seed + k + 4)
+        for p in bush_pressures(plant, rng, count):
+            cases.append((plant, p, start_configuration(rng, plant.n)))
+    model = cases[0][0].model
+    base = gains if gains is not None else Gains.default_for(model)
     for mode in ("position", "hybrid"):
         for schedule in ("step", "smooth"):
-            res = Resolver(plant.model, mode, base.replace(schedule=schedule))
+            res = Resolver(model, mode, base.replace(schedule=schedule))
             switch = base.position_switch if mode == "position" else base.hybrid_switch
             finals, settles, jumps, sats = [], [], [], []
-            for p, q0 in zip(pressures, starts, strict=True):
+            for plant, p, q0 in cases:
                 pose = plant.pose_at_pressure(p)
                 target = pose[:3, 3] if mode == "position" else pose
                 tr = closed_loop(res, plant, target, q0, duration)
