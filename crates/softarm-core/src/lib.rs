@@ -45,3 +45,5 @@ pub use kinematics::Kinematics;
 pub use math::{Frame, Mat3, Mat4, Vec3};
 pub use planner::{Plan, PlannerOptions, PotentialFieldPlanner, Termination};
 pub use soft_arm::{Section, SoftArm};
+pub mod resolver;
+pub use resolver::{Gains, Mode, Resolver, Schedule, Solution, SolveOptions, Target};

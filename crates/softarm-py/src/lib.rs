@@ -7,6 +7,7 @@ mod distance;
 mod errors;
 mod kinematics;
 mod planner;
+mod resolver;
 
 use pyo3::prelude::*;
 
@@ -15,6 +16,7 @@ use pyo3::prelude::*;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kinematics::register(m)?;
+    resolver::register(m)?;
     distance::register(m)?;
     planner::register(m)?;
     Ok(())

@@ -12,3 +12,17 @@ __all__ = [
     "TexturedPlane",
     "cube_scene_markers",
 ]
+
+from softarm.sim.arm import PlantConfig, SimulatedArm, perturbed_arm
+from softarm.sim.hysteresis import PlayHysteresis
+from softarm.sim.pressure import PressureDynamics
+from softarm.sim.tracker import PoseTracker
+
+__all__ += [
+    "PlantConfig",
+    "PlayHysteresis",
+    "PoseTracker",
+    "PressureDynamics",
+    "SimulatedArm",
+    "perturbed_arm",
+]
