@@ -81,10 +81,16 @@ impl ArcParams {
 
     /// Position at fraction `s` with its derivatives with respect to (L, ux, uy) and s.
     pub fn point_with_derivatives(&self, s: f64) -> ArcPoint {
+        let x = s * s * (self.ux * self.ux + self.uy * self.uy);
+        self.point_with_derivatives_from(s, &ArcFunctions::at(x))
+    }
+
+    /// [`ArcParams::point_with_derivatives`] given the functions at `x = s² |u|²`.
+    #[inline]
+    fn point_with_derivatives_from(&self, s: f64, f: &ArcFunctions) -> ArcPoint {
         let (ux, uy, l) = (self.ux, self.uy, self.length);
         let u2 = ux * ux + uy * uy;
         let s2 = s * s;
-        let f = ArcFunctions::at(s2 * u2);
         let pos = Vec3::new(l * s2 * f.f2 * ux, l * s2 * f.f2 * uy, l * s * f.f1);
         // ∂x/∂ux where x = s² u²  is 2 s² ux.
         let (dxu, dxv) = (2.0 * s2 * ux, 2.0 * s2 * uy);
@@ -135,9 +141,9 @@ impl ArcParams {
     /// `J_l = I + f2 [ω]× + f3 [ω]×²`.
     #[inline]
     pub fn frame_with_derivatives(&self, s: f64) -> (Frame, Mat3, Mat3) {
-        let pt = self.point_with_derivatives(s);
         let (wx, wy) = (-self.uy * s, self.ux * s);
         let f = ArcFunctions::at(wx * wx + wy * wy);
+        let pt = self.point_with_derivatives_from(s, &f);
         let rot = rodrigues(wx, wy, f.f1, f.f2);
         // Columns 0 and 1 of J_l (ω_z = 0).
         let jl0 = Vec3::new(1.0 - f.f3 * wy * wy, f.f3 * wx * wy, -f.f2 * wy);
