@@ -48,7 +48,10 @@
 //! closer point. The Lipschitz bound of the circle branch uses the true distance at the
 //! samples (the circle branch matters only where it is the true distance), bisection
 //! midpoints are shared between the branches, and on a bracket proven convex the regula
-//! falsi stops once the tangent bound is within 1e-12 m of the best distance.
+//! falsi stops once the tangent bound is within 1e-12 m of the best distance. An interval
+//! is also discarded for branch `b` when the second-order bound (`d_b²/2` has slope `g_b`
+//! and curvature `≥ −M`, expanded from both ends to the midpoint) stays at or above the
+//! best distance.
 //!
 //! Every distance reported is evaluated exactly at the final `(s, u)`. The only case this
 //! does not certify is a single grid interval in which one smooth branch has a minimum
@@ -450,6 +453,39 @@ impl Query {
         (da + 2.0 * ga * (u - a.u)).max(0.0).sqrt()
     }
 
+    /// Bound `M ≥ |g_k'|` on [a, b] (`None` near the circle's axis):
+    /// `g_k' = |F_o'|² − p_k'·F_o' + (F_o − p_k)·F_o''`.
+    fn curvature_bound(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> Option<f64> {
+        let w = b.u - a.u;
+        let d_max = a.d[k].min(b.d[k]) + bo.speed * w;
+        let foot_speed = match k {
+            0 => {
+                let ratio_min = Self::ratio_min(a, b, bo);
+                if ratio_min <= 0.0 {
+                    return None;
+                }
+                bo.speed / ratio_min
+            }
+            _ => 0.0,
+        };
+        Some(bo.speed * bo.speed + bo.speed * foot_speed + d_max * bo.accel)
+    }
+
+    /// Whether branch `k` provably stays at or above `best` on [a, b]: `f = d_k² / 2` has
+    /// `f' = g_k` and `f'' ≥ −M`, so on [a, m] (m the midpoint) it lies above the concave
+    /// `f(a) + g(a)(u − a) − M (u − a)² / 2`, whose minimum there is at a or m, and
+    /// likewise on [m, b] from b.
+    fn above_best(a: &Sample, b: &Sample, k: usize, bo: &Bounds, best: f64) -> bool {
+        let Some(m) = Self::curvature_bound(a, b, k, bo) else {
+            return false;
+        };
+        let h = 0.5 * (b.u - a.u);
+        let (fa, fb) = (0.5 * a.d[k] * a.d[k], 0.5 * b.d[k] * b.d[k]);
+        let drop = 0.5 * m * h * h;
+        let low = (fa + a.g[k] * h - drop).min(fb - b.g[k] * h - drop);
+        low.min(fa).min(fb) >= 0.5 * best * best
+    }
+
     /// Whether branch `k`'s derivative provably keeps one sign on [a, b].
     fn monotone(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> bool {
         let (ga, gb) = (a.g[k], b.g[k]);
@@ -479,6 +515,7 @@ impl Query {
             || Self::lower_bound(a, b, k, bo.speed) >= self.best_d
             || (k == 0 && Self::foot_off_arc(a, b, bo))
             || Self::monotone(a, b, k, bo)
+            || (self.best_d.is_finite() && Self::above_best(a, b, k, bo, self.best_d))
             || (Self::convex(a, b, k, bo) && !Sample::falls_then_rises(a, b, k))
             || Self::flat(a, b, k)
         {
