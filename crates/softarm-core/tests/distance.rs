@@ -418,3 +418,22 @@ fn bad_input_gets_typed_errors() {
         Err(Error::NonFinite { .. })
     ));
 }
+
+#[test]
+fn arc_curve_benchmark_pairs_match_dense_sampling() {
+    use softarm_core::distance::placed_arcs;
+    use softarm_core::planner::scenarios::scenario;
+    let chain = ArcChain::new(&[1.0, 1.0, 1.0]).unwrap();
+    let q = [0.65, 0.25, 0.66, 0.67, 0.36, 0.24, 0.7, 0.13, 0.02];
+    let arcs = placed_arcs(&chain, &q);
+    let mut curves = scenario("curve").unwrap().curves;
+    curves.extend(scenario("tree").unwrap().curves);
+    for arc in &arcs {
+        for curve in &curves {
+            let got = check_hit(arc, curve);
+            let want = reference(arc, curve, 60, 400);
+            assert!(got <= want + 1e-9, "exact {got} > reference {want}");
+            assert!(closest_arc_curve(arc, curve).evaluations <= 200);
+        }
+    }
+}

@@ -37,6 +37,22 @@
 //!   the circle at most `S r / ρ` per unit of `u`); otherwise it is bisected and searched again (to depth 24, within a budget of 200
 //!   evaluations per pair).
 //!
+//! Cost. The curve's coefficients are moved into the arc's frame once per query, so an
+//! evaluation is one Horner pass (value and derivative together) plus a few square roots:
+//! the foot on the circle and whether it lies on the arc come from the in-plane
+//! coordinates against the arc's end directions, without trigonometry, and the foot's
+//! distance from the arc (in `s`) is bounded below by chords (a chord never exceeds its
+//! arc). Grid intervals are sampled nearest first and only while a lower bound (the
+//! curve's Taylor sphere over the interval against the arc's sphere of radius `L/2`
+//! around its middle) beats the best distance so far; the other intervals cannot hold a
+//! closer point. The Lipschitz bound of the circle branch uses the true distance at the
+//! samples (the circle branch matters only where it is the true distance), bisection
+//! midpoints are shared between the branches, and on a bracket proven convex the regula
+//! falsi stops once the tangent bound is within 1e-12 m of the best distance. An interval
+//! is also discarded for branch `b` when the second-order bound (`d_b²/2` has slope `g_b`
+//! and curvature `≥ −M`, expanded from both ends to the midpoint) stays at or above the
+//! best distance.
+//!
 //! Every distance reported is evaluated exactly at the final `(s, u)`. The only case this
 //! does not certify is a single grid interval in which one smooth branch has a minimum
 //! *and* two more turning points with a lower minimum, which needs the curve to turn on
@@ -71,6 +87,8 @@ const BRANCHES: usize = 3;
 #[derive(Debug, Clone, Copy, Default)]
 struct Sample {
     u: f64,
+    /// The true distance to the arc: the smallest valid branch.
+    dist: f64,
     d: [f64; BRANCHES],
     /// Half derivative of d_b² in u: (F_o − p_b)·F_o'.
     g: [f64; BRANCHES],
@@ -80,7 +98,8 @@ struct Sample {
     speed: f64,
     /// F_o'(u) · t, t the circle's unit tangent at the foot.
     along: f64,
-    /// How far (in s, around the circle) the circle foot lies outside the arc's [0, 1].
+    /// A lower bound of how far (in s, around the circle) the circle foot lies outside the
+    /// arc's [0, 1] (0 when on the arc).
     gap: f64,
 }
 
@@ -111,74 +130,177 @@ impl Sample {
     }
 }
 
-struct Query<'a> {
-    arc: &'a PlacedArc,
-    curve: &'a PolynomialCurve,
-    best_d: f64,
-    best_u: f64,
-    best_s: f64,
-    evals: u32,
+/// Most coefficients kept on the stack for the curve in the arc's frame.
+const STACK_COEFFS: usize = 16;
+
+/// The arc's geometry in its plane, precomputed once per query.
+struct Geometry {
+    length: f64,
+    theta: f64,
+    dir: (f64, f64),
+    tip: Vec3,
+    cos: f64,
+    sin: f64,
+    /// sin Θ / Θ (1 at Θ = 0).
+    sinc: f64,
+    /// Θ > π: the arc covers more than half its circle.
+    wide: bool,
 }
 
-impl Query<'_> {
+struct Query {
+    geo: Geometry,
+    /// The curve's coefficients in the arc's base frame (ascending powers).
+    stack: [Vec3; STACK_COEFFS],
+    heap: Vec<Vec3>,
+    ncoeffs: usize,
+    best_d: f64,
+    best_u: f64,
+    best_k: usize,
+    evals: u32,
+    /// Bisection midpoints already evaluated (the branches of one interval share them).
+    memo_u: [f64; MEMO],
+    memo: [Sample; MEMO],
+    memo_len: usize,
+}
+
+/// Bisection midpoints remembered per query.
+const MEMO: usize = 16;
+
+/// Absolute tolerance (m) of the regula falsi's stopping test on a convex bracket.
+const STOP_TOL: f64 = 1e-12;
+
+/// Lower bound, in fractions of the arc, of the angle between the unit vector along
+/// `(a, b)` (`h = |(a, b)|`, `b = Θ bs`) and the unit vector along the x axis: the chord
+/// `|f − e| = |b| √(2 / (h (h + a)))` (no cancellation) when `a > 0`, else `√(2 (1 − a/h))`;
+/// a chord never exceeds its arc.
+#[inline]
+fn chord_fraction(bs: f64, a: f64, h: f64, theta: f64) -> f64 {
+    if a > 0.0 {
+        bs.abs() * (2.0 / (h * (h + a))).sqrt()
+    } else {
+        (2.0 * (1.0 - a / h)).sqrt() / theta
+    }
+}
+
+impl Query {
+    #[inline]
+    fn coeffs(&self) -> &[Vec3] {
+        if self.ncoeffs <= STACK_COEFFS {
+            &self.stack[..self.ncoeffs]
+        } else {
+            &self.heap
+        }
+    }
+
+    /// The curve point and tangent at `u`, in the arc's frame (Horner, value and
+    /// derivative together).
+    #[inline]
+    fn curve_local(&self, u: f64) -> (Vec3, Vec3) {
+        let c = self.coeffs();
+        let mut p = c[c.len() - 1];
+        let mut dp = Vec3::zeros();
+        for ck in c[..c.len() - 1].iter().rev() {
+            dp = dp * u + p;
+            p = p * u + ck;
+        }
+        (p, dp)
+    }
+
+    /// Distances, derivatives and certificates' data of the three branches at `u`. No
+    /// trigonometry: the foot of the perpendicular on the circle and whether it lies on
+    /// the arc come from the plane coordinates `(a, b) = Θ (r − x_d, x_z)` against the
+    /// arc's end directions (1, 0) and (cos Θ, sin Θ).
     #[inline]
     fn eval(&mut self, u: f64) -> Sample {
-        let (f, df) = self.curve.eval_with_derivative(u);
-        let x = self.arc.to_local(&f);
-        let dx = self.arc.dir_to_local(&df);
-        let local = &self.arc.arc;
+        let (x, dx) = self.curve_local(u);
         self.evals += 1;
-        let (sc, ratio, tangent, foot) = local.circle_foot(&x);
-        let vs = [x - foot, x, x - local.tip()];
+        let geo = &self.geo;
+        let (l, theta) = (geo.length, geo.theta);
+        let xd = x.x * geo.dir.0 + x.y * geo.dir.1;
+        let xz = x.z;
+        let a = l - theta * xd; // Θ · (r − x_d)
+        let b = theta * xz; // Θ · x_z
+        let h = (a * a + b * b).sqrt();
+        let ratio = h / l;
+        let (tangent, foot, on_arc, gap) = if h > 0.0 {
+            let ih = 1.0 / h;
+            let (sa, ca) = (b * ih, a * ih);
+            let along = l * xz * ih;
+            let across = if a > 0.0 {
+                l * theta * xz * xz * ih / (h + a)
+            } else {
+                (l / theta) * (1.0 - ca)
+            };
+            // (a, b) rotated by −Θ, with its second component over Θ.
+            let a1 = a * geo.cos + b * geo.sin;
+            let bs1 = xz * geo.cos - a * geo.sinc;
+            let (past0, past1) = (xz >= 0.0, bs1 <= 0.0);
+            let on = if geo.wide {
+                past0 || past1
+            } else {
+                past0 && past1
+            };
+            let gap = if on {
+                0.0
+            } else {
+                chord_fraction(xz, a, h, theta).min(chord_fraction(bs1, a1, h, theta))
+            };
+            (
+                Vec3::new(sa * geo.dir.0, sa * geo.dir.1, ca),
+                Vec3::new(across * geo.dir.0, across * geo.dir.1, along),
+                on,
+                gap,
+            )
+        } else {
+            // On the circle's axis: every circle point is a foot; take the base.
+            (Vec3::z(), Vec3::zeros(), true, 0.0)
+        };
+        let vs = [x - foot, x, x - geo.tip];
         let d = [vs[0].norm(), vs[1].norm(), vs[2].norm()];
         let g = [vs[0].dot(&dx), vs[1].dot(&dx), vs[2].dot(&dx)];
         // The true distance: the smallest valid branch.
-        let (mut dd, mut ss) = if d[1] <= d[2] {
-            (d[1], 0.0)
-        } else {
-            (d[2], 1.0)
-        };
-        if (0.0..=1.0).contains(&sc) && d[0] < dd {
+        let (mut dd, mut kk) = if d[1] <= d[2] { (d[1], 1) } else { (d[2], 2) };
+        if on_arc && d[0] < dd {
             dd = d[0];
-            ss = sc;
+            kk = 0;
         }
         if dd < self.best_d {
             self.best_d = dd;
             self.best_u = u;
-            self.best_s = ss;
+            self.best_k = kk;
         }
-        let gap = if (0.0..=1.0).contains(&sc) {
-            0.0
-        } else {
-            let theta = local.theta();
-            let ahead = if sc > 1.0 { sc - 1.0 } else { -sc };
-            if theta > 0.0 {
-                // The other way round the circle (period 2π/Θ in s).
-                let period = std::f64::consts::TAU / theta;
-                let behind = if sc > 1.0 {
-                    period - sc
-                } else {
-                    sc + period - 1.0
-                };
-                ahead.min(behind.max(0.0))
-            } else {
-                ahead
-            }
-        };
         Sample {
             u,
+            dist: dd,
             d,
             g,
             ratio,
-            speed: df.norm(),
+            speed: dx.norm(),
             along: dx.dot(&tangent),
             gap,
         }
     }
 
+    /// [`Query::eval`] at the midpoint of [a, b], remembered: the bisections of the
+    /// three branches of one interval hit the same points.
+    fn eval_mid(&mut self, a: &Sample, b: &Sample) -> Sample {
+        let u = 0.5 * (a.u + b.u);
+        let n = self.memo_len.min(MEMO);
+        if let Some(i) = self.memo_u[..n].iter().position(|&v| v == u) {
+            return self.memo[i];
+        }
+        let m = self.eval(u);
+        let slot = self.memo_len % MEMO;
+        self.memo_u[slot] = u;
+        self.memo[slot] = m;
+        self.memo_len += 1;
+        m
+    }
+
     /// Illinois regula falsi for the root of branch `k`'s derivative on [a, b],
-    /// g(a) < 0 < g(b).
-    fn refine(&mut self, k: usize, mut a: Sample, mut b: Sample, speed: f64) {
+    /// g(a) < 0 < g(b). On a bracket proven `convex`, it stops as soon as the tangent
+    /// bound shows that the branch cannot go `STOP_TOL` below the best distance.
+    fn refine(&mut self, k: usize, mut a: Sample, mut b: Sample, speed: f64, convex: bool) {
         let (mut ga, mut gb) = (a.g[k], b.g[k]);
         if ga == 0.0 || gb == 0.0 {
             // The minimum is the end sample, already counted.
@@ -205,7 +327,9 @@ impl Query<'_> {
             prev = u;
             // Stop as soon as the shrinking bracket cannot beat the best any more.
             let (l, r) = if gc > 0.0 { (&a, &c) } else { (&c, &b) };
-            if Self::lower_bound(l, r, k, speed) >= self.best_d {
+            if Self::lower_bound(l, r, k, speed) >= self.best_d
+                || (convex && Self::tangent_bound(l, r, k) >= self.best_d - STOP_TOL)
+            {
                 break;
             }
             if gc > 0.0 {
@@ -226,10 +350,12 @@ impl Query<'_> {
         }
     }
 
-    /// Lipschitz lower bound of branch `k` on [a, b].
+    /// Lipschitz lower bound on [a, b] of branch `k` (an end) or, for the circle branch,
+    /// of the true distance (where the circle branch is valid it is the true distance, and
+    /// elsewhere it cannot give the minimum): both are 1-Lipschitz in the curve point.
     #[inline]
     fn lower_bound(a: &Sample, b: &Sample, k: usize, speed: f64) -> f64 {
-        0.5 * (a.d[k] + b.d[k] - speed * (b.u - a.u))
+        0.5 * (a.d[k].max(a.dist) + b.d[k].max(b.dist) - speed * (b.u - a.u))
     }
 
     /// Lower bound of ρ / r on [a, b] (ρ / r is (Θ/L)·S-Lipschitz in u).
@@ -250,30 +376,30 @@ impl Query<'_> {
     /// circle branch has a concave kink where the curve crosses the circle's axis, with a
     /// minimum on either side, so while the interval may contain such a crossing it is
     /// bisected further.
-    fn bracket(&mut self, k: usize, a: Sample, b: Sample, bo: &Bounds, depth: u32) {
-        if Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d
-            || (k == 0 && Self::foot_off_arc(&a, &b, bo))
+    fn bracket(&mut self, k: usize, a: &Sample, b: &Sample, bo: &Bounds, depth: u32) {
+        if Self::lower_bound(a, b, k, bo.speed) >= self.best_d
+            || (k == 0 && Self::foot_off_arc(a, b, bo))
         {
             return;
         }
-        let convex = Self::convex(&a, &b, k, bo);
-        if convex && Self::tangent_bound(&a, &b, k) >= self.best_d {
+        let convex = Self::convex(a, b, k, bo);
+        if convex && Self::tangent_bound(a, b, k) >= self.best_d {
             return;
         }
         // A bracket not proven convex may hold two minima (with a maximum between them):
         // it is bisected up to SPLIT_LEVELS times, and without limit near the circle's axis.
-        let near_axis = k == 0 && Self::ratio_min(&a, &b, bo) <= 0.0;
+        let near_axis = k == 0 && Self::ratio_min(a, b, bo) <= 0.0;
         if !convex && depth > 0 && self.evals < BUDGET && (near_axis || depth > 24 - SPLIT_LEVELS) {
-            let m = self.eval(0.5 * (a.u + b.u));
-            for (l, r) in [(a, m), (m, b)] {
-                if Sample::falls_then_rises(&l, &r, k) {
+            let m = self.eval_mid(a, b);
+            for (l, r) in [(a, &m), (&m, b)] {
+                if Sample::falls_then_rises(l, r, k) {
                     self.bracket(k, l, r, bo, depth - 1);
                 } else {
                     self.certify(k, l, r, bo, depth - 1);
                 }
             }
         } else {
-            self.refine(k, a, b, bo.speed);
+            self.refine(k, *a, *b, bo.speed, convex);
         }
     }
 
@@ -327,6 +453,39 @@ impl Query<'_> {
         (da + 2.0 * ga * (u - a.u)).max(0.0).sqrt()
     }
 
+    /// Bound `M ≥ |g_k'|` on [a, b] (`None` near the circle's axis):
+    /// `g_k' = |F_o'|² − p_k'·F_o' + (F_o − p_k)·F_o''`.
+    fn curvature_bound(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> Option<f64> {
+        let w = b.u - a.u;
+        let d_max = a.d[k].min(b.d[k]) + bo.speed * w;
+        let foot_speed = match k {
+            0 => {
+                let ratio_min = Self::ratio_min(a, b, bo);
+                if ratio_min <= 0.0 {
+                    return None;
+                }
+                bo.speed / ratio_min
+            }
+            _ => 0.0,
+        };
+        Some(bo.speed * bo.speed + bo.speed * foot_speed + d_max * bo.accel)
+    }
+
+    /// Whether branch `k` provably stays at or above `best` on [a, b]: `f = d_k² / 2` has
+    /// `f' = g_k` and `f'' ≥ −M`, so on [a, m] (m the midpoint) it lies above the concave
+    /// `f(a) + g(a)(u − a) − M (u − a)² / 2`, whose minimum there is at a or m, and
+    /// likewise on [m, b] from b.
+    fn above_best(a: &Sample, b: &Sample, k: usize, bo: &Bounds, best: f64) -> bool {
+        let Some(m) = Self::curvature_bound(a, b, k, bo) else {
+            return false;
+        };
+        let h = 0.5 * (b.u - a.u);
+        let (fa, fb) = (0.5 * a.d[k] * a.d[k], 0.5 * b.d[k] * b.d[k]);
+        let drop = 0.5 * m * h * h;
+        let low = (fa + a.g[k] * h - drop).min(fb - b.g[k] * h - drop);
+        low.min(fa).min(fb) >= 0.5 * best * best
+    }
+
     /// Whether branch `k`'s derivative provably keeps one sign on [a, b].
     fn monotone(a: &Sample, b: &Sample, k: usize, bo: &Bounds) -> bool {
         let (ga, gb) = (a.g[k], b.g[k]);
@@ -350,23 +509,122 @@ impl Query<'_> {
     }
 
     /// Certify, or search, branch `k` on an interval without a − → + sign change.
-    fn certify(&mut self, k: usize, a: Sample, b: Sample, bo: &Bounds, depth: u32) {
+    fn certify(&mut self, k: usize, a: &Sample, b: &Sample, bo: &Bounds, depth: u32) {
         if depth == 0
             || self.evals >= BUDGET
-            || Self::lower_bound(&a, &b, k, bo.speed) >= self.best_d
-            || (k == 0 && Self::foot_off_arc(&a, &b, bo))
-            || Self::monotone(&a, &b, k, bo)
-            || (Self::convex(&a, &b, k, bo) && !Sample::falls_then_rises(&a, &b, k))
-            || Self::flat(&a, &b, k)
+            || Self::lower_bound(a, b, k, bo.speed) >= self.best_d
+            || (k == 0 && Self::foot_off_arc(a, b, bo))
+            || Self::monotone(a, b, k, bo)
+            || (self.best_d.is_finite() && Self::above_best(a, b, k, bo, self.best_d))
+            || (Self::convex(a, b, k, bo) && !Sample::falls_then_rises(a, b, k))
+            || Self::flat(a, b, k)
         {
             return;
         }
-        let m = self.eval(0.5 * (a.u + b.u));
-        for (l, r) in [(a, m), (m, b)] {
-            if Sample::falls_then_rises(&l, &r, k) {
+        let m = self.eval_mid(a, b);
+        for (l, r) in [(a, &m), (&m, b)] {
+            if Sample::falls_then_rises(l, r, k) {
                 self.bracket(k, l, r, bo, depth - 1);
             } else {
                 self.certify(k, l, r, bo, depth - 1);
+            }
+        }
+    }
+}
+
+/// Θ / L.
+fn inv_radius_of(arc: &super::arc_point::LocalArc) -> f64 {
+    arc.theta() / arc.params.length
+}
+
+/// Sorts a short slice by a key (insertion sort: the slices hold at most a few dozen).
+fn insertion_sort<T: Copy>(v: &mut [T], key: impl Fn(&T) -> f64) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let kx = key(&x);
+        let mut j = i;
+        while j > 0 && key(&v[j - 1]) > kx {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+    }
+}
+
+/// Samples the grid intervals that can beat the best distance, then searches their
+/// brackets (lowest first) and certifies the rest. `M` ≥ grid points, `B` ≥ 3 intervals.
+fn search<const M: usize, const B: usize>(
+    q: &mut Query,
+    curve: &PolynomialCurve,
+    middle: Vec3,
+    inv_radius: f64,
+) {
+    let grid = curve.grid();
+    let speed = curve.speed_bounds();
+    let accel = curve.accel_bounds();
+    let spheres = curve.interval_spheres();
+    let length = q.geo.length;
+    let n = grid.len().min(M);
+    let intervals = n - 1;
+    // A lower bound of the distance over each grid interval: the curve's sphere there
+    // against the arc's (the arc lies within L/2 of its middle point). Intervals are
+    // sampled nearest first, and only while their bound beats the best distance so far.
+    let (middle, half) = (middle, 0.5 * length);
+    let mut lower = [0.0f64; M];
+    let mut order = [0usize; M];
+    for i in 0..intervals {
+        let (c, r) = spheres[i];
+        lower[i] = ((c - middle).norm() - r - half).max(0.0);
+        order[i] = i;
+    }
+    let order = &mut order[..intervals];
+    insertion_sort(order, |&i| lower[i]);
+    let mut samples = [Sample::default(); M];
+    let mut sampled = [false; M];
+    let mut active = [false; M];
+    for &i in order.iter() {
+        if lower[i] >= q.best_d {
+            break;
+        }
+        for j in [i, i + 1] {
+            if !sampled[j] {
+                samples[j] = q.eval(grid[j]);
+                sampled[j] = true;
+            }
+        }
+        active[i] = true;
+    }
+    // Brackets of local minima, lowest first, so that later ones prune against a good bound.
+    let mut brackets = [(0.0f64, 0usize, 0usize); B];
+    let mut nb = 0;
+    for i in (0..intervals).filter(|&i| active[i]) {
+        for k in 0..BRANCHES {
+            if Sample::falls_then_rises(&samples[i], &samples[i + 1], k) {
+                brackets[nb] = (samples[i].d[k].min(samples[i + 1].d[k]), i, k);
+                nb += 1;
+            }
+        }
+    }
+    let brackets = &mut brackets[..nb];
+    insertion_sort(brackets, |b| b.0);
+    let bounds = |i: usize| Bounds {
+        speed: speed[i],
+        accel: accel[i],
+        inv_radius,
+        length,
+    };
+    for &(_, i, k) in brackets.iter() {
+        if lower[i] < q.best_d {
+            q.bracket(k, &samples[i], &samples[i + 1], &bounds(i), 24);
+        }
+    }
+    for &i in order.iter() {
+        if !active[i] || lower[i] >= q.best_d {
+            continue;
+        }
+        for k in 0..BRANCHES {
+            if !Sample::falls_then_rises(&samples[i], &samples[i + 1], k) {
+                q.certify(k, &samples[i], &samples[i + 1], &bounds(i), 24);
             }
         }
     }
@@ -393,61 +651,85 @@ pub fn closest_arc_curve_within(
     cutoff: f64,
 ) -> Option<ArcCurveHit> {
     let (centre, radius) = curve.bounding_sphere();
-    let gap = (arc.point(0.5) - centre).norm() - radius - 0.5 * arc.arc.params.length;
+    let middle = arc.point(0.5);
+    let gap = (middle - centre).norm() - radius - 0.5 * arc.arc.params.length;
     if gap >= cutoff {
         return None;
     }
+    let local = &arc.arc;
+    let theta = local.theta();
+    let params = local.params;
+    let dir = if theta > 0.0 {
+        (params.ux / theta, params.uy / theta)
+    } else {
+        (1.0, 0.0)
+    };
+    let (sin, cos) = theta.sin_cos();
+    let geo = Geometry {
+        length: params.length,
+        theta,
+        dir,
+        tip: local.tip(),
+        cos,
+        sin,
+        sinc: crate::math::f1_f2(theta * theta).0,
+        wide: theta > std::f64::consts::PI,
+    };
+    let coeffs = curve.coeffs();
     let mut q = Query {
-        arc,
-        curve,
+        geo,
+        stack: [Vec3::zeros(); STACK_COEFFS],
+        heap: Vec::new(),
+        ncoeffs: coeffs.len(),
         best_d: cutoff,
         best_u: 0.0,
-        best_s: 0.0,
+        best_k: 1,
         evals: 0,
+        memo_u: [f64::NAN; MEMO],
+        memo: [Sample::default(); MEMO],
+        memo_len: 0,
     };
-    let grid = curve.grid();
-    let speed = curve.speed_bounds();
-    let accel = curve.accel_bounds();
-    let length = arc.arc.params.length;
-    let inv_radius = arc.arc.theta() / length;
-    let n = grid.len().min(MAX_INTERVALS + 1);
-    let mut samples = [Sample::default(); MAX_INTERVALS + 1];
-    for (smp, &u) in samples.iter_mut().zip(grid).take(n) {
-        *smp = q.eval(u);
-    }
-    // Brackets of local minima, lowest first, so that later ones prune against a good bound.
-    let mut brackets: [(f64, usize, usize); 3 * MAX_INTERVALS] = [(0.0, 0, 0); 3 * MAX_INTERVALS];
-    let mut nb = 0;
-    for i in 0..n - 1 {
-        for k in 0..BRANCHES {
-            if Sample::falls_then_rises(&samples[i], &samples[i + 1], k) {
-                brackets[nb] = (samples[i].d[k].min(samples[i + 1].d[k]), i, k);
-                nb += 1;
-            }
+    let to_local = |k: usize, c: &Vec3| {
+        if k == 0 {
+            arc.to_local(c)
+        } else {
+            arc.dir_to_local(c)
         }
-    }
-    let brackets = &mut brackets[..nb];
-    brackets.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-    let bounds = |i: usize| Bounds {
-        speed: speed[i],
-        accel: accel[i],
-        inv_radius,
-        length,
     };
-    for &(_, i, k) in brackets.iter() {
-        q.bracket(k, samples[i], samples[i + 1], &bounds(i), 24);
-    }
-    for i in 0..n - 1 {
-        for k in 0..BRANCHES {
-            if !Sample::falls_then_rises(&samples[i], &samples[i + 1], k) {
-                q.certify(k, samples[i], samples[i + 1], &bounds(i), 24);
-            }
+    if coeffs.len() <= STACK_COEFFS {
+        for (k, (dst, c)) in q.stack.iter_mut().zip(coeffs).enumerate() {
+            *dst = to_local(k, c);
         }
+    } else {
+        q.heap = coeffs
+            .iter()
+            .enumerate()
+            .map(|(k, c)| to_local(k, c))
+            .collect();
+    }
+    // Fixed-size scratch arrays: small ones for the usual low degrees.
+    if curve.grid().len() <= 25 {
+        search::<25, 75>(&mut q, curve, middle, inv_radius_of(local));
+    } else {
+        search::<{ MAX_INTERVALS + 1 }, { 3 * MAX_INTERVALS }>(
+            &mut q,
+            curve,
+            middle,
+            inv_radius_of(local),
+        );
     }
     if q.best_d >= cutoff {
         return None;
     }
-    let (u, s) = (q.best_u, q.best_s);
+    let u = q.best_u;
+    let s = match q.best_k {
+        1 => 0.0,
+        2 => 1.0,
+        _ => {
+            let (x, _) = q.curve_local(u);
+            local.circle_fraction(&x).clamp(0.0, 1.0)
+        }
+    };
     Some(ArcCurveHit {
         distance: q.best_d,
         s,

@@ -19,6 +19,8 @@ pub struct PolynomialCurve {
     grid: Vec<f64>,
     speed: Vec<f64>,
     accel: Vec<f64>,
+    /// Bounding sphere (centre, radius) of the curve over each grid interval.
+    spheres: Vec<(Vec3, f64)>,
     /// Bounding sphere of the whole curve: centre and radius.
     sphere: (Vec3, f64),
 }
@@ -109,6 +111,10 @@ impl PolynomialCurve {
             .windows(2)
             .map(|w| speed_bound(&deriv2, w[0], w[1]))
             .collect();
+        let spheres = grid
+            .windows(2)
+            .map(|w| bounding_sphere(&coeffs, w[0], w[1]))
+            .collect();
         let sphere = bounding_sphere(&coeffs, u_min, u_max);
         Ok(PolynomialCurve {
             coeffs,
@@ -117,6 +123,7 @@ impl PolynomialCurve {
             grid,
             speed,
             accel,
+            spheres,
             sphere,
         })
     }
@@ -176,6 +183,11 @@ impl PolynomialCurve {
     /// A sphere (centre, radius) holding the whole curve.
     pub fn bounding_sphere(&self) -> (Vec3, f64) {
         self.sphere
+    }
+
+    /// A sphere (centre, radius) holding the curve over each grid interval.
+    pub(crate) fn interval_spheres(&self) -> &[(Vec3, f64)] {
+        &self.spheres
     }
 
     /// Upper bound of `|F_o''|` on each grid interval.
