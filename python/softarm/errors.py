@@ -11,19 +11,19 @@ A message always names the offending argument and, where it helps, its value.
 from __future__ import annotations
 
 __all__ = [
-    "SoftarmError",
+    "ConfigError",
+    "HardwareError",
+    "HardwareUnavailableError",
     "InputError",
-    "ShapeError",
     "NonFiniteError",
     "OutOfRangeError",
     "ParameterError",
     "PoseError",
+    "SafetyError",
+    "ShapeError",
+    "SoftarmError",
     "UnreachableError",
     "VisionError",
-    "HardwareError",
-    "HardwareUnavailableError",
-    "SafetyError",
-    "ConfigError",
 ]
 
 

@@ -1,0 +1,86 @@
+"""Intrinsic calibration from chessboard or ChArUco images (``cv2.calibrateCamera``)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import VisionError
+from softarm.vision._checks import as_gray, positive
+from softarm.vision.camera_model import CameraModel
+from softarm.vision.dictionaries import get_dictionary
+
+_SUBPIX = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
+_MIN_VIEWS = 3
+
+
+def calibrate_chessboard(
+    images: Sequence[npt.NDArray[Any]], pattern: tuple[int, int], square: float
+) -> tuple[CameraModel, float]:
+    """Calibrate from views of a chessboard with ``pattern`` = (columns, rows) inner
+    corners and ``square`` side (m). Returns the model and the RMS reprojection error (px).
+    Views where the board is not found are skipped; at least 3 must remain."""
+    size = positive(square, "square")
+    cols, rows = int(pattern[0]), int(pattern[1])
+    grid = np.zeros((cols * rows, 3), np.float32)
+    grid[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * size
+    obj, img, shape = [], [], None
+    for k, image in enumerate(images):
+        gray = as_gray(image, f"images[{k}]")
+        shape = _same_shape(shape, gray, k)
+        found, corners = cv2.findChessboardCorners(gray, (cols, rows))
+        if not found:
+            continue
+        corners = cv2.cornerSubPix(gray, corners, (5, 5), (-1, -1), _SUBPIX)
+        obj.append(grid)
+        img.append(corners)
+    return _calibrate(obj, img, shape)
+
+
+def calibrate_charuco(
+    images: Sequence[npt.NDArray[Any]],
+    squares: tuple[int, int],
+    square_length: float,
+    marker_length: float,
+    dictionary: str = "DICT_4X4_50",
+) -> tuple[CameraModel, float]:
+    """Calibrate from views of a ChArUco board of ``squares`` = (columns, rows) squares.
+    Views with fewer than 6 ChArUco corners are skipped; at least 3 must remain."""
+    board = cv2.aruco.CharucoBoard(
+        (int(squares[0]), int(squares[1])),
+        positive(square_length, "square_length"),
+        positive(marker_length, "marker_length"),
+        get_dictionary(dictionary),
+    )
+    detector = cv2.aruco.CharucoDetector(board)
+    obj, img, shape = [], [], None
+    for k, image in enumerate(images):
+        gray = as_gray(image, f"images[{k}]")
+        shape = _same_shape(shape, gray, k)
+        ch_corners, ch_ids, _, _ = detector.detectBoard(gray)
+        if ch_ids is None or len(ch_ids) < 6:
+            continue
+        o, i = board.matchImagePoints(ch_corners, ch_ids)
+        obj.append(o.astype(np.float32))
+        img.append(i.astype(np.float32))
+    return _calibrate(obj, img, shape)
+
+
+def _same_shape(shape: tuple[int, int] | None, gray: npt.NDArray[Any], k: int) -> tuple[int, int]:
+    if shape is not None and gray.shape != shape:
+        raise VisionError(f"images[{k}] has shape {gray.shape}, the first image {shape}")
+    return (int(gray.shape[0]), int(gray.shape[1]))
+
+
+def _calibrate(
+    obj: list[npt.NDArray[Any]], img: list[npt.NDArray[Any]], shape: tuple[int, int] | None
+) -> tuple[CameraModel, float]:
+    if shape is None or len(obj) < _MIN_VIEWS:
+        raise VisionError(f"calibration needs >= {_MIN_VIEWS} usable views, got {len(obj)}")
+    h, w = shape
+    rms, mat, dist, _, _ = cv2.calibrateCamera(obj, img, (w, h), None, None)
+    return CameraModel(mat, np.ravel(dist), (w, h)), float(rms)

@@ -1,0 +1,152 @@
+"""Pinhole camera intrinsics with OpenCV lens distortion, saved as JSON.
+
+File format (JSON, UTF-8), version ``softarm.camera/1``::
+
+    {
+      "format": "softarm.camera/1",
+      "image_size": [1280, 720],            # [width, height] in pixels, or null
+      "camera_matrix": [[fx, 0, cx], [0, fy, cy], [0, 0, 1]],   # pixels
+      "distortion": [k1, k2, p1, p2, k3]    # OpenCV order; 0, 4, 5, 8, 12 or 14 values
+    }
+
+Pixel coordinates follow OpenCV: origin at the centre of the top-left pixel, x right,
+y down; the camera frame has z along the optical axis, x right, y down.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import ConfigError, ParameterError, ShapeError
+from softarm.vision._checks import FloatArray, as_array
+
+FORMAT = "softarm.camera/1"
+_DIST_LENGTHS = (0, 4, 5, 8, 12, 14)
+
+
+@dataclass(frozen=True)
+class CameraModel:
+    """Intrinsics ``matrix`` (3x3, pixels) and OpenCV ``distortion`` coefficients.
+
+    ``image_size`` is ``(width, height)`` in pixels when known. Arrays are validated and
+    stored as read-only float64.
+    """
+
+    matrix: FloatArray
+    distortion: FloatArray = field(default_factory=lambda: np.zeros(5))
+    image_size: tuple[int, int] | None = None
+
+    def __post_init__(self) -> None:
+        mat = as_array(self.matrix, (3, 3), "matrix")
+        if not (mat[0, 0] > 0 and mat[1, 1] > 0) or not np.allclose(mat[2], [0, 0, 1]):
+            raise ParameterError(
+                f"matrix must be [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0, "
+                f"got {mat.tolist()}"
+            )
+        if abs(mat[1, 0]) > 0:
+            raise ParameterError(f"matrix[1, 0] must be 0, got {mat[1, 0]}")
+        dist = as_array(np.ravel(np.asarray(self.distortion, dtype=object)), (None,), "distortion")
+        if dist.size not in _DIST_LENGTHS:
+            raise ShapeError(
+                f"distortion must have one of {_DIST_LENGTHS} coefficients, got {dist.size}"
+            )
+        if self.image_size is not None:
+            size = tuple(int(v) for v in self.image_size)
+            if len(size) != 2 or min(size) <= 0:
+                raise ParameterError(f"image_size must be (width, height) > 0, got {size}")
+            object.__setattr__(self, "image_size", size)
+        mat.setflags(write=False)
+        dist.setflags(write=False)
+        object.__setattr__(self, "matrix", mat)
+        object.__setattr__(self, "distortion", dist)
+
+    @classmethod
+    def ideal(
+        cls, focal: float, width: int, height: int, distortion: npt.ArrayLike | None = None
+    ) -> CameraModel:
+        """A camera with square pixels of focal length ``focal`` (px), centred principal point."""
+        mat = np.array([[focal, 0.0, (width - 1) / 2], [0.0, focal, (height - 1) / 2], [0, 0, 1]])
+        dist = np.zeros(5) if distortion is None else np.asarray(distortion, dtype=np.float64)
+        return cls(mat, dist, (width, height))
+
+    @property
+    def focal(self) -> float:
+        """Mean focal length in pixels."""
+        return float(0.5 * (self.matrix[0, 0] + self.matrix[1, 1]))
+
+    def project(self, points: npt.ArrayLike) -> FloatArray:
+        """Project (N, 3) points in the camera frame to (N, 2) distorted pixel coordinates."""
+        pts = as_array(points, (None, 3), "points")
+        if pts.shape[0] == 0:
+            return np.zeros((0, 2))
+        if np.any(pts[:, 2] <= 0.0):
+            raise ParameterError("points must lie in front of the camera (z > 0)")
+        pix, _ = cv2.projectPoints(pts, np.zeros(3), np.zeros(3), self.matrix, self.distortion)
+        return np.asarray(pix, dtype=np.float64).reshape(-1, 2)
+
+    def normalize(self, pixels: npt.ArrayLike) -> FloatArray:
+        """Undistort (N, 2) pixel coordinates to normalised image coordinates (x/z, y/z)."""
+        pix = as_array(pixels, (None, 2), "pixels")
+        if pix.shape[0] == 0:
+            return np.zeros((0, 2))
+        criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-12)
+        out = cv2.undistortPoints(
+            pix.reshape(-1, 1, 2), self.matrix, self.distortion, R=None, P=None, criteria=criteria
+        )
+        return np.asarray(out, dtype=np.float64).reshape(-1, 2)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON-ready dictionary of the documented file format."""
+        return {
+            "format": FORMAT,
+            "image_size": list(self.image_size) if self.image_size else None,
+            "camera_matrix": self.matrix.tolist(),
+            "distortion": self.distortion.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> CameraModel:
+        """Build from the dictionary of the documented file format."""
+        if not isinstance(data, dict) or data.get("format") != FORMAT:
+            fmt = data.get("format") if isinstance(data, dict) else data
+            raise ConfigError(f"camera file format must be {FORMAT!r}, got {fmt!r}")
+        try:
+            size = data.get("image_size")
+            return cls(
+                np.asarray(data["camera_matrix"], dtype=np.float64),
+                np.asarray(data.get("distortion", []), dtype=np.float64),
+                None if size is None else (int(size[0]), int(size[1])),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ConfigError(f"camera file is malformed: {exc}") from exc
+
+    def save(self, path: str | Path) -> None:
+        """Write the model to ``path`` as JSON (see the module docstring for the format)."""
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2) + "\n", encoding="utf-8")
+
+    @classmethod
+    def load(cls, path: str | Path) -> CameraModel:
+        """Read a model written by :meth:`save`."""
+        try:
+            data = json.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ConfigError(f"cannot read camera file {str(path)!r}: {exc}") from exc
+        return cls.from_dict(data)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, CameraModel):
+            return NotImplemented
+        return (
+            np.array_equal(self.matrix, other.matrix)
+            and np.array_equal(self.distortion, other.distortion)
+            and self.image_size == other.image_size
+        )
+
+    __hash__ = None  # type: ignore[assignment]

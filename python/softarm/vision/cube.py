@@ -1,0 +1,189 @@
+"""The end-effector marker cube: a pose from all visible markers jointly.
+
+The markers are an ArUco ``Board`` (``cv2.aruco.Board``); ``matchImagePoints`` pairs the
+detected corners with their cube-frame points, and the pose is the one that minimises the
+reprojection error of all of them (``solvePnPRefineLM``). Starting points are both IPPE
+solutions of every visible marker, so a single visible face yields its two ambiguous
+poses; where they fit the image about equally well, the one nearer the ``previous`` pose
+is kept (section II-C: a cube with four tags tracks the end effector).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import ParameterError
+from softarm.vision._checks import FloatArray, as_pose, positive
+from softarm.vision.camera_model import CameraModel
+from softarm.vision.detector import (
+    Detection,
+    MarkerDetector,
+    marker_object_points,
+    square_marker_poses,
+)
+from softarm.vision.dictionaries import check_marker_id
+from softarm.vision.poses import (
+    invert,
+    pose_from_rvec_tvec,
+    rotation_angle,
+    rvec_tvec_from_pose,
+    transform_points,
+)
+
+# A candidate whose RMS reprojection error is within this of the best one is "as good"
+# (planar ambiguity): then the previous pose decides. Errors are in pixels.
+AMBIGUITY_FACTOR = 2.0
+AMBIGUITY_MARGIN_PX = 0.05
+_LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
+
+
+@dataclass(frozen=True)
+class CubePose:
+    """A cube pose estimate: ``T_camera_cube``, RMS reprojection error (px), markers used."""
+
+    T_camera_cube: FloatArray
+    rms: float
+    marker_ids: tuple[int, ...]
+
+
+class MarkerCube:
+    """A rigid set of square markers: ``markers`` maps id → (4, 4) pose of the marker in
+    the cube frame (ArUco marker convention: z out of the face); all share ``marker_length``
+    (m) and ``dictionary``."""
+
+    def __init__(
+        self,
+        markers: Mapping[int, npt.ArrayLike],
+        marker_length: float,
+        dictionary: str = "DICT_4X4_50",
+    ) -> None:
+        if not markers:
+            raise ParameterError("markers must name at least one marker, got none")
+        self.marker_length = positive(marker_length, "marker_length")
+        self.dictionary = dictionary
+        self.markers: dict[int, FloatArray] = {
+            check_marker_id(dictionary, k): as_pose(v, f"markers[{k}]") for k, v in markers.items()
+        }
+        corners = marker_object_points(self.marker_length)
+        ids = sorted(self.markers)
+        self._object_points = {i: transform_points(self.markers[i], corners) for i in ids}
+        self.board = cv2.aruco.Board(
+            [self._object_points[i].astype(np.float32) for i in ids],
+            cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary)),
+            np.array(ids, dtype=np.int32),
+        )
+        self.detector = MarkerDetector(dictionary)
+
+    @classmethod
+    def standard(
+        cls,
+        marker_length: float = 0.08,
+        cube_size: float | None = None,
+        ids: tuple[int, int, int, int] = (0, 1, 2, 3),
+        dictionary: str = "DICT_4X4_50",
+    ) -> MarkerCube:
+        """The paper's cube: four markers on the four side faces (normals +x, +y, -x, -y
+        of the cube frame, in the order of ``ids``), each marker's y axis along the cube's
+        +z. ``cube_size`` (edge, m) defaults to 1.25 × ``marker_length`` (80 mm tags on a
+        100 mm cube). The cube frame is at the cube's centre."""
+        length = positive(marker_length, "marker_length")
+        size = 1.25 * length if cube_size is None else positive(cube_size, "cube_size")
+        if size < length:
+            raise ParameterError(f"cube_size must be >= marker_length, got {size} < {length}")
+        markers = {}
+        for k, marker_id in enumerate(ids):
+            a = k * np.pi / 2
+            n = np.array([np.cos(a), np.sin(a), 0.0])  # face normal = marker z
+            y = np.array([0.0, 0.0, 1.0])
+            pose = np.eye(4)
+            pose[:3, :3] = np.column_stack([np.cross(y, n), y, n])
+            pose[:3, 3] = 0.5 * size * n
+            markers[marker_id] = pose
+        return cls(markers, length, dictionary)
+
+    def object_points(self, marker_id: int) -> FloatArray:
+        """(4, 3) corners of marker ``marker_id`` in the cube frame, detection order."""
+        return self._object_points[marker_id].copy()
+
+    def estimate_pose(
+        self,
+        image: npt.NDArray[Any] | None,
+        camera: CameraModel,
+        previous: npt.ArrayLike | None = None,
+    ) -> FloatArray | None:
+        """``T_camera_cube`` (4, 4) from ``image``, or None when no cube marker is seen.
+
+        ``previous`` (a recent ``T_camera_cube``) resolves the single-face ambiguity.
+        """
+        est = self.estimate(self.detector.detect(image, camera), camera, previous)
+        return None if est is None else est.T_camera_cube
+
+    def estimate(
+        self,
+        detections: list[Detection],
+        camera: CameraModel,
+        previous: npt.ArrayLike | None = None,
+    ) -> CubePose | None:
+        """Like :meth:`estimate_pose` from existing detections, with fit details."""
+        prev = None if previous is None else as_pose(previous, "previous", tol=1e-4)
+        mine = [d for d in detections if d.marker_id in self.markers]
+        if not mine:
+            return None
+        corners = [d.corners.astype(np.float32).reshape(1, 4, 2) for d in mine]
+        ids = np.array([d.marker_id for d in mine], dtype=np.int32)
+        obj, img = self.board.matchImagePoints(corners, ids)
+        if obj is None or len(obj) < 4:
+            return None
+        obj = obj.reshape(-1, 3).astype(np.float64)
+        img = img.reshape(-1, 2).astype(np.float64)
+        cands = []
+        for det in mine:
+            for sol in square_marker_poses(det.corners, camera, self.marker_length):
+                start = sol.T_camera_marker @ invert(self.markers[det.marker_id])
+                cands.append(self._refine(start, obj, img, camera))
+        cands.sort(key=lambda c: c[1])
+        best_rms = cands[0][1]
+        pick = cands[0]
+        if prev is not None:
+            ok = [c for c in cands if c[1] <= AMBIGUITY_FACTOR * best_rms + AMBIGUITY_MARGIN_PX]
+            pick = min(ok, key=lambda c: rotation_angle(c[0], prev))
+        return CubePose(pick[0], pick[1], tuple(int(i) for i in ids))
+
+    @staticmethod
+    def _refine(
+        start: FloatArray, obj: FloatArray, img: FloatArray, camera: CameraModel
+    ) -> tuple[FloatArray, float]:
+        """Levenberg–Marquardt over all matched corners from ``start``; (pose, RMS px)."""
+        rvec, tvec = rvec_tvec_from_pose(start)
+        rvec, tvec = cv2.solvePnPRefineLM(
+            obj, img, camera.matrix, camera.distortion, rvec, tvec, _LM_CRITERIA
+        )
+        proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
+        rms = float(np.sqrt(np.mean(np.sum((proj.reshape(-1, 2) - img) ** 2, axis=1))))
+        return pose_from_rvec_tvec(rvec, tvec), rms
+
+
+class CubeTracker:
+    """Tracks one :class:`MarkerCube` in one camera, feeding each estimate back as the
+    ``previous`` pose of the next (so a lone visible face keeps its correct solution)."""
+
+    def __init__(self, cube: MarkerCube, camera: CameraModel) -> None:
+        self.cube, self.camera = cube, camera
+        self.last: FloatArray | None = None
+
+    def update(self, image: npt.NDArray[Any] | None) -> FloatArray | None:
+        """``T_camera_cube`` for this frame, or None (the last pose is kept for the next)."""
+        pose = self.cube.estimate_pose(image, self.camera, self.last)
+        if pose is not None:
+            self.last = pose
+        return pose
+
+    def reset(self) -> None:
+        """Forget the previous pose."""
+        self.last = None
