@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 
+from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest import BerryTarget, FaultReason, HarvestConfig, HarvestState
 from softarm.harvest.targets import grasp_point
 
@@ -27,7 +28,8 @@ def test_happy_path_visits_every_state_in_order_and_ends_at_rest() -> None:
         assert b.orientation_error_deg < 1e-6
         assert b.duration_s > 0 and b.steps > 0
         assert b.cameras["eye_to_hand"] > 0 and b.cameras["eye_in_hand"] > 0
-    assert np.all(rig.plant.psi == 0.0)  # back at rest
+    home_psi = rig.machine.config.home_elongation / METRES_PER_PSI
+    assert np.allclose(rig.plant.psi, home_psi)  # back at the ready pose
     assert not rig.gripper.closed  # berry dropped at home
     assert rig.bank.vent_log[-1].reason == "startup"  # never vented: no fault
 

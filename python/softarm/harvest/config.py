@@ -38,7 +38,8 @@ class HarvestConfig:
             improvement → UNREACHABLE.
         stall_progress: see ``stall_time``.
         ripeness_threshold: below it a grasped berry is unripe and released.
-        home_speed: elongation rate (m/s) of the open-loop move back to rest.
+        home_speed: elongation rate (m/s) of the open-loop moves to the ready pose.
+        home_elongation: every actuator's elongation (m) at the ready pose (straight arm).
     """
 
     period: float = 0.05
@@ -59,6 +60,7 @@ class HarvestConfig:
     stall_progress: float = 0.002
     ripeness_threshold: float = 0.5
     home_speed: float = 0.03
+    home_elongation: float = 0.0167
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",

@@ -5,13 +5,14 @@ Per berry::
     IDLE → INITIAL_PLACEMENT → FINE_POSITIONING → GRASP → RETURN_HOME → DONE
       └──────────────┴────────────────┴────────────┴──────────┴──→ FAULT (vented)
 
-* IDLE: select the berry's tag; wait until the cube and the berry are both seen.
+* IDLE: select the berry's tag; ramp to the ready pose; wait until the cube and the berry
+  are both seen.
 * INITIAL_PLACEMENT: eye-to-hand feedback (eq. 22) drives the gripper to a pre-grasp pose
   ``standoff`` short of the berry, facing it along ``approach``.
 * FINE_POSITIONING: the berry position from the eye-in-hand camera (eq. 21), held while
   hidden, drives the grasp point onto the berry.
 * GRASP: close, read the ripeness; an unripe berry is released and skipped.
-* RETURN_HOME: back out along the approach axis, then ramp the elongations to rest.
+* RETURN_HOME: back out along the approach axis, then ramp to the ready pose.
 
 Every transition is logged (and fsync'd) with its reason. A fault vents every channel at
 once, logs the reason, and ends the berry in FAULT; :data:`~softarm.harvest.states.
@@ -86,6 +87,9 @@ class HarvestMachine:
         #: Commanded elongations (m): the soft arm has no joint sensors, so the resolver's
         #: Jacobian is evaluated at the command, and the measured pose closes the loop.
         self.q: FloatArray = np.zeros(n_actuators)
+        #: The ready pose between berries: straight, every actuator at ``home_elongation``,
+        #: away from the lower limits where the resolver's steps would be clipped.
+        self.home: FloatArray = np.full(n_actuators, self.config.home_elongation)
         self.servo = Servo(clock, tracker, locator, controller, actuator, self.config, self.log)
 
     def run(self, berries: Sequence[BerryTarget]) -> HarvestReport:
@@ -110,6 +114,7 @@ class HarvestMachine:
         self._transition(S.IDLE, berry, "new berry")
         try:
             self.locator.select(berry)
+            self.q = self.servo.ramp(self.q, self.home)
             self.servo.wait_visible(self.q)
             self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
             self.q = self.servo.place(self.q)
@@ -119,7 +124,7 @@ class HarvestMachine:
             self._transition(S.GRASP, berry, "berry within the grasp workspace")
             self._grasp(result)
             self._transition(S.RETURN_HOME, berry, "grasp finished")
-            self.q = self.servo.go_home(self.q)
+            self.q = self.servo.go_home(self.q, self.home)
             if result.harvested:
                 self.gripper.open()  # drop the berry at the rest pose
             self._transition(S.DONE, berry, "harvested" if result.harvested else "skipped")

@@ -76,6 +76,7 @@ class Servo:
 
     def wait_visible(self, q: FloatArray) -> None:
         """IDLE: hold the arm until both the cube and the berry are seen."""
+        self._pose_seen = self._fix_seen = self.clock.now()
         while True:
             seen = self._observe()
             self._log_step(seen, q, None, None, False)
@@ -95,9 +96,9 @@ class Servo:
         c = self.cfg
         return self._servo(q, c.grasp_offset, c.fine_tolerance, c.fine_timeout, c.fine_budget)
 
-    def go_home(self, q: FloatArray) -> FloatArray:
+    def go_home(self, q: FloatArray, home: FloatArray) -> FloatArray:
         """RETURN_HOME: back out to the pre-grasp pose (the approach line is free of
-        branches), then ramp every elongation to 0 in actuator space."""
+        branches), then ramp the elongations to ``home`` in actuator space."""
         c = self.cfg
         start = self.clock.now()
         try:
@@ -107,14 +108,19 @@ class Servo:
         except Fault as fault:
             if fault.reason is not FaultReason.TIMEOUT:
                 raise
-        step = c.home_speed * c.period
-        while np.any(q != 0.0):
-            if self.clock.now() - start > c.home_timeout:
-                raise Fault(FaultReason.TIMEOUT, f"home not reached in {c.home_timeout} s")
-            q = q - np.clip(q, -step, step)
+        return self.ramp(q, home, start + c.home_timeout)
+
+    def ramp(self, q: FloatArray, home: FloatArray, deadline: float = np.inf) -> FloatArray:
+        """Move the elongations straight to ``home`` at ``home_speed`` (open loop: the
+        rest pose needs no vision)."""
+        step = self.cfg.home_speed * self.cfg.period
+        while np.any(q != home):
+            if self.clock.now() > deadline:
+                raise Fault(FaultReason.TIMEOUT, "home not reached in time")
+            q = q + np.clip(home - q, -step, step)
             self.actuator.send(q)
             self._log_step(_Seen(self.clock.now(), None, None), q, None, None, False)
-            self.clock.sleep(c.period)
+            self.clock.sleep(self.cfg.period)
         return q
 
     # -- the loop -------------------------------------------------------------------
