@@ -24,8 +24,9 @@ from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import LagArmPlant
-from softarm.harvest.sim_vision import SimCameras, SimVision, look_at
+from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
+from softarm.harvest.vision_loop import CameraVision
 from softarm.sim.bush import Bush
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
@@ -82,7 +83,7 @@ class SimRig:
     plant: LagArmPlant
     clock: SimClock
     bank: SafePressureBank
-    vision: SimVision
+    vision: CameraVision
     gripper: SimGripper
     watch: ArmWatch
     machine: HarvestMachine
@@ -142,7 +143,7 @@ def build_sim_rig(
         SimulatedPressureBank(plant, plant.arm.n_actuators), 70.0, 100.0, 0.5, clock.now,
         watchdog_thread=False,
     )  # fmt: skip
-    vision = SimVision(
+    vision = sim_vision(
         default_cameras(o.scale, o.noise_std), plant.pose, lambda: on_bush, cfg.grasp_offset,
         seed=o.seed, hidden=o.hidden,
     )  # fmt: skip

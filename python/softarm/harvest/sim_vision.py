@@ -1,10 +1,7 @@
-"""Simulated perception of the harvest loop: the synthetic eye-to-hand camera C1 renders
-the base tag, the end-effector marker cube and the berry tags; the synthetic eye-in-hand
-camera C2 renders the berry tags in front of the gripper. Images go through the real
-vision pipeline (ArUco detection, cube pose, base-tag registration) and the two-camera
-fusion of eq. (21)–(22). Implements both
-:class:`~softarm.harvest.interfaces.EndEffectorTracker` and
-:class:`~softarm.harvest.interfaces.BerryLocator`.
+"""Synthetic cameras for the simulated harvest: C1 (eye-to-hand) renders the base tag, the
+end-effector marker cube and the berry tags; C2 (eye-in-hand) renders the berry tags in
+front of the gripper. The images go through the real pipeline of
+:class:`~softarm.harvest.vision_loop.CameraVision`.
 """
 
 from __future__ import annotations
@@ -14,17 +11,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softarm.harvest.interfaces import BerryFix, BerryTarget, FloatArray
+from softarm.harvest.interfaces import FloatArray
+from softarm.harvest.vision_loop import CameraVision, register_c1
 from softarm.sim.bush import Berry
 from softarm.sim.camera import SyntheticCamera
 from softarm.sim.markers import SceneMarker, cube_scene_markers
-from softarm.vision import BaseRegistration, CameraFusion, CameraModel, MarkerCube, MarkerDetector
-from softarm.vision.detector import square_marker_poses
+from softarm.vision import CameraModel, MarkerCube
 from softarm.vision.poses import invert
 
-__all__ = ["SimCameras", "SimVision", "look_at"]
+__all__ = ["BASE_TAG_ID", "SimCameras", "look_at", "sim_vision"]
 
 DICT = "DICT_4X4_50"
+#: The base tag's id; the cube uses 0–3 and the berries 10 and up.
+BASE_TAG_ID = 4
 
 
 def look_at(
@@ -45,7 +44,7 @@ def look_at(
 class SimCameras:
     """Geometry of the simulated cameras and markers (true values).
 
-    ``scale`` multiplies both image sizes and focal lengths (0.5 = quarter the pixels).
+    ``scale`` multiplies both image sizes and focal lengths (0.5 = a quarter of the pixels).
     """
 
     T_base_c1: FloatArray
@@ -63,119 +62,54 @@ class SimCameras:
     scale: float = 1.0
 
     def model(self, which: int) -> CameraModel:
-        """The intrinsics of C1 (``which`` = 1) or C2 (2), mild barrel distortion."""
+        """Intrinsics of C1 (``which`` = 1) or C2 (2), mild barrel distortion."""
         size, f = (self.c1_size, self.c1_focal) if which == 1 else (self.c2_size, self.c2_focal)
         w, h = round(size[0] * self.scale), round(size[1] * self.scale)
         return CameraModel.ideal(f * self.scale, w, h, [-0.05, 0.01, 0.0, 0.0, 0.0])
 
 
-class SimVision:
-    """Renders and measures both cameras at the true arm pose ``true_pose()``.
+def sim_vision(
+    cams: SimCameras,
+    true_pose: Callable[[], FloatArray],
+    berries: Callable[[], Sequence[Berry]],
+    grasp_offset: float,
+    seed: int = 0,
+    max_age: float = 1.0,
+    hidden: Callable[[float], bool] | None = None,
+) -> CameraVision:
+    """:class:`CameraVision` on synthetic images of the scene at the arm's true pose
+    ``true_pose()``. ``berries()`` are the berries still on the bush; while ``hidden(t)``
+    no berry tag is drawn (a leaf in front of the berry)."""
+    hide = hidden or (lambda t: False)
+    m1, m2 = cams.model(1), cams.model(2)
+    c1 = SyntheticCamera(m1, *m1.image_size, noise_std=cams.noise_std, supersample=2, seed=seed)
+    c2 = SyntheticCamera(m2, *m2.image_size, noise_std=cams.noise_std, supersample=2, seed=seed + 1)
+    cube = MarkerCube.standard(cams.cube_marker)
+    T_c1_base = invert(cams.T_base_c1)
 
-    ``berries()`` gives the berries still on the bush; ``hidden(t)`` (optional) hides
-    the selected berry's tag from both cameras, like a leaf; ``max_age`` is how long
-    the last berry fix is held (section III-D).
-    """
-
-    def __init__(
-        self,
-        cams: SimCameras,
-        true_pose: Callable[[], FloatArray],
-        berries: Callable[[], Sequence[Berry]],
-        grasp_offset: float,
-        seed: int = 0,
-        max_age: float = 1.0,
-        registration_frames: int = 5,
-        hidden: Callable[[float], bool] | None = None,
-    ) -> None:
-        self.cams, self.true_pose, self.berries = cams, true_pose, berries
-        self.hidden = hidden or (lambda t: False)
-        self.model1, self.model2 = cams.model(1), cams.model(2)
-        self.c1 = SyntheticCamera(
-            self.model1, *self.model1.image_size, noise_std=cams.noise_std, seed=seed, supersample=2
-        )
-        self.c2 = SyntheticCamera(
-            self.model2,
-            *self.model2.image_size,
-            noise_std=cams.noise_std,
-            seed=seed + 1,
-            supersample=2,
-        )
-        self.cube = MarkerCube.standard(cams.cube_marker)
-        self.detector = MarkerDetector(DICT)
-        self.selected = BerryTarget(-1)
-        self._cube_prev: FloatArray | None = None
-        self._c1: tuple[FloatArray | None, FloatArray | None] = (None, None)
-        # Online registration of C1 from the base tag (section II-C): T_C1^Base of eq. (22).
-        reg = BaseRegistration(
-            self.model1, 4, cams.base_tag, cams.T_base_tag, DICT, registration_frames
-        )
-        for _ in range(registration_frames):
-            reg.update(self._render_c1(include_berries=False))
-        if reg.T_base_camera is None:
-            raise RuntimeError("the eye-to-hand camera does not see the base tag")
-        self.T_base_c1 = reg.T_base_camera
-        self.fusion = CameraFusion(
-            self.T_base_c1, cams.T_ee_c2, max_age=max_age, tool_point=(0, 0, grasp_offset)
-        )
-
-    # -- BerryLocator / EndEffectorTracker ------------------------------------------
-
-    def select(self, berry: BerryTarget) -> None:
-        """Track ``berry`` from now on (the fusion forgets any held target)."""
-        self.selected = berry
-        self.fusion.reset()
-
-    def track(self, time: float) -> FloatArray | None:
-        """C1: ``T_base_ee`` from the cube (eq. 22), also the berry in C1 for :meth:`locate`."""
-        img = self._render_c1(include_berries=True, time=time)
-        dets = self.detector.detect(img, self.model1)
-        est = self.cube.estimate(dets, self.model1, self._cube_prev)
-        berry_c1 = self._tag_position(dets, self.model1)
-        if est is None:
-            self._c1 = (None, berry_c1)
-            return None
-        self._cube_prev = est.T_camera_cube
-        T_c1_ee = est.T_camera_cube @ invert(self.cams.T_ee_cube)
-        self._c1 = (T_c1_ee, berry_c1)
-        return self.T_base_c1 @ T_c1_ee
-
-    def locate(self, time: float, T_base_ee: FloatArray | None) -> BerryFix | None:
-        """C2 and the fusion: the berry in the base frame (eq. 21), held while hidden."""
-        T_c1_ee, berry_c1 = self._c1
-        berry_c2 = None
-        if not self.hidden(time):
-            T_c2_base = invert(self.true_pose() @ self.cams.T_ee_c2)
-            img = self.c2.render(self._berry_markers(T_c2_base))
-            berry_c2 = self._tag_position(self.detector.detect(img, self.model2), self.model2)
-        est = self.fusion.update(time, T_c1_ee, berry_c1, berry_c2)
-        if est.target is None or est.source == "none":
-            return None
-        return BerryFix(est.target, est.source, est.target_age)
-
-    # -- rendering ------------------------------------------------------------------
-
-    def _render_c1(self, include_berries: bool, time: float = 0.0) -> np.ndarray:
-        T_c1_base = invert(self.cams.T_base_c1)
-        items = [SceneMarker(4, DICT, self.cams.base_tag, T_c1_base @ self.cams.T_base_tag)]
-        T_c1_cube = T_c1_base @ self.true_pose() @ self.cams.T_ee_cube
-        items += cube_scene_markers(self.cube.markers, self.cube.marker_length, DICT, T_c1_cube)
-        if include_berries and not self.hidden(time):
-            items += self._berry_markers(T_c1_base)
-        return self.c1.render(items)
-
-    def _berry_markers(self, T_cam_base: FloatArray) -> list[SceneMarker]:
+    def tags(T_cam_base: FloatArray) -> list[SceneMarker]:
         out = []
-        for b in self.berries():
+        for b in berries():
             pose = T_cam_base @ b.tag_pose()
             if pose[2, 3] > 0.01:  # in front of the camera
-                out.append(SceneMarker(b.tag_id, DICT, self.cams.berry_tag, pose))
+                out.append(SceneMarker(b.tag_id, DICT, cams.berry_tag, pose))
         return out
 
-    def _tag_position(self, dets: list, model: CameraModel) -> FloatArray | None:
-        for d in dets:
-            if d.marker_id == self.selected.tag_id:
-                sols = square_marker_poses(d.corners, model, self.cams.berry_tag)
-                if sols:
-                    return sols[0].T_camera_marker[:3, 3]
-        return None
+    def frame1(t: float, with_berries: bool = True) -> np.ndarray:
+        items = [SceneMarker(BASE_TAG_ID, DICT, cams.base_tag, T_c1_base @ cams.T_base_tag)]
+        T_c1_cube = T_c1_base @ true_pose() @ cams.T_ee_cube
+        items += cube_scene_markers(cube.markers, cube.marker_length, DICT, T_c1_cube)
+        if with_berries and not hide(t):
+            items += tags(T_c1_base)
+        return c1.render(items)
+
+    def frame2(t: float) -> np.ndarray:
+        return c2.render([] if hide(t) else tags(invert(true_pose() @ cams.T_ee_c2)))
+
+    T_base_c1 = register_c1(
+        lambda t: frame1(t, False), m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag
+    )
+    return CameraVision(
+        frame1, frame2, m1, m2, T_base_c1, cams.T_ee_c2, cams.T_ee_cube, cube,
+        cams.berry_tag, grasp_offset, max_age,
+    )  # fmt: skip
