@@ -10,7 +10,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-import softarm  # noqa: E402
+import softarm
 
 
 @pytest.fixture

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from oracle import fd_jacobian, soft_arm_forward
 
 import softarm
+from oracle import fd_jacobian, soft_arm_forward
 
 ARM = softarm.SoftArm.blackberry()
 ELONGATION = st.floats(0.0, 70 / 2100, allow_nan=False)

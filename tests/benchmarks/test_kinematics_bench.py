@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from oracle import fd_jacobian, soft_arm_forward
 
 import softarm
+from oracle import fd_jacobian, soft_arm_forward
 
 ARM = softarm.SoftArm.blackberry()
 SECTIONS = [(s.radius, s.rest_length, s.offset, s.twist) for s in ARM.sections]
@@ -48,14 +48,20 @@ def numpy_forward_batch(qs: np.ndarray) -> np.ndarray:
         a[:, 2, 3] = np.where(th > 0, rad * st_, length)
         a[:, 3, 3] = 1
         tail = np.eye(4)
-        tail[:3, :3] = [[np.cos(beta), -np.sin(beta), 0], [np.sin(beta), np.cos(beta), 0], [0, 0, 1]]
+        tail[:3, :3] = [
+            [np.cos(beta), -np.sin(beta), 0],
+            [np.sin(beta), np.cos(beta), 0],
+            [0, 0, 1],
+        ]
         tail[2, 3] = b
         t = t @ a @ tail
     return t
 
 
 def test_numpy_batch_baseline_is_correct() -> None:
-    np.testing.assert_allclose(numpy_forward_batch(BATCH[:100]), ARM.forward_batch(BATCH[:100]), atol=1e-12)
+    np.testing.assert_allclose(
+        numpy_forward_batch(BATCH[:100]), ARM.forward_batch(BATCH[:100]), atol=1e-12
+    )
 
 
 @pytest.mark.benchmark(group="forward (one call)")

@@ -8,10 +8,10 @@ import time
 
 import numpy as np
 import pytest
-from conftest import FakeClock
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from conftest import FakeClock
 from softarm.errors import (
     HardwareError,
     HardwareUnavailableError,

@@ -39,3 +39,5 @@ pub use error::{Error, Result};
 pub use kinematics::Kinematics;
 pub use math::{Frame, Mat3, Mat4, Vec3};
 pub use soft_arm::{Section, SoftArm};
+pub mod resolver;
+pub use resolver::{Gains, Mode, Resolver, Schedule, Solution, SolveOptions, Target};

@@ -5,6 +5,7 @@
 mod convert;
 mod errors;
 mod kinematics;
+mod resolver;
 
 use pyo3::prelude::*;
 
@@ -13,5 +14,6 @@ use pyo3::prelude::*;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kinematics::register(m)?;
+    resolver::register(m)?;
     Ok(())
 }

@@ -1,0 +1,467 @@
+//! `Gains`, `Resolver`, `StepResult` and `Solution` for Python (redundancy paper eq. 7,
+//! 13, 20, 23–25). Conversion only: the resolver lives in softarm-core.
+
+use nalgebra::{Matrix4, Vector3};
+use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use softarm_core::resolver::{self as core, Mode, Schedule, SolveOptions, Target};
+use softarm_core::SoftArm as CoreArm;
+
+use crate::convert::{array, as_array, shape_str};
+use crate::errors::{IntoPyResult, ParameterError, ShapeError};
+use crate::kinematics::SoftArm;
+
+/// Every field name of `Gains`, in declaration order.
+const FIELDS: [&str; 18] = [
+    "conventional_alpha",
+    "position_alpha",
+    "position_gamma",
+    "position_switch",
+    "orientation_alpha",
+    "orientation_gamma",
+    "orientation_switch",
+    "hybrid_alpha",
+    "hybrid_position",
+    "hybrid_orientation",
+    "hybrid_gamma",
+    "hybrid_switch",
+    "schedule",
+    "axis_mask",
+    "damping",
+    "singular_threshold",
+    "limit_margin",
+    "max_step",
+];
+
+fn float_field<'a>(g: &'a mut core::Gains, name: &str) -> Option<&'a mut f64> {
+    Some(match name {
+        "conventional_alpha" => &mut g.conventional_alpha,
+        "position_alpha" => &mut g.position_alpha,
+        "position_gamma" => &mut g.position_gamma,
+        "position_switch" => &mut g.position_switch,
+        "orientation_alpha" => &mut g.orientation_alpha,
+        "orientation_gamma" => &mut g.orientation_gamma,
+        "orientation_switch" => &mut g.orientation_switch,
+        "hybrid_alpha" => &mut g.hybrid_alpha,
+        "hybrid_position" => &mut g.hybrid_position,
+        "hybrid_orientation" => &mut g.hybrid_orientation,
+        "hybrid_gamma" => &mut g.hybrid_gamma,
+        "hybrid_switch" => &mut g.hybrid_switch,
+        "damping" => &mut g.damping,
+        "singular_threshold" => &mut g.singular_threshold,
+        "limit_margin" => &mut g.limit_margin,
+        "max_step" => &mut g.max_step,
+        _ => return None,
+    })
+}
+
+/// Applies keyword overrides to `g`, then validates the result.
+fn apply(mut g: core::Gains, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<core::Gains> {
+    if let Some(kw) = kwargs {
+        for (k, v) in kw.iter() {
+            let name: String = k.extract()?;
+            if let Some(f) = float_field(&mut g, &name) {
+                *f = v.extract::<f64>().map_err(|_| {
+                    ParameterError::new_err(format!("{name}: expected a float, got {v}"))
+                })?;
+            } else if name == "schedule" {
+                let s: String = v.extract().map_err(|_| {
+                    ParameterError::new_err(format!("schedule: expected a str, got {v}"))
+                })?;
+                g.schedule = Schedule::parse(&s).py()?;
+            } else if name == "axis_mask" {
+                let m: Vec<bool> = v.extract().map_err(|_| {
+                    ParameterError::new_err(format!("axis_mask: expected 3 bools, got {v}"))
+                })?;
+                g.axis_mask = <[bool; 3]>::try_from(m.as_slice()).map_err(|_| {
+                    ShapeError::new_err(format!("axis_mask: expected 3 bools, got {}", m.len()))
+                })?;
+            } else {
+                return Err(ParameterError::new_err(format!(
+                    "{name}: unknown gain; expected one of {}",
+                    FIELDS.join(", ")
+                )));
+            }
+        }
+    }
+    g.validate().py()?;
+    Ok(g)
+}
+
+/// Tuning parameters of the resolver (see the stub for units).
+#[pyclass(module = "softarm._core", frozen, eq, from_py_object)]
+#[derive(Clone, PartialEq)]
+pub struct Gains {
+    pub(crate) inner: core::Gains,
+}
+
+#[pymethods]
+impl Gains {
+    #[getter]
+    fn conventional_alpha(&self) -> f64 {
+        self.inner.conventional_alpha
+    }
+
+    #[getter]
+    fn position_alpha(&self) -> f64 {
+        self.inner.position_alpha
+    }
+
+    #[getter]
+    fn position_gamma(&self) -> f64 {
+        self.inner.position_gamma
+    }
+
+    #[getter]
+    fn position_switch(&self) -> f64 {
+        self.inner.position_switch
+    }
+
+    #[getter]
+    fn orientation_alpha(&self) -> f64 {
+        self.inner.orientation_alpha
+    }
+
+    #[getter]
+    fn orientation_gamma(&self) -> f64 {
+        self.inner.orientation_gamma
+    }
+
+    #[getter]
+    fn orientation_switch(&self) -> f64 {
+        self.inner.orientation_switch
+    }
+
+    #[getter]
+    fn hybrid_alpha(&self) -> f64 {
+        self.inner.hybrid_alpha
+    }
+
+    #[getter]
+    fn hybrid_position(&self) -> f64 {
+        self.inner.hybrid_position
+    }
+
+    #[getter]
+    fn hybrid_orientation(&self) -> f64 {
+        self.inner.hybrid_orientation
+    }
+
+    #[getter]
+    fn hybrid_gamma(&self) -> f64 {
+        self.inner.hybrid_gamma
+    }
+
+    #[getter]
+    fn hybrid_switch(&self) -> f64 {
+        self.inner.hybrid_switch
+    }
+
+    #[getter]
+    fn damping(&self) -> f64 {
+        self.inner.damping
+    }
+
+    #[getter]
+    fn singular_threshold(&self) -> f64 {
+        self.inner.singular_threshold
+    }
+
+    #[getter]
+    fn limit_margin(&self) -> f64 {
+        self.inner.limit_margin
+    }
+
+    #[getter]
+    fn max_step(&self) -> f64 {
+        self.inner.max_step
+    }
+
+    #[new]
+    #[pyo3(signature = (**kwargs))]
+    fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        Ok(Gains {
+            inner: apply(core::Gains::blackberry(), kwargs)?,
+        })
+    }
+
+    /// The paper's gains, eq. (23)–(25).
+    #[staticmethod]
+    fn paper() -> Self {
+        Gains {
+            inner: core::Gains::paper(),
+        }
+    }
+
+    /// Gains that converge for `arm` (the blackberry-tuned preset).
+    #[staticmethod]
+    fn default_for(arm: PyRef<'_, SoftArm>) -> Self {
+        let _ = arm;
+        Gains {
+            inner: core::Gains::blackberry(),
+        }
+    }
+
+    /// A copy with some fields changed.
+    #[pyo3(signature = (**kwargs))]
+    fn replace(&self, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        Ok(Gains {
+            inner: apply(self.inner, kwargs)?,
+        })
+    }
+
+    /// "step" or "smooth".
+    #[getter]
+    fn schedule(&self) -> &'static str {
+        self.inner.schedule.name()
+    }
+
+    /// Controlled orientation axes (x, y, z) of the base frame.
+    #[getter]
+    fn axis_mask(&self) -> (bool, bool, bool) {
+        let m = self.inner.axis_mask;
+        (m[0], m[1], m[2])
+    }
+
+    /// Every field as a dict.
+    fn as_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let mut g = self.inner;
+        for name in FIELDS {
+            if let Some(v) = float_field(&mut g, name) {
+                d.set_item(name, *v)?;
+            }
+        }
+        d.set_item("schedule", self.inner.schedule.name())?;
+        d.set_item("axis_mask", PyTuple::new(py, self.inner.axis_mask)?)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        let g = &self.inner;
+        format!(
+            "Gains(hybrid_alpha={}, hybrid_position={}, hybrid_orientation={}, hybrid_gamma={}, \
+             hybrid_switch={}, schedule={:?}, axis_mask={:?}, ...)",
+            g.hybrid_alpha,
+            g.hybrid_position,
+            g.hybrid_orientation,
+            g.hybrid_gamma,
+            g.hybrid_switch,
+            g.schedule.name(),
+            g.axis_mask
+        )
+    }
+}
+
+/// One step's result.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct StepResult {
+    q: Vec<f64>,
+    unclamped: Vec<f64>,
+    info: core::StepInfo,
+}
+
+#[pymethods]
+impl StepResult {
+    /// The next command (n,), inside [lower, upper].
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.q)
+    }
+    /// The command before clamping (n,).
+    #[getter]
+    fn unclamped<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.unclamped)
+    }
+    /// Whether the command was clamped into the limits.
+    #[getter]
+    fn saturated(&self) -> bool {
+        self.info.saturated
+    }
+    /// ‖e_p‖ (m) at the input state.
+    #[getter]
+    fn position_error(&self) -> f64 {
+        self.info.position_error
+    }
+    /// Masked ‖e_ζ‖ (rad) at the input state.
+    #[getter]
+    fn orientation_error(&self) -> f64 {
+        self.info.orientation_error
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "StepResult(saturated={}, position_error={:.3e}, orientation_error={:.3e})",
+            self.info.saturated, self.info.position_error, self.info.orientation_error
+        )
+    }
+}
+
+/// The result of `Resolver.solve`.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct Solution {
+    inner: core::Solution,
+}
+
+#[pymethods]
+impl Solution {
+    /// Best configuration found (n,).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.inner.q)
+    }
+    /// Whether the controlled errors are within tolerance at `q`.
+    #[getter]
+    fn converged(&self) -> bool {
+        self.inner.converged
+    }
+    /// Steps taken to reach `q`.
+    #[getter]
+    fn steps(&self) -> usize {
+        self.inner.steps
+    }
+    /// ‖e_p‖ at `q` (m).
+    #[getter]
+    fn position_error(&self) -> f64 {
+        self.inner.position_error
+    }
+    /// Masked ‖e_ζ‖ at `q` (rad).
+    #[getter]
+    fn orientation_error(&self) -> f64 {
+        self.inner.orientation_error
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Solution(converged={}, steps={}, position_error={:.3e}, orientation_error={:.3e})",
+            self.inner.converged,
+            self.inner.steps,
+            self.inner.position_error,
+            self.inner.orientation_error
+        )
+    }
+}
+
+/// Reads a (4, 4) pose or (in modes that accept one) a (3,) point.
+fn target(obj: &Bound<'_, PyAny>) -> PyResult<Target> {
+    let a = as_array(obj, "target")?;
+    let shape = a.shape().to_vec();
+    let ro = a.readonly();
+    let flat = ro.as_slice()?;
+    match shape.as_slice() {
+        [4, 4] => Ok(Target::Pose(Matrix4::from_row_slice(flat))),
+        [3] => Ok(Target::Position(Vector3::from_column_slice(flat))),
+        _ => Err(ShapeError::new_err(format!(
+            "target: expected shape (4, 4) or (3,), got {}",
+            shape_str(&shape)
+        ))),
+    }
+}
+
+fn pose(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Matrix4<f64>> {
+    let (flat, _) = array(obj, arg, &[Some(4), Some(4)])?;
+    Ok(Matrix4::from_row_slice(&flat))
+}
+
+/// Gain-scheduled task-priority resolver for a `SoftArm`.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct Resolver {
+    inner: core::Resolver<CoreArm>,
+}
+
+#[pymethods]
+impl Resolver {
+    #[new]
+    #[pyo3(signature = (arm, mode = "hybrid", gains = None))]
+    fn new(arm: PyRef<'_, SoftArm>, mode: &str, gains: Option<PyRef<'_, Gains>>) -> PyResult<Self> {
+        let mode = Mode::parse(mode).py()?;
+        let gains = gains.map_or_else(core::Gains::blackberry, |g| g.inner);
+        Ok(Resolver {
+            inner: core::Resolver::new(arm.inner.clone(), mode, gains).py()?,
+        })
+    }
+
+    /// "conventional", "position", "orientation" or "hybrid".
+    #[getter]
+    fn mode(&self) -> &'static str {
+        self.inner.mode().name()
+    }
+
+    /// The gains.
+    #[getter]
+    fn gains(&self) -> Gains {
+        Gains {
+            inner: *self.inner.gains(),
+        }
+    }
+
+    /// The arm model.
+    #[getter]
+    fn arm(&self) -> SoftArm {
+        SoftArm {
+            inner: self.inner.arm().clone(),
+        }
+    }
+
+    /// One step from `q` towards `target`; `current` is the measured pose or None.
+    #[pyo3(signature = (q, target, current = None))]
+    fn step(
+        &self,
+        q: &Bound<'_, PyAny>,
+        target: &Bound<'_, PyAny>,
+        current: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<StepResult> {
+        let n = softarm_core::chain::SectionModel::n_dofs(self.inner.arm());
+        let q = crate::convert::vector(q, "q", n)?;
+        let t = self::target(target)?;
+        let current = current.map(|c| pose(c, "current")).transpose()?;
+        let s = self.inner.step(&q, &t, current.as_ref()).py()?;
+        Ok(StepResult {
+            q: s.q,
+            unclamped: s.unclamped,
+            info: s.info,
+        })
+    }
+
+    /// Iterates steps on the model to tolerance. Releases the GIL.
+    #[pyo3(signature = (q0, target, max_steps = 1000, position_tolerance = 1e-4,
+                        orientation_tolerance = 0.1f64.to_radians()))]
+    fn solve(
+        &self,
+        py: Python<'_>,
+        q0: &Bound<'_, PyAny>,
+        target: &Bound<'_, PyAny>,
+        max_steps: i64,
+        position_tolerance: f64,
+        orientation_tolerance: f64,
+    ) -> PyResult<Solution> {
+        let n = softarm_core::chain::SectionModel::n_dofs(self.inner.arm());
+        let q0 = crate::convert::vector(q0, "q0", n)?;
+        let t = self::target(target)?;
+        let max_steps = usize::try_from(max_steps).map_err(|_| {
+            crate::errors::OutOfRangeError::new_err(format!(
+                "max_steps = {max_steps} is out of range [0, inf]"
+            ))
+        })?;
+        let opts = SolveOptions {
+            max_steps,
+            position_tolerance,
+            orientation_tolerance,
+        };
+        let res = &self.inner;
+        let sol = py.detach(|| res.solve(&q0, &t, &opts)).py()?;
+        Ok(Solution { inner: sol })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Resolver(mode={:?})", self.inner.mode().name())
+    }
+}
+
+/// Registers the resolver classes.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Gains>()?;
+    m.add_class::<Resolver>()?;
+    m.add_class::<StepResult>()?;
+    m.add_class::<Solution>()?;
+    Ok(())
+}
