@@ -19,6 +19,8 @@ class HarvestConfig:
         period: control period (s).
         approach: unit direction along which the gripper faces every berry (the bush
             lies along +Y of the base frame, section IV-F).
+        approach_cone_deg: a placement planner may tilt the approach axis this far from
+            ``approach`` when the arm cannot face the berry squarely.
         grasp_offset: how far ahead of the end-effector origin (m), along its z axis, a
             berry sits when it is between the fingers.
         standoff: pre-grasp distance (m) short of the grasp pose. Inside the 6 cm at which
@@ -44,6 +46,7 @@ class HarvestConfig:
 
     period: float = 0.05
     approach: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    approach_cone_deg: float = 20.0
     grasp_offset: float = 0.03
     standoff: float = 0.05
     placement_tolerance: float = 0.01

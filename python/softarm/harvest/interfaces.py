@@ -23,6 +23,7 @@ __all__ = [
     "EndEffectorTracker",
     "GripperDevice",
     "GroundTruth",
+    "PlacementPlanner",
     "PressureActuator",
     "RipenessProbe",
 ]
@@ -99,6 +100,18 @@ class Controller(Protocol):
         ...
 
 
+class PlacementPlanner(Protocol):
+    """Plans initial placement on the controller's model before the loop closes."""
+
+    def plan(
+        self, q: FloatArray, berry: FloatArray, current: FloatArray
+    ) -> tuple[FloatArray, FloatArray] | None:
+        """``(q_pre_grasp, approach_axis)``: elongations (m) that put the gripper at the
+        pre-grasp pose of the berry at ``berry`` (base frame), and the unit axis it
+        approaches along; None when no pose in the allowed cone is reachable."""
+        ...
+
+
 class PressureActuator(Protocol):
     """Elongations (m) to pressures (psi) through the safety layer."""
 
@@ -134,6 +147,6 @@ class RipenessProbe(Protocol):
 class GroundTruth(Protocol):
     """Simulation only: true errors, to report what vision cannot see."""
 
-    def grasp_errors(self, berry: BerryTarget) -> tuple[float, float]:
-        """True (position error m, orientation error rad) of the gripper to ``berry`` now."""
+    def grasp_errors(self, berry: BerryTarget, axis: FloatArray) -> tuple[float, float]:
+        """True (grasp point to ``berry`` in m, gripper axis to ``axis`` in rad) now."""
         ...

@@ -36,6 +36,7 @@ from softarm.harvest.interfaces import (
     FloatArray,
     GripperDevice,
     GroundTruth,
+    PlacementPlanner,
     PressureActuator,
     RipenessProbe,
 )
@@ -59,6 +60,8 @@ class HarvestMachine:
         config: tuning; defaults follow the paper.
         log: where steps and transitions go (in memory by default).
         ground_truth: simulation only, to report true errors at the grasp.
+        planner: plans placement on the model first (see :mod:`softarm.harvest.ik`);
+            without one the resolver closes the loop from the ready pose directly.
     """
 
     def __init__(
@@ -74,6 +77,7 @@ class HarvestMachine:
         config: HarvestConfig | None = None,
         log: HarvestLog | None = None,
         ground_truth: GroundTruth | None = None,
+        planner: PlacementPlanner | None = None,
     ) -> None:
         self.clock = clock
         self.locator = locator
@@ -91,6 +95,7 @@ class HarvestMachine:
         #: away from the lower limits where the resolver's steps would be clipped.
         self.home: FloatArray = np.full(n_actuators, self.config.home_elongation)
         self.servo = Servo(clock, tracker, locator, controller, actuator, self.config, self.log)
+        self.planner = planner
 
     def run(self, berries: Sequence[BerryTarget]) -> HarvestReport:
         """Harvest ``berries`` in order; stop early after a fault in FAULTS_THAT_STOP."""
@@ -117,7 +122,7 @@ class HarvestMachine:
             self.q = self.servo.ramp(self.q, self.home)
             self.servo.wait_visible(self.q)
             self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
-            self.q = self.servo.place(self.q)
+            self.q = self.servo.place(self.q, self.planner)
             self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
             self.q = self.servo.fine(self.q)
             self._record_grasp_errors(berry, result)
@@ -161,7 +166,7 @@ class HarvestMachine:
     def _record_grasp_errors(self, berry: BerryTarget, result: BerryResult) -> None:
         if self.ground_truth is None:
             return
-        pos, ang = self.ground_truth.grasp_errors(berry)
+        pos, ang = self.ground_truth.grasp_errors(berry, self.servo.axis)
         result.true_position_error_mm = 1e3 * pos
         result.true_orientation_error_deg = float(np.degrees(ang))
 

@@ -18,6 +18,7 @@ from softarm.harvest.interfaces import (
     Controller,
     EndEffectorTracker,
     FloatArray,
+    PlacementPlanner,
     PressureActuator,
 )
 from softarm.harvest.log import HarvestLog
@@ -65,12 +66,15 @@ class Servo:
         self._result = BerryResult(-1)
         self._pose_seen = self._fix_seen = -np.inf
         self._last_fix: BerryFix | None = None
+        #: The approach axis of the current berry (the planner may tilt it).
+        self.axis = config.approach_axis
 
     def begin(self, berry: BerryTarget, result: BerryResult) -> None:
         """Start a new berry: forget what was seen."""
         self._berry, self._result = berry, result
         self._pose_seen = self._fix_seen = self.clock.now()
         self._last_fix = None
+        self.axis = self.cfg.approach_axis
 
     # -- stages ---------------------------------------------------------------------
 
@@ -84,9 +88,25 @@ class Servo:
                 return
             self._hold(q)
 
-    def place(self, q: FloatArray) -> FloatArray:
-        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose."""
+    def place(self, q: FloatArray, planner: PlacementPlanner | None) -> FloatArray:
+        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose.
+
+        With a ``planner`` the pose (and the approach axis, inside the allowed cone) is
+        first solved on the model and reached open loop; the loop then closes on the
+        cameras (eq. 22) to remove the model's error.
+        """
         c = self.cfg
+        if planner is not None:
+            seen = self._observe()
+            while seen.pose is None or seen.fix is None:
+                self._hold(q)
+                seen = self._observe()
+            plan = planner.plan(q, seen.fix.position, seen.pose)
+            if plan is None:
+                raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
+            q_plan, self.axis = plan
+            self.log.event("plan", t=seen.t, q=q_plan, axis=self.axis, berry=seen.fix.position)
+            q = self.ramp(q, q_plan, observe=True)
         return self._servo(
             q, c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout, None
         )
@@ -110,16 +130,19 @@ class Servo:
                 raise
         return self.ramp(q, home, start + c.home_timeout)
 
-    def ramp(self, q: FloatArray, home: FloatArray, deadline: float = np.inf) -> FloatArray:
-        """Move the elongations straight to ``home`` at ``home_speed`` (open loop: the
-        rest pose needs no vision)."""
+    def ramp(
+        self, q: FloatArray, goal: FloatArray, deadline: float = np.inf, observe: bool = False
+    ) -> FloatArray:
+        """Move the elongations straight to ``goal`` at ``home_speed``, open loop; with
+        ``observe`` the cameras are still read (and checked) at every step."""
         step = self.cfg.home_speed * self.cfg.period
-        while np.any(q != home):
+        while np.any(q != goal):
             if self.clock.now() > deadline:
-                raise Fault(FaultReason.TIMEOUT, "home not reached in time")
-            q = q + np.clip(home - q, -step, step)
+                raise Fault(FaultReason.TIMEOUT, f"{self.state.value}: ramp not done in time")
+            q = q + np.clip(goal - q, -step, step)
             self.actuator.send(q)
-            self._log_step(_Seen(self.clock.now(), None, None), q, None, None, False)
+            seen = self._observe() if observe else _Seen(self.clock.now(), None, None)
+            self._log_step(seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
         return q
 
@@ -130,7 +153,7 @@ class Servo:
     ) -> FloatArray:
         """Drive the end effector to ``distance`` short of the berry along the approach
         axis until the error stays below ``tol``; see :class:`HarvestConfig`."""
-        c, axis = self.cfg, self.cfg.approach_axis
+        c, axis = self.cfg, self.axis
         start = self.clock.now()
         inside = 0
         best, best_t, saturated_since = np.inf, start, None
@@ -174,6 +197,10 @@ class Servo:
                 saturated_since is not None
                 and min(seen.t - saturated_since, seen.t - best_t) > c.stall_time
             ):
+                if budget is not None and err <= c.grasp_workspace:
+                    # On a joint limit but inside the gripper's ±1 cm: grasp (III-D).
+                    self.log.event("limit_grasp", t=seen.t, error=err)
+                    return q
                 raise Fault(
                     FaultReason.UNREACHABLE, f"{self.state.value}: saturated at error {err:.4f} m"
                 )

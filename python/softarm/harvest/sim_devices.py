@@ -8,7 +8,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from softarm.harvest.interfaces import BerryTarget, FloatArray
-from softarm.harvest.sim_plant import LagArmPlant
+from softarm.harvest.sim_plant import ArmPlant
 from softarm.sim.bush import Berry, Branch
 
 __all__ = ["ArmWatch", "SimClock", "SimGripper"]
@@ -42,16 +42,14 @@ class SimGripper:
 
     def __init__(
         self,
-        plant: LagArmPlant,
+        plant: ArmPlant,
         vision: object,
         on_bush: list[Berry],
         offset: float,
         workspace: float,
-        axis: FloatArray | None = None,
     ) -> None:
         self.plant, self.vision, self.on_bush = plant, vision, on_bush
         self.offset, self.workspace = offset, workspace
-        self.axis = np.array([0.0, 1.0, 0.0]) if axis is None else axis
         self.holding: Berry | None = None
         self.delivered: list[int] = []
 
@@ -80,13 +78,13 @@ class SimGripper:
         """Ripeness of the berry in the fingers; 0.0 (unripe) when there is none."""
         return 0.0 if self.holding is None else self.holding.ripeness
 
-    def grasp_errors(self, berry: BerryTarget) -> tuple[float, float]:
-        """True (distance grasp point → berry, pointing error) now."""
+    def grasp_errors(self, berry: BerryTarget, axis: FloatArray) -> tuple[float, float]:
+        """True (distance grasp point → berry, angle gripper axis → ``axis``) now."""
         b = self._berry(berry.tag_id)
         if b is None:
             return float("nan"), float("nan")
         z = self.plant.pose()[:3, 2]
-        ang = float(np.arccos(np.clip(z @ self.axis, -1.0, 1.0)))
+        ang = float(np.arccos(np.clip(z @ axis, -1.0, 1.0)))
         return float(np.linalg.norm(self._grasp_point() - b.position)), ang
 
 
@@ -100,7 +98,7 @@ class ArmWatch:
 
     def __init__(
         self,
-        plant: LagArmPlant,
+        plant: ArmPlant,
         branches: Sequence[Branch],
         offset: float,
         contact_distance: float = 0.03,

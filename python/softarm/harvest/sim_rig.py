@@ -14,16 +14,18 @@ from pathlib import Path
 import numpy as np
 
 import softarm
+from softarm._core import Resolver
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
+from softarm.harvest.ik import ModelIK
 from softarm.harvest.interfaces import BerryTarget, Controller, FloatArray
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
-from softarm.harvest.sim_plant import LagArmPlant
+from softarm.harvest.sim_plant import ArmPlant
 from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
 from softarm.harvest.vision_loop import CameraVision
@@ -44,7 +46,6 @@ class SimRigOptions:
     seed: int = 0
     scale: float = 1.0
     noise_std: float = 2.0
-    tau: float = 0.1
     unripe_fraction: float = 0.0
     config: HarvestConfig = field(default_factory=HarvestConfig)
     log_path: str | Path | None = None
@@ -54,7 +55,8 @@ class SimRigOptions:
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
     """C1 about 1 m from the workspace, looking across it from +X/-Y so that it sees the
     cube's side faces, the base tag and the berry tags (section II-C); C2 at the centre
-    of the gripper looking along its axis; the cube 5 cm behind the gripper frame."""
+    of the gripper (3 cm behind its frame) looking along its axis; the cube 5 cm behind
+    the gripper frame."""
     centre = np.array([0.0, 0.25, 0.3])
     eye = np.array([0.7, -0.45, 0.55])
     tag = np.eye(4)
@@ -64,9 +66,11 @@ def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
     tag[:3, 3] = tag_pos
     cube = np.eye(4)
     cube[2, 3] = -0.05
+    c2 = np.eye(4)
+    c2[2, 3] = -0.03  # in the palm, 6 cm behind the grasp point: the whole tag stays in view
     return SimCameras(
         T_base_c1=look_at(eye, centre),
-        T_ee_c2=np.eye(4),
+        T_ee_c2=c2,
         T_ee_cube=cube,
         T_base_tag=tag,
         noise_std=noise_std,
@@ -80,7 +84,7 @@ class SimRig:
 
     bush: Bush
     model: softarm.SoftArm
-    plant: LagArmPlant
+    plant: ArmPlant
     clock: SimClock
     bank: SafePressureBank
     vision: CameraVision
@@ -131,7 +135,7 @@ def build_sim_rig(
     o = options or SimRigOptions()
     cfg = o.config
     model = softarm.SoftArm.blackberry()
-    plant = LagArmPlant.around(model, o.seed + 1000, o.tau)
+    plant = ArmPlant.seeded(model, o.seed + 1000)
     bush = Bush.generate(
         plant.arm, o.n_berries, o.seed, grasp_offset=cfg.grasp_offset,
         unripe_fraction=o.unripe_fraction,
@@ -148,8 +152,9 @@ def build_sim_rig(
         seed=o.seed, hidden=o.hidden,
     )  # fmt: skip
     gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    resolver = Resolver(model, mode="hybrid")
     if controller is None:
-        controller = ResolverController(softarm.Resolver(model, mode="hybrid"))
+        controller = ResolverController(resolver)
     machine = HarvestMachine(
         clock,
         vision,
@@ -162,6 +167,7 @@ def build_sim_rig(
         config=cfg,
         log=HarvestLog(o.log_path),
         ground_truth=gripper,
+        planner=ModelIK(resolver, cfg, seed=o.seed),
     )
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)
 

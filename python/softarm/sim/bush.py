@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import ParameterError
+from softarm.harvest.ik import cone_axes
 
 __all__ = ["Berry", "Branch", "Bush"]
 
@@ -84,6 +85,7 @@ class Bush:
         branch_clearance: float = 0.035,
         first_tag: int = 10,
         unripe_fraction: float = 0.0,
+        cone_deg: float = 20.0,
     ) -> Bush:
         """A bush of ``n_berries`` for ``arm`` (anything with ``lower``, ``upper`` and
         ``forward_batch``), deterministic in ``seed``.
@@ -91,7 +93,8 @@ class Bush:
         A berry is accepted when its gripper axis is within ``max_tilt_deg`` of +Y and it
         is at least ``min_spacing`` from the others. Each gets one cane behind it, kept
         ``branch_clearance`` away from every berry's approach corridor (``corridor``
-        m in front of the berry, straight along +Y, to 2 cm behind it).
+        m in front of the berry to 2 cm behind it, along +Y and every axis within
+        ``cone_deg`` of it).
         """
         if not 1 <= n_berries <= 40:
             raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
@@ -115,7 +118,13 @@ class Bush:
                 break
         else:
             raise ParameterError(f"could not place {n_berries} berries {min_spacing} m apart")
-        segments = [(b.position - corridor * PLUS_Y, b.position + 0.02 * PLUS_Y) for b in berries]
+        # Approach lines: along +Y and along every axis of the cone the planner may tilt to
+        # (softarm.harvest.ik.cone_axes), so no straight approach meets a cane.
+        segments = [
+            (b.position - corridor * a, b.position + 0.02 * a)
+            for b in berries
+            for a in cone_axes(PLUS_Y, cone_deg)
+        ]
         branches = [_cane(rng, b, segments, branch_clearance) for b in berries]
         return cls(berries, [c for c in branches if c is not None], seed)
 
