@@ -9,6 +9,9 @@ and adds vision, hardware drivers, simulation, the harvest state machine and the
 np.float64(0.534)
 """
 
+import importlib
+from types import ModuleType
+
 from softarm._core import ArcChain, Section, SoftArm, __version__
 from softarm.errors import (
     ConfigError,
@@ -45,3 +48,13 @@ __all__ = [
     "VisionError",
     "__version__",
 ]
+
+#: Subpackages imported on first attribute access: vision pulls in OpenCV, and the
+#: kinematics should not pay for that.
+_LAZY_SUBPACKAGES = frozenset({"vision", "sim", "hardware", "harvest", "config"})
+
+
+def __getattr__(name: str) -> ModuleType:
+    if name in _LAZY_SUBPACKAGES:
+        return importlib.import_module(f"softarm.{name}")
+    raise AttributeError(f"module 'softarm' has no attribute {name!r}")

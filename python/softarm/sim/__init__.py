@@ -2,15 +2,23 @@
 synthetic cameras, so that everything runs with no hardware attached."""
 
 from softarm.sim.arm import PlantConfig, SimulatedArm, perturbed_arm
+from softarm.sim.camera import Lighting, Scene, SyntheticCamera
 from softarm.sim.hysteresis import PlayHysteresis
+from softarm.sim.markers import SceneMarker, TexturedPlane, cube_scene_markers
 from softarm.sim.pressure import PressureDynamics
 from softarm.sim.tracker import PoseTracker
 
 __all__ = [
+    "Lighting",
     "PlantConfig",
     "PlayHysteresis",
     "PoseTracker",
     "PressureDynamics",
+    "Scene",
+    "SceneMarker",
     "SimulatedArm",
+    "SyntheticCamera",
+    "TexturedPlane",
+    "cube_scene_markers",
     "perturbed_arm",
 ]

@@ -109,12 +109,12 @@ class SyntheticCamera:
         if light.vignetting > 0:
             img *= self._vignette(light.vignetting)
         if self.blur > 0:
-            img = cv2.GaussianBlur(img, (0, 0), self.blur)
+            img = np.asarray(cv2.GaussianBlur(img, (0, 0), self.blur), dtype=np.float32)
         if self.noise_std > 0:
             img += np.float32(self.noise_std) * self._noise()
         np.maximum(img, 0.0, out=img)
         # Rounds to nearest and saturates at 255 (values are >= 0 here, so abs is a no-op).
-        return cv2.convertScaleAbs(img)
+        return np.asarray(cv2.convertScaleAbs(img), dtype=np.uint8)
 
     def _draw(self, img: npt.NDArray[np.float32], item: SceneItem) -> None:
         pose = _pose_of(item)

@@ -16,14 +16,21 @@ from softarm.vision.dictionaries import get_dictionary
 
 _SUBPIX = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
 _MIN_VIEWS = 3
+# k3 fixed at 0: with views that do not reach the image corners, a free k3 fits the
+# covered area and extrapolates wildly outside it (the usual advice for mild lenses).
+DEFAULT_FLAGS = cv2.CALIB_FIX_K3
 
 
 def calibrate_chessboard(
-    images: Sequence[npt.NDArray[Any]], pattern: tuple[int, int], square: float
+    images: Sequence[npt.NDArray[Any]],
+    pattern: tuple[int, int],
+    square: float,
+    flags: int = DEFAULT_FLAGS,
 ) -> tuple[CameraModel, float]:
     """Calibrate from views of a chessboard with ``pattern`` = (columns, rows) inner
     corners and ``square`` side (m). Returns the model and the RMS reprojection error (px).
-    Views where the board is not found are skipped; at least 3 must remain."""
+    Views where the board is not found are skipped; at least 3 must remain. ``flags`` are
+    ``cv2.calibrateCamera`` flags (default: k3 fixed at 0, see :data:`DEFAULT_FLAGS`)."""
     size = positive(square, "square")
     cols, rows = int(pattern[0]), int(pattern[1])
     grid = np.zeros((cols * rows, 3), np.float32)
@@ -38,7 +45,7 @@ def calibrate_chessboard(
         corners = cv2.cornerSubPix(gray, corners, (5, 5), (-1, -1), _SUBPIX)
         obj.append(grid)
         img.append(corners)
-    return _calibrate(obj, img, shape)
+    return _calibrate(obj, img, shape, flags)
 
 
 def calibrate_charuco(
@@ -47,6 +54,7 @@ def calibrate_charuco(
     square_length: float,
     marker_length: float,
     dictionary: str = "DICT_4X4_50",
+    flags: int = DEFAULT_FLAGS,
 ) -> tuple[CameraModel, float]:
     """Calibrate from views of a ChArUco board of ``squares`` = (columns, rows) squares.
     Views with fewer than 6 ChArUco corners are skipped; at least 3 must remain."""
@@ -64,10 +72,11 @@ def calibrate_charuco(
         ch_corners, ch_ids, _, _ = detector.detectBoard(gray)
         if ch_ids is None or len(ch_ids) < 6:
             continue
-        o, i = board.matchImagePoints(ch_corners, ch_ids)
-        obj.append(o.astype(np.float32))
-        img.append(i.astype(np.float32))
-    return _calibrate(obj, img, shape)
+        # ChArUco corners are one (N, 1, 2) array; the stubs only know the marker form.
+        o, i = board.matchImagePoints(ch_corners, ch_ids)  # type: ignore[call-overload]
+        obj.append(np.asarray(o, dtype=np.float32))
+        img.append(np.asarray(i, dtype=np.float32))
+    return _calibrate(obj, img, shape, flags)
 
 
 def _same_shape(shape: tuple[int, int] | None, gray: npt.NDArray[Any], k: int) -> tuple[int, int]:
@@ -77,10 +86,13 @@ def _same_shape(shape: tuple[int, int] | None, gray: npt.NDArray[Any], k: int) -
 
 
 def _calibrate(
-    obj: list[npt.NDArray[Any]], img: list[npt.NDArray[Any]], shape: tuple[int, int] | None
+    obj: list[npt.NDArray[Any]],
+    img: list[npt.NDArray[Any]],
+    shape: tuple[int, int] | None,
+    flags: int,
 ) -> tuple[CameraModel, float]:
     if shape is None or len(obj) < _MIN_VIEWS:
         raise VisionError(f"calibration needs >= {_MIN_VIEWS} usable views, got {len(obj)}")
     h, w = shape
-    rms, mat, dist, _, _ = cv2.calibrateCamera(obj, img, (w, h), None, None)
-    return CameraModel(mat, np.ravel(dist), (w, h)), float(rms)
+    rms, mat, dist, _, _ = cv2.calibrateCamera(obj, img, (w, h), None, None, flags=flags)
+    return CameraModel(np.asarray(mat, dtype=np.float64), np.ravel(dist), (w, h)), float(rms)

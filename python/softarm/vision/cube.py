@@ -36,10 +36,12 @@ from softarm.vision.poses import (
     transform_points,
 )
 
-# A candidate whose RMS reprojection error is within this of the best one is "as good"
-# (planar ambiguity): then the previous pose decides. Errors are in pixels.
-AMBIGUITY_FACTOR = 2.0
-AMBIGUITY_MARGIN_PX = 0.05
+# A candidate is "as good as the best" (planar ambiguity, then the previous pose decides)
+# when its extra squared reprojection error is within what corner noise of std
+# ``corner_sigma`` explains: N (rms² − best²) ≤ σ² χ²(6 dof, 99 %), N the matched corners
+# (rms is per corner). 16.81 is the 99 % quantile of χ² with 6 degrees of freedom (a pose).
+CHI2_6DOF_99 = 16.81
+DEFAULT_CORNER_SIGMA_PX = 0.05
 _LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
 
 
@@ -55,18 +57,21 @@ class CubePose:
 class MarkerCube:
     """A rigid set of square markers: ``markers`` maps id → (4, 4) pose of the marker in
     the cube frame (ArUco marker convention: z out of the face); all share ``marker_length``
-    (m) and ``dictionary``."""
+    (m) and ``dictionary``. ``corner_sigma`` (px) is the expected corner noise, which sets
+    how close in reprojection error two solutions must be to count as ambiguous."""
 
     def __init__(
         self,
         markers: Mapping[int, npt.ArrayLike],
         marker_length: float,
         dictionary: str = "DICT_4X4_50",
+        corner_sigma: float = DEFAULT_CORNER_SIGMA_PX,
     ) -> None:
         if not markers:
             raise ParameterError("markers must name at least one marker, got none")
         self.marker_length = positive(marker_length, "marker_length")
         self.dictionary = dictionary
+        self.corner_sigma = positive(corner_sigma, "corner_sigma")
         self.markers: dict[int, FloatArray] = {
             check_marker_id(dictionary, k): as_pose(v, f"markers[{k}]") for k, v in markers.items()
         }
@@ -132,37 +137,50 @@ class MarkerCube:
     ) -> CubePose | None:
         """Like :meth:`estimate_pose` from existing detections, with fit details."""
         prev = None if previous is None else as_pose(previous, "previous", tol=1e-4)
+        cands = self.candidates(detections, camera)
+        if not cands:
+            return None
+        pick = cands[0]
+        if prev is not None:
+            n = round(len(pick.marker_ids) * 4)
+            limit = self.corner_sigma**2 * CHI2_6DOF_99 / n
+            ok = [c for c in cands if c.rms**2 - cands[0].rms ** 2 <= limit]
+            pick = min(ok, key=lambda c: rotation_angle(c.T_camera_cube, prev))
+        return pick
+
+    def candidates(self, detections: list[Detection], camera: CameraModel) -> list[CubePose]:
+        """Every local optimum found: each IPPE solution of each visible cube marker,
+        refined by LM over all matched corners; lowest RMS first ([] if none)."""
         mine = [d for d in detections if d.marker_id in self.markers]
         if not mine:
-            return None
+            return []
         corners = [d.corners.astype(np.float32).reshape(1, 4, 2) for d in mine]
         ids = np.array([d.marker_id for d in mine], dtype=np.int32)
-        obj, img = self.board.matchImagePoints(corners, ids)
-        if obj is None or len(obj) < 4:
-            return None
-        obj = obj.reshape(-1, 3).astype(np.float64)
-        img = img.reshape(-1, 2).astype(np.float64)
-        cands = []
+        obj_pts, _ = self.board.matchImagePoints(corners, ids)
+        if obj_pts is None or len(obj_pts) < 4:
+            return []
+        # matchImagePoints hands back float32; the refinement below works in float64
+        # from the original (float64) corners, in the same marker order.
+        obj = np.asarray(obj_pts, dtype=np.float64).reshape(-1, 3)
+        img = np.concatenate([d.corners for d in mine]).reshape(-1, 2)
+        used = tuple(int(i) for i in ids)
+        out = []
         for det in mine:
             for sol in square_marker_poses(det.corners, camera, self.marker_length):
                 start = sol.T_camera_marker @ invert(self.markers[det.marker_id])
-                cands.append(self._refine(start, obj, img, camera))
-        cands.sort(key=lambda c: c[1])
-        best_rms = cands[0][1]
-        pick = cands[0]
-        if prev is not None:
-            ok = [c for c in cands if c[1] <= AMBIGUITY_FACTOR * best_rms + AMBIGUITY_MARGIN_PX]
-            pick = min(ok, key=lambda c: rotation_angle(c[0], prev))
-        return CubePose(pick[0], pick[1], tuple(int(i) for i in ids))
+                pose, rms = self._refine(start, obj, img, camera)
+                out.append(CubePose(pose, rms, used))
+        out.sort(key=lambda c: c.rms)
+        return out
 
     @staticmethod
     def _refine(
         start: FloatArray, obj: FloatArray, img: FloatArray, camera: CameraModel
     ) -> tuple[FloatArray, float]:
         """Levenberg–Marquardt over all matched corners from ``start``; (pose, RMS px)."""
-        rvec, tvec = rvec_tvec_from_pose(start)
+        rvec0, tvec0 = rvec_tvec_from_pose(start)
         rvec, tvec = cv2.solvePnPRefineLM(
-            obj, img, camera.matrix, camera.distortion, rvec, tvec, _LM_CRITERIA
+            obj, img, camera.matrix, camera.distortion, rvec0, tvec0, _LM_CRITERIA
         )
         proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
         rms = float(np.sqrt(np.mean(np.sum((proj.reshape(-1, 2) - img) ** 2, axis=1))))

@@ -51,8 +51,9 @@ def refine_marker_corners(
         normals.append(normal)
         counts.append(len(fractions))
     pts64 = np.concatenate(samples)  # (N, m, 2) pixel positions of the profile samples
-    lo = np.floor(pts64.reshape(-1, 2).min(axis=0)).astype(int)
-    hi = np.ceil(pts64.reshape(-1, 2).max(axis=0)).astype(int)
+    # Every sample lies within ``reach`` of the quad's sides.
+    lo = np.floor(quad.min(axis=0) - reach - 1).astype(int)
+    hi = np.ceil(quad.max(axis=0) + reach + 1).astype(int)
     if lo.min() < 0 or hi[0] > w - 1 or hi[1] > h - 1:
         return quad
     # Work on a float copy of the marker's neighbourhood only (a full-frame copy costs ~1 ms).
