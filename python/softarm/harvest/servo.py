@@ -24,7 +24,7 @@ from softarm.harvest.interfaces import (
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.report import BerryResult
 from softarm.harvest.states import FaultReason, HarvestState
-from softarm.harvest.targets import approach_pose, grasp_point, pointing_error
+from softarm.harvest.targets import grasp_point, pointing_error, tool_pose
 
 __all__ = ["Fault", "Servo"]
 
@@ -165,8 +165,12 @@ class Servo:
                 self._log_step(seen, q, None, None, False)
                 self._hold(q)
                 continue
-            goal = approach_pose(seen.pose, seen.fix.position, axis, distance)
-            err = float(np.linalg.norm(goal[:3, 3] - seen.pose[:3, 3]))
+            # The grasp point, not the end-effector origin, is servoed onto its goal
+            # ``distance - grasp_offset`` short of the berry: a residual pointing error then
+            # does not move the berry off the fingers.
+            point = seen.fix.position - (distance - c.grasp_offset) * axis
+            goal = tool_pose(seen.pose, point, axis, c.grasp_offset)
+            err = float(np.linalg.norm(grasp_point(seen.pose, c.grasp_offset) - point))
             ang = pointing_error(seen.pose, axis)
             if self.state is not HarvestState.RETURN_HOME:  # the errors at the grasp
                 self._result.position_error_mm = 1e3 * float(

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["align_z", "approach_pose", "grasp_point", "pointing_error"]
+__all__ = ["align_z", "approach_pose", "grasp_point", "pointing_error", "tool_pose"]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -45,6 +45,19 @@ def approach_pose(
     target = np.eye(4)
     target[:3, :3] = align_z(current[:3, :3], approach)
     target[:3, 3] = berry - distance * approach
+    return target
+
+
+def tool_pose(
+    current: FloatArray, point: FloatArray, approach: FloatArray, offset: float
+) -> FloatArray:
+    """Target ``T_base_ee`` (4, 4) for the resolver that moves the grasp point (``offset``
+    ahead of the end effector) to ``point`` while the z axis turns to ``approach``: the
+    origin goes ``offset`` behind ``point`` along the CURRENT z axis, so the position task
+    places the grasp point itself whatever the remaining pointing error."""
+    target = np.eye(4)
+    target[:3, :3] = align_z(current[:3, :3], approach)
+    target[:3, 3] = point - offset * current[:3, 2]
     return target
 
 
