@@ -7,6 +7,10 @@ for approach axes in a cone around +Y (squarest first), from several starts (the
 command and the best of a seeded batch of random configurations, scored by forward
 kinematics), it looks for elongations reaching the pre-grasp pose AND the grasp pose.
 The machine ramps the actuators to that solution, then servos on the cameras (eq. 22).
+
+With known canes (curve obstacles, as in the planning paper) a solution is kept only if
+the model arm clears them by ``margin`` all along the straight actuator-space ramp to it,
+along the final approach to the berry and at the grasp.
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.targets import approach_pose
 
@@ -46,6 +51,9 @@ class ModelIK:
         samples: random configurations scored per axis.
         starts: how many of the best-scored ones are refined (plus the current command).
         seed: seed of the random configurations.
+        clearance: the model arm's gap to the known canes; None = no obstacles.
+        margin: smallest gap (m) accepted along the planned motions.
+        via: how much further back (m) than the pre-grasp pose the via point lies.
     """
 
     def __init__(
@@ -55,31 +63,63 @@ class ModelIK:
         samples: int = 3000,
         starts: int = 4,
         seed: int = 0,
+        clearance: Clearance | None = None,
+        margin: float = 0.01,
+        via: float = 0.1,
     ) -> None:
         self.resolver = resolver
         self.arm = resolver.arm  # type: ignore[attr-defined]
         self.cfg = config
         self.samples, self.starts = samples, starts
         self.rng = np.random.default_rng(seed)
+        self.clearance, self.margin, self.via = clearance, margin, via
 
     def plan(
         self, q: FloatArray, berry: FloatArray, current: FloatArray
-    ) -> tuple[FloatArray, FloatArray] | None:
-        """``(q_pre_grasp, axis)`` for the squarest reachable approach, or None."""
-        c = self.cfg
-        for axis in cone_axes(c.approach_axis, c.approach_cone_deg):
-            pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
-            q_pre = self.solve(q, pre)
-            if q_pre is None:
-                continue
-            grasp = approach_pose(current, berry, axis, c.grasp_offset)
-            if self.solve(q_pre, grasp, sample=False) is not None:
-                return q_pre, axis
+    ) -> tuple[list[FloatArray], FloatArray] | None:
+        """``(waypoints, axis)`` for the squarest reachable approach whose ramp is clear:
+        straight to the pre-grasp pose if possible, else via a pose ``via`` further back
+        on the approach line (the arm then enters the bush along that line)."""
+        for via in (None, self.via):
+            for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
+                path = self._path(q, berry, current, axis, via)
+                if path is not None:
+                    return path, axis
         return None
 
-    def solve(self, q: FloatArray, target: FloatArray, sample: bool = True) -> FloatArray | None:
-        """Elongations reaching ``target`` (4, 4) on the model, nearest to ``q`` among the
-        converged starts; None when none converges."""
+    def _path(
+        self,
+        q: FloatArray,
+        berry: FloatArray,
+        current: FloatArray,
+        axis: FloatArray,
+        via: float | None,
+    ) -> list[FloatArray] | None:
+        c = self.cfg
+        pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
+        grasp = approach_pose(current, berry, axis, c.grasp_offset)
+        for q_pre in self.solve(q, pre):
+            q_grasp = self.solve(q_pre, grasp, sample=False)
+            if not q_grasp or not self._clear(q_pre, q_grasp[0], 5):
+                continue
+            if via is None:
+                if self._clear(q, q_pre):
+                    return [q_pre]
+                continue
+            back = approach_pose(current, berry, axis, c.grasp_offset + c.standoff + via)
+            for q_via in self.solve(q_pre, back, sample=False) + self.solve(q, back):
+                if self._clear(q, q_via) and self._clear(q_via, q_pre, 6):
+                    return [q_via, q_pre]
+        return None
+
+    def _clear(self, q0: FloatArray, q1: FloatArray, steps: int = 12) -> bool:
+        if self.clearance is None:
+            return True
+        return self.clearance.path_gap(q0, q1, steps) >= self.margin
+
+    def solve(self, q: FloatArray, target: FloatArray, sample: bool = True) -> list[FloatArray]:
+        """Elongations reaching ``target`` (4, 4) on the model from each start that
+        converges, nearest to ``q`` first; [] when none does."""
         starts = [q]
         if sample:
             lo, hi = self.arm.lower, self.arm.upper
@@ -89,13 +129,11 @@ class ModelIK:
             cos = np.clip(poses[:, :3, 2] @ target[:3, 2], -1.0, 1.0)
             score = pos_err + 0.05 * np.arccos(cos)  # 5 cm per rad: both matter
             starts += list(qs[np.argsort(score)[: self.starts]])
-        best: FloatArray | None = None
+        found = []
         for q0 in starts:
             sol = self.resolver.solve(  # type: ignore[attr-defined]
                 q0, target, max_steps=1500, position_tolerance=1e-3, orientation_tolerance=0.02
             )
             if sol.converged:
-                cand = np.asarray(sol.q, dtype=np.float64)
-                if best is None or np.linalg.norm(cand - q) < np.linalg.norm(best - q):
-                    best = cand
-        return best
+                found.append(np.asarray(sol.q, dtype=np.float64))
+        return sorted(found, key=lambda x: float(np.linalg.norm(x - q)))

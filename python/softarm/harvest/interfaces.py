@@ -105,10 +105,11 @@ class PlacementPlanner(Protocol):
 
     def plan(
         self, q: FloatArray, berry: FloatArray, current: FloatArray
-    ) -> tuple[FloatArray, FloatArray] | None:
-        """``(q_pre_grasp, approach_axis)``: elongations (m) that put the gripper at the
-        pre-grasp pose of the berry at ``berry`` (base frame), and the unit axis it
-        approaches along; None when no pose in the allowed cone is reachable."""
+    ) -> tuple[list[FloatArray], FloatArray] | None:
+        """``(waypoints, approach_axis)``: elongations (m) to ramp through, the last one
+        putting the gripper at the pre-grasp pose of the berry at ``berry`` (base frame),
+        and the unit axis it approaches along; None when nothing in the allowed cone is
+        reachable (clear of known obstacles)."""
         ...
 
 

@@ -104,9 +104,10 @@ class Servo:
             plan = planner.plan(q, seen.fix.position, seen.pose)
             if plan is None:
                 raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
-            q_plan, self.axis = plan
-            self.log.event("plan", t=seen.t, q=q_plan, axis=self.axis, berry=seen.fix.position)
-            q = self.ramp(q, q_plan, observe=True)
+            waypoints, self.axis = plan
+            self.log.event("plan", t=seen.t, q=waypoints, axis=self.axis, berry=seen.fix.position)
+            for q_way in waypoints:
+                q = self.ramp(q, q_way, observe=True)
         return self._servo(
             q, c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout, None
         )

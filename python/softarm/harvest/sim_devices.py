@@ -7,9 +7,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from softarm.harvest.clearance import Clearance
 from softarm.harvest.interfaces import BerryTarget, FloatArray
 from softarm.harvest.sim_plant import ArmPlant
-from softarm.sim.bush import Berry, Branch
+from softarm.sim.bush import Berry
 
 __all__ = ["ArmWatch", "SimClock", "SimGripper"]
 
@@ -89,36 +90,16 @@ class SimGripper:
 
 
 class ArmWatch:
-    """Samples the true arm's smallest distance to the canes after every time step.
+    """Samples the TRUE arm's gap to the canes after every time step (ground truth of
+    "no contact with a branch"); a gap below zero is a contact."""
 
-    The arm is its backbone (``samples`` points per section) plus the gripper up to the
-    grasp point; a cane is 80 points along its curve. A distance under
-    ``contact_distance`` (arm body radius plus cane radius) counts as a contact.
-    """
-
-    def __init__(
-        self,
-        plant: ArmPlant,
-        branches: Sequence[Branch],
-        offset: float,
-        contact_distance: float = 0.03,
-        samples: int = 8,
-    ) -> None:
-        self.plant, self.offset, self.samples = plant, offset, samples
-        self.canes = np.concatenate([b.points(80) for b in branches]) if branches else None
-        self.contact_distance = contact_distance
-        self.min_clearance = float("inf")
+    def __init__(self, plant: ArmPlant, clearance: Clearance) -> None:
+        self.plant, self.clearance = plant, clearance
+        self.min_gap = float("inf")
         self.contacts = 0
 
     def sample(self, dt: float = 0.0) -> None:
-        """Record the clearance of the arm as it is now."""
-        if self.canes is None:
-            return
-        q = self.plant.q()
-        body = self.plant.arm.backbone(q, self.samples)
-        ee = self.plant.arm.forward(q)
-        tip = ee[:3, 3] + np.outer(np.linspace(-0.06, self.offset, 6), ee[:3, 2])
-        pts = np.concatenate([body, tip])
-        d = float(np.min(np.linalg.norm(pts[:, None, :] - self.canes[None], axis=2)))
-        self.min_clearance = min(self.min_clearance, d)
-        self.contacts += d < self.contact_distance
+        """Record the gap of the arm as it is now."""
+        gap = self.clearance.gap(self.plant.q())
+        self.min_gap = min(self.min_gap, gap)
+        self.contacts += gap < 0.0

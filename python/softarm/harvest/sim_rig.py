@@ -17,6 +17,7 @@ import softarm
 from softarm._core import Resolver
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator
+from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK
@@ -118,9 +119,8 @@ class SimRig:
         report.berries = [results.get(t, BerryResult(t)) for t in order]
         report.extra.update(
             seed=self.bush.seed,
-            min_branch_clearance_m=self.watch.min_clearance,
-            branch_contacts=self.watch.contacts,
-            contact_distance_m=self.watch.contact_distance,
+            min_branch_gap_m=self.watch.min_gap,
+            branch_contact_steps=self.watch.contacts,
             sim_time_s=self.clock.now(),
         )
         self.machine.log.close()
@@ -141,7 +141,8 @@ def build_sim_rig(
         unripe_fraction=o.unripe_fraction,
     )  # fmt: skip
     on_bush = list(bush.berries)
-    watch = ArmWatch(plant, bush.branches, cfg.grasp_offset)
+    canes = [b.points(120) for b in bush.branches]
+    watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
     clock = SimClock([plant.advance, watch.sample])
     bank = SafePressureBank(
         SimulatedPressureBank(plant, plant.arm.n_actuators), 70.0, 100.0, 0.5, clock.now,
@@ -167,7 +168,10 @@ def build_sim_rig(
         config=cfg,
         log=HarvestLog(o.log_path),
         ground_truth=gripper,
-        planner=ModelIK(resolver, cfg, seed=o.seed),
+        # The canes are known obstacles (mapped), as the curve obstacles of the planning paper.
+        planner=ModelIK(
+            resolver, cfg, seed=o.seed, clearance=Clearance(model, canes, cfg.grasp_offset)
+        ),
     )
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)
 
