@@ -53,6 +53,8 @@ class SimGripper:
         self.offset, self.workspace = offset, workspace
         self.holding: Berry | None = None
         self.delivered: list[int] = []
+        #: True elongations at each grasp, for plots of the arm.
+        self.grasp_shapes: list[FloatArray] = []
 
     def _grasp_point(self) -> FloatArray:
         pose = self.plant.pose()
@@ -82,6 +84,7 @@ class SimGripper:
     def grasp_errors(self, berry: BerryTarget, axis: FloatArray) -> tuple[float, float]:
         """True (distance grasp point → berry, angle gripper axis → ``axis``) now."""
         b = self._berry(berry.tag_id)
+        self.grasp_shapes.append(self.plant.q())
         if b is None:
             return float("nan"), float("nan")
         z = self.plant.pose()[:3, 2]
@@ -97,9 +100,13 @@ class ArmWatch:
         self.plant, self.clearance = plant, clearance
         self.min_gap = float("inf")
         self.contacts = 0
+        #: True gripper positions (3,) after every step, for plots.
+        self.trajectory: list[FloatArray] = []
 
     def sample(self, dt: float = 0.0) -> None:
-        """Record the gap of the arm as it is now."""
-        gap = self.clearance.gap(self.plant.q())
+        """Record the gap of the arm (and the gripper position) as it is now."""
+        q = self.plant.q()
+        self.trajectory.append(self.plant.arm.forward(q)[:3, 3])
+        gap = self.clearance.gap(q)
         self.min_gap = min(self.min_gap, gap)
         self.contacts += gap < 0.0
