@@ -54,6 +54,9 @@ class ModelIK:
         clearance: the model arm's gap to the known canes; None = no obstacles.
         margin: smallest gap (m) accepted along the planned motions.
         via: how much further back (m) than the pre-grasp pose the via point lies.
+        limit_room: smallest distance (m) of the pre-grasp and grasp solutions to the
+            joint limits, so that the true arm (gains and geometry a few % off the model)
+            can still reach them in closed loop.
     """
 
     def __init__(
@@ -66,6 +69,7 @@ class ModelIK:
         clearance: Clearance | None = None,
         margin: float = 0.01,
         via: float = 0.1,
+        limit_room: float = 0.0015,
     ) -> None:
         self.resolver = resolver
         self.arm = resolver.arm  # type: ignore[attr-defined]
@@ -73,6 +77,7 @@ class ModelIK:
         self.samples, self.starts = samples, starts
         self.rng = np.random.default_rng(seed)
         self.clearance, self.margin, self.via = clearance, margin, via
+        self.limit_room = limit_room
 
     def plan(
         self, q: FloatArray, berry: FloatArray, current: FloatArray
@@ -100,7 +105,9 @@ class ModelIK:
         grasp = approach_pose(current, berry, axis, c.grasp_offset)
         for q_pre in self.solve(q, pre):
             q_grasp = self.solve(q_pre, grasp, sample=False)
-            if not q_grasp or not self._clear(q_pre, q_grasp[0], 5):
+            if not q_grasp or min(self._room(q_pre), self._room(q_grasp[0])) < self.limit_room:
+                continue  # the true arm differs by a few %: keep away from the limits
+            if not self._clear(q_pre, q_grasp[0], 5):
                 continue
             if via is None:
                 if self._clear(q, q_pre):
@@ -111,6 +118,10 @@ class ModelIK:
                 if self._clear(q, q_via) and self._clear(q_via, q_pre, 6):
                     return [q_via, q_pre]
         return None
+
+    def _room(self, q: FloatArray) -> float:
+        """Distance (m) of ``q`` to the nearest joint limit."""
+        return float(min(np.min(q - self.arm.lower), np.min(self.arm.upper - q)))
 
     def _clear(self, q0: FloatArray, q1: FloatArray, steps: int = 12) -> bool:
         if self.clearance is None:

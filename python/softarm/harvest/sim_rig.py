@@ -136,9 +136,10 @@ def build_sim_rig(
     cfg = o.config
     model = softarm.SoftArm.blackberry()
     plant = ArmPlant.seeded(model, o.seed + 1000)
+    cams = default_cameras(o.scale, o.noise_std)
     bush = Bush.generate(
         plant.arm, o.n_berries, o.seed, grasp_offset=cfg.grasp_offset,
-        unripe_fraction=o.unripe_fraction,
+        unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],
     )  # fmt: skip
     on_bush = list(bush.berries)
     canes = [b.points(120) for b in bush.branches]
@@ -149,7 +150,7 @@ def build_sim_rig(
         watchdog_thread=False,
     )  # fmt: skip
     vision = sim_vision(
-        default_cameras(o.scale, o.noise_std), plant.pose, lambda: on_bush, cfg.grasp_offset,
+        cams, plant.pose, lambda: on_bush, cfg.grasp_offset,
         seed=o.seed, hidden=o.hidden,
     )  # fmt: skip
     gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)

@@ -64,6 +64,9 @@ class CameraVision:
         grasp_offset: the grasp point (m) ahead of the end effector; the 6 cm hand-over
             is measured from it.
         max_age: how long (s) the most recent berry fix is held while it is hidden.
+        max_jump: a cube pose this far (m) from the previous one is an outlier (a wrong
+            solution of an ambiguous view: the arm cannot move that fast in one frame)
+            and is dropped, unless ``max_rejects`` in a row agree it is real.
     """
 
     def __init__(
@@ -79,6 +82,8 @@ class CameraVision:
         berry_tag: float,
         grasp_offset: float,
         max_age: float = 1.0,
+        max_jump: float = 0.03,
+        max_rejects: int = 3,
     ) -> None:
         self.frame1, self.frame2 = frame1, frame2
         self.model1, self.model2 = model1, model2
@@ -91,6 +96,9 @@ class CameraVision:
         self.selected = BerryTarget(-1)
         self._cube_prev: FloatArray | None = None
         self._c1: tuple[FloatArray | None, FloatArray | None] = (None, None)
+        self.max_jump, self.max_rejects = max_jump, max_rejects
+        self._last_ee: FloatArray | None = None
+        self._rejects = 0
 
     def select(self, berry: BerryTarget) -> None:
         """Track ``berry`` from now on (the fusion forgets any held target)."""
@@ -105,10 +113,23 @@ class CameraVision:
         if est is None:
             self._c1 = (None, berry_c1)
             return None
-        self._cube_prev = est.T_camera_cube
         T_c1_ee = est.T_camera_cube @ invert(self.T_ee_cube)
+        if self._outlier(T_c1_ee):
+            self._c1 = (None, berry_c1)
+            return None
+        self._cube_prev = est.T_camera_cube
         self._c1 = (T_c1_ee, berry_c1)
         return self.T_base_c1 @ T_c1_ee
+
+    def _outlier(self, T_c1_ee: FloatArray) -> bool:
+        last = self._last_ee
+        if last is not None and np.linalg.norm(T_c1_ee[:3, 3] - last[:3, 3]) > self.max_jump:
+            self._rejects += 1
+            if self._rejects < self.max_rejects:
+                return True
+        self._rejects = 0
+        self._last_ee = T_c1_ee
+        return False
 
     def locate(self, time: float, T_base_ee: FloatArray | None) -> BerryFix | None:
         """C2 and the fusion: the berry in the base frame (eq. 21), or the held fix."""

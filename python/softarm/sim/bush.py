@@ -86,6 +86,8 @@ class Bush:
         first_tag: int = 10,
         unripe_fraction: float = 0.0,
         cone_deg: float = 20.0,
+        view_point: FloatArray | None = None,
+        min_view_angle_deg: float = 3.0,
     ) -> Bush:
         """A bush of ``n_berries`` for ``arm`` (anything with ``lower``, ``upper`` and
         ``forward_batch``), deterministic in ``seed``.
@@ -94,7 +96,9 @@ class Bush:
         is at least ``min_spacing`` from the others. Each gets one cane behind it, kept
         ``branch_clearance`` away from every berry's approach corridor (``corridor``
         m in front of the berry to 2 cm behind it, along +Y and every axis within
-        ``cone_deg`` of it).
+        ``cone_deg`` of it). With a ``view_point`` (the eye-to-hand camera), no two berries
+        are within ``min_view_angle_deg`` of each other as seen from it: none hides
+        another's tag, so every berry can be found.
         """
         if not 1 <= n_berries <= 40:
             raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
@@ -108,6 +112,11 @@ class Bush:
             for i in np.flatnonzero(ok):
                 pos = poses[i, :3, 3] + grasp_offset * poses[i, :3, 2]
                 if any(np.linalg.norm(pos - b.position) < min_spacing for b in berries):
+                    continue
+                if view_point is not None and any(
+                    _angle(pos - view_point, b.position - view_point) < min_view_angle_deg
+                    for b in berries
+                ):
                     continue
                 ripe = 0.2 if rng.uniform() < unripe_fraction else 1.0
                 tag = first_tag + len(berries)
@@ -155,6 +164,12 @@ def _cane(
         if all(_segment_distance(pts, a, b) >= clearance for a, b in corridors):
             return branch
     return None
+
+
+def _angle(a: FloatArray, b: FloatArray) -> float:
+    """Angle (deg) between two vectors."""
+    c = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
+    return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
 
 
 def _segment_distance(points: FloatArray, a: FloatArray, b: FloatArray) -> float:
