@@ -69,7 +69,7 @@ class ModelIK:
         clearance: Clearance | None = None,
         margin: float = 0.01,
         via: float = 0.1,
-        limit_room: float = 0.0015,
+        limit_room: float = 0.001,
     ) -> None:
         self.resolver = resolver
         self.arm = resolver.arm  # type: ignore[attr-defined]

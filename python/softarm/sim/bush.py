@@ -92,7 +92,8 @@ class Bush:
         """A bush of ``n_berries`` for ``arm`` (anything with ``lower``, ``upper`` and
         ``forward_batch``), deterministic in ``seed``.
 
-        A berry is accepted when its gripper axis is within ``max_tilt_deg`` of +Y and it
+        Generating elongations lie 10 % of the range inside the limits. A berry is
+        accepted when its gripper axis is within ``max_tilt_deg`` of +Y and it
         is at least ``min_spacing`` from the others. Each gets one cane behind it, kept
         ``branch_clearance`` away from every berry's approach corridor (``corridor``
         m in front of the berry to 2 cm behind it, along +Y and every axis within
@@ -103,7 +104,10 @@ class Bush:
         if not 1 <= n_berries <= 40:
             raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
         rng = np.random.default_rng(seed)
-        lower, upper = np.asarray(arm.lower), np.asarray(arm.upper)  # type: ignore[attr-defined]
+        lo, hi = np.asarray(arm.lower), np.asarray(arm.upper)  # type: ignore[attr-defined]
+        # Feasible with room: 10 % of the range off each limit (the paper's actuators work
+        # at 10-60 of 70 psi), so the controller's model, a few % off, can reach them too.
+        lower, upper = lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)
         berries: list[Berry] = []
         for _ in range(200):
             qs = rng.uniform(lower, upper, size=(4000, lower.size))
