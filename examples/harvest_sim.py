@@ -41,9 +41,7 @@ def main() -> None:
         reports = [f.result() for f in futures]
     rows = [b for r in reports for b in r["berries"]]
     errors = [b["true_position_error_mm"] for b in rows if b["harvested"]]
-    print(
-        "| seed | harvested | mean error (mm) | max error (mm) | min cane gap (mm) | contact steps |"
-    )
+    print("| seed | harvested | mean error (mm) | max error (mm) | min cane gap (mm) | contacts |")
     print("| --- | --- | --- | --- | --- | --- |")
     for r in reports:
         e = [b["true_position_error_mm"] for b in r["berries"] if b["harvested"]]

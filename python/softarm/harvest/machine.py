@@ -111,8 +111,12 @@ class HarvestMachine:
         self.log.event("run_done", success_rate=report.success_rate)
         return report
 
-    def run_berry(self, berry: BerryTarget) -> BerryResult:
-        """Take one berry through the whole workflow; never raises for a device fault."""
+    def run_berry(self, berry: BerryTarget, grasp: bool = True) -> BerryResult:
+        """Take one berry through the whole workflow; never raises for a device fault.
+
+        With ``grasp=False`` the machine stops after fine positioning (DONE with the
+        gripper on the berry): visual servoing only, e.g. to check a calibration.
+        """
         result = BerryResult(berry.tag_id)
         start = self.clock.now()
         self.servo.begin(berry, result)
@@ -126,6 +130,9 @@ class HarvestMachine:
             self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
             self.q = self.servo.fine(self.q)
             self._record_grasp_errors(berry, result)
+            if not grasp:
+                self._transition(S.DONE, berry, "positioned; no grasp requested")
+                return self._finish(result, start)
             self._transition(S.GRASP, berry, "berry within the grasp workspace")
             self._grasp(result)
             self._transition(S.RETURN_HOME, berry, "grasp finished")
@@ -146,6 +153,9 @@ class HarvestMachine:
             self._vent(f"unexpected {exc!r}")
             self.log.event("crash", berry=berry.tag_id, error=repr(exc))
             raise
+        return self._finish(result, start)
+
+    def _finish(self, result: BerryResult, start: float) -> BerryResult:
         result.final_state = self.state
         result.duration_s = self.clock.now() - start
         self.log.event("berry_result", **result.to_dict())
