@@ -26,7 +26,7 @@ from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.actuator import SafeActuator
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
-from softarm.harvest.ik import ModelIK
+from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.vision_loop import CameraVision
@@ -116,7 +116,8 @@ def build_hardware_rig(
         machine = HarvestMachine(
             MonotonicClock(), vision, vision, ResolverController(resolver),
             SafeActuator(bank, ElongationMap(ch.p_max, ch.metres_per_psi)), gripper,
-            ArduinoRipenessSensor(link), arm.n_actuators, cfg, log, planner=ModelIK(resolver, cfg),
+            ArduinoRipenessSensor(link), arm.n_actuators, cfg, log,
+            planner=ModelIK(planning_resolver(arm), cfg),
         )  # fmt: skip
         return HardwareRig(machine, stack.pop_all())
     raise AssertionError("unreachable")  # pragma: no cover  (the with block returns)

@@ -18,13 +18,22 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from softarm._core import Resolver, SoftArm
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.targets import approach_pose
 
-__all__ = ["ModelIK", "cone_axes"]
+__all__ = ["ModelIK", "cone_axes", "planning_resolver"]
 
 FloatArray = npt.NDArray[np.float64]
+
+
+def planning_resolver(model: SoftArm, joint_limit_gain: float = -1e-3) -> Resolver:
+    """A hybrid resolver for planning on ``model``: the default gains with a joint-limit
+    gain (γ₅ of eq. 20, on the cost of eq. 14) 500 times the closed-loop one, so solutions
+    sit mid-range, where the true arm (a few % off the model) can still reach them."""
+    gains = Resolver(model, mode="hybrid").gains.replace(hybrid_gamma=joint_limit_gain)
+    return Resolver(model, mode="hybrid", gains=gains)
 
 
 def cone_axes(axis: FloatArray, cone_deg: float, rings: int = 2, per_ring: int = 8) -> FloatArray:
@@ -46,7 +55,8 @@ class ModelIK:
     """Implements :class:`~softarm.harvest.interfaces.PlacementPlanner`.
 
     Args:
-        resolver: a ``softarm.Resolver`` on the model (its ``solve`` refines each start).
+        resolver: a ``softarm.Resolver`` on the model (its ``solve`` refines each start),
+            best from :func:`planning_resolver`.
         config: the machine's configuration (approach axis and cone, offsets).
         samples: random configurations scored per axis.
         starts: how many of the best-scored ones are refined (plus the current command).
@@ -54,9 +64,9 @@ class ModelIK:
         clearance: the model arm's gap to the known canes; None = no obstacles.
         margin: smallest gap (m) accepted along the planned motions.
         via: how much further back (m) than the pre-grasp pose the via point lies.
-        limit_room: smallest distance (m) of the pre-grasp and grasp solutions to the
-            joint limits, so that the true arm (gains and geometry a few % off the model)
-            can still reach them in closed loop.
+        limit_room: smallest distance (m) of the grasp solution to the joint limits, so
+            that the true arm (gains and geometry a few % off the model) can still reach
+            the berry within a millimetre in closed loop.
     """
 
     def __init__(
@@ -105,8 +115,8 @@ class ModelIK:
         grasp = approach_pose(current, berry, axis, c.grasp_offset)
         for q_pre in self.solve(q, pre):
             q_grasp = self.solve(q_pre, grasp, sample=False)
-            if not q_grasp or min(self._room(q_pre), self._room(q_grasp[0])) < self.limit_room:
-                continue  # the true arm differs by a few %: keep away from the limits
+            if not q_grasp or self._room(q_grasp[0]) < self.limit_room:
+                continue  # the true arm differs by a few %: grasp away from the limits
             if not self._clear(q_pre, q_grasp[0], 5):
                 continue
             if via is None:

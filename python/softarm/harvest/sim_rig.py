@@ -20,7 +20,7 @@ from softarm.harvest.actuator import SafeActuator
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
-from softarm.harvest.ik import ModelIK
+from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.interfaces import BerryTarget, Controller, FloatArray
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
@@ -171,8 +171,11 @@ def build_sim_rig(
         ground_truth=gripper,
         # The canes are known obstacles (mapped), as the curve obstacles of the planning paper.
         planner=ModelIK(
-            resolver, cfg, seed=o.seed, clearance=Clearance(model, canes, cfg.grasp_offset)
-        ),
+            planning_resolver(model),
+            cfg,
+            seed=o.seed,
+            clearance=Clearance(model, canes, cfg.grasp_offset),
+        ),  # fmt: skip
     )
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)
 
