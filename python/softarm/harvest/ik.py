@@ -94,12 +94,14 @@ class ModelIK:
     ) -> tuple[list[FloatArray], FloatArray] | None:
         """``(waypoints, axis)`` for the squarest reachable approach whose ramp is clear:
         straight to the pre-grasp pose if possible, else via a pose ``via`` further back
-        on the approach line (the arm then enters the bush along that line)."""
-        for via in (None, self.via):
-            for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
-                path = self._path(q, berry, current, axis, via)
-                if path is not None:
-                    return path, axis
+        on the approach line (the arm then enters the bush along that line). Grasps with
+        three times ``limit_room`` from the joint limits are preferred."""
+        for room in (3 * self.limit_room, self.limit_room):
+            for via in (None, self.via):
+                for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
+                    path = self._path(q, berry, current, axis, via, room)
+                    if path is not None:
+                        return path, axis
         return None
 
     def _path(
@@ -109,13 +111,14 @@ class ModelIK:
         current: FloatArray,
         axis: FloatArray,
         via: float | None,
+        room: float,
     ) -> list[FloatArray] | None:
         c = self.cfg
         pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
         grasp = approach_pose(current, berry, axis, c.grasp_offset)
         for q_pre in self.solve(q, pre):
             q_grasp = self.solve(q_pre, grasp, sample=False)
-            if not q_grasp or self._room(q_grasp[0]) < self.limit_room:
+            if not q_grasp or self._room(q_grasp[0]) < room:
                 continue  # the true arm differs by a few %: grasp away from the limits
             if not self._clear(q_pre, q_grasp[0], 5):
                 continue

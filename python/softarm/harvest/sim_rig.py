@@ -21,7 +21,7 @@ from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK, planning_resolver
-from softarm.harvest.interfaces import BerryTarget, Controller, FloatArray
+from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.report import BerryResult, HarvestReport
@@ -92,7 +92,6 @@ class SimRig:
     gripper: SimGripper
     watch: ArmWatch
     machine: HarvestMachine
-    picked: list[int] = field(default_factory=list)
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
         """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
@@ -175,14 +174,6 @@ def build_sim_rig(
             cfg,
             seed=o.seed,
             clearance=Clearance(model, canes, cfg.grasp_offset),
-        ),  # fmt: skip
+        ),
     )
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)
-
-
-def true_grasp_errors(
-    pose: FloatArray, berry: FloatArray, offset: float, axis: FloatArray
-) -> tuple[float, float]:
-    """(distance grasp point → berry, angle z → axis) for a true pose."""
-    g = pose[:3, 3] + offset * pose[:3, 2]
-    return float(np.linalg.norm(g - berry)), float(np.arccos(np.clip(pose[:3, 2] @ axis, -1, 1)))
