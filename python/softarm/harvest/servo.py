@@ -122,9 +122,15 @@ class Servo:
         branches), then ramp the elongations to ``home`` in actuator space."""
         c = self.cfg
         start = self.clock.now()
+        berry = self._last_fix.position if self._last_fix is not None else None
         try:
             q = self._servo(
-                q, c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2, None
+                q,
+                c.grasp_offset + c.standoff,
+                c.placement_tolerance,
+                c.home_timeout / 2,
+                None,
+                frozen=berry,
             )
         except Fault as fault:
             if fault.reason is not FaultReason.TIMEOUT:
@@ -142,7 +148,7 @@ class Servo:
                 raise Fault(FaultReason.TIMEOUT, f"{self.state.value}: ramp not done in time")
             q = q + np.clip(goal - q, -step, step)
             self.actuator.send(q)
-            seen = self._observe() if observe else _Seen(self.clock.now(), None, None)
+            seen = self._observe(need_fix=False) if observe else _Seen(self.clock.now(), None, None)
             self._log_step(seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
         return q
@@ -150,17 +156,28 @@ class Servo:
     # -- the loop -------------------------------------------------------------------
 
     def _servo(
-        self, q: FloatArray, distance: float, tol: float, timeout: float, budget: float | None
+        self,
+        q: FloatArray,
+        distance: float,
+        tol: float,
+        timeout: float,
+        budget: float | None,
+        frozen: FloatArray | None = None,
     ) -> FloatArray:
         """Drive the end effector to ``distance`` short of the berry along the approach
-        axis until the error stays below ``tol``; see :class:`HarvestConfig`."""
+        axis until the error stays below ``tol``; see :class:`HarvestConfig`. With
+        ``frozen`` the berry position is that fixed point, not the cameras' (the berry is
+        in the fingers on the way back)."""
         c, axis = self.cfg, self.axis
         start = self.clock.now()
+        self._fix_seen = max(self._fix_seen, start)  # the open-loop ramp needed no berry
         inside = 0
         best, best_t, saturated_since = np.inf, start, None
         angle_tol = np.radians(c.angle_tolerance_deg)
         while True:
-            seen = self._observe()
+            seen = self._observe(need_fix=frozen is None)
+            if frozen is not None:
+                seen.fix = BerryFix(frozen, "held", seen.t - start)
             elapsed = seen.t - start
             if seen.pose is None or seen.fix is None:
                 self._log_step(seen, q, None, None, False)
@@ -214,8 +231,9 @@ class Servo:
             q = q_next
             self.clock.sleep(c.period)
 
-    def _observe(self) -> _Seen:
-        """Read the tracker and the locator; check for NaN and for markers lost too long."""
+    def _observe(self, need_fix: bool = True) -> _Seen:
+        """Read the tracker and the locator; check for NaN and for markers lost too long
+        (the berry only if ``need_fix``)."""
         t = self.clock.now()
         pose = self.tracker.track(t)
         if pose is not None:
@@ -233,7 +251,7 @@ class Servo:
             self._last_fix = fix
             self._result.target = [float(v) for v in fix.position]
             self._result.cameras[fix.camera] = self._result.cameras.get(fix.camera, 0) + 1
-        elif t - self._fix_seen > self.cfg.marker_timeout:
+        elif need_fix and t - self._fix_seen > self.cfg.marker_timeout:
             raise Fault(FaultReason.MARKER_LOST, f"berry not seen for {t - self._fix_seen:.2f} s")
         return _Seen(t, pose, fix)
 
