@@ -94,8 +94,9 @@ class ModelIK:
     ) -> tuple[list[FloatArray], FloatArray] | None:
         """``(waypoints, axis)`` for the squarest reachable approach whose ramp is clear:
         straight to the pre-grasp pose if possible, else via a pose ``via`` further back
-        on the approach line (the arm then enters the bush along that line). Grasps with
-        three times ``limit_room`` from the joint limits are preferred."""
+        on the approach line (the arm then enters the bush along that line). Plans whose
+        grasp is three times ``limit_room`` from the joint limits, and whose pre-grasp pose
+        is ``limit_room`` from them, are preferred."""
         for room in (3 * self.limit_room, self.limit_room):
             for via in (None, self.via):
                 for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
@@ -120,6 +121,8 @@ class ModelIK:
             q_grasp = self.solve(q_pre, grasp, sample=False)
             if not q_grasp or self._room(q_grasp[0]) < room:
                 continue  # the true arm differs by a few %: grasp away from the limits
+            if room > self.limit_room and self._room(q_pre) < self.limit_room:
+                continue
             if not self._clear(q_pre, q_grasp[0], 5):
                 continue
             if via is None:

@@ -31,6 +31,7 @@ from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
 from softarm.harvest.vision_loop import CameraVision
 from softarm.sim.bush import Bush
+from softarm.sim.pressure import MAX_PSI
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
 
@@ -136,9 +137,12 @@ def build_sim_rig(
     model = softarm.SoftArm.blackberry()
     plant = ArmPlant.seeded(model, o.seed + 1000)
     cams = default_cameras(o.scale, o.noise_std)
+    # The true actuators' range: 0-70 psi through each one's true elongation per psi.
+    true_upper = MAX_PSI * plant.sim.metres_per_psi
     bush = Bush.generate(
         plant.arm, o.n_berries, o.seed, grasp_offset=cfg.grasp_offset,
         unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],
+        limits=(np.zeros_like(true_upper), true_upper),
     )  # fmt: skip
     on_bush = list(bush.berries)
     canes = [b.points(120) for b in bush.branches]

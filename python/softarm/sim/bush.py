@@ -88,6 +88,7 @@ class Bush:
         cone_deg: float = 20.0,
         view_point: FloatArray | None = None,
         min_view_angle_deg: float = 3.0,
+        limits: tuple[FloatArray, FloatArray] | None = None,
     ) -> Bush:
         """A bush of ``n_berries`` for ``arm`` (anything with ``lower``, ``upper`` and
         ``forward_batch``), deterministic in ``seed``.
@@ -99,12 +100,14 @@ class Bush:
         m in front of the berry to 2 cm behind it, along +Y and every axis within
         ``cone_deg`` of it). With a ``view_point`` (the eye-to-hand camera), no two berries
         are within ``min_view_angle_deg`` of each other as seen from it: none hides
-        another's tag, so every berry can be found.
+        another's tag, so every berry can be found. ``limits`` (lower, upper) overrides
+        the arm's own elongation limits (e.g. the true actuators' range at 0–70 psi).
         """
         if not 1 <= n_berries <= 40:
             raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
         rng = np.random.default_rng(seed)
-        lo, hi = np.asarray(arm.lower), np.asarray(arm.upper)  # type: ignore[attr-defined]
+        lo, hi = limits or (arm.lower, arm.upper)  # type: ignore[attr-defined]
+        lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         # Feasible with room: 10 % of the range off each limit (the paper's actuators work
         # at 10-60 of 70 psi), so the controller's model, a few % off, can reach them too.
         lower, upper = lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo)
