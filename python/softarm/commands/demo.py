@@ -16,7 +16,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "loop harvests a few berries. Writes plots, the report and the log into --out.",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder")
-    p.add_argument("--berries", type=int, default=4, help="berries (default 4)")
+    p.add_argument("--berries", type=int, default=5, help="berries (default 5)")
     p.add_argument("--seed", type=int, default=0, help="seed of the bush and the arm")
     p.set_defaults(run=run)
 

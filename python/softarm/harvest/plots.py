@@ -59,13 +59,21 @@ def plot_errors(ax_p: Any, ax_o: Any, records: list[dict[str, Any]]) -> None:
         if r["kind"] == "step" and r["position_error"] is not None:
             if r["state"] in ("initial_placement", "fine_positioning"):
                 berries.setdefault(r["berry"], []).append(r)
-    for tag, steps in berries.items():
-        t0 = steps[0]["t"]
-        t = [s["t"] - t0 for s in steps]
-        ax_p.semilogy(t, [1e3 * s["position_error"] for s in steps], lw=1, label=f"tag {tag}")
-        ax_o.plot(t, [np.degrees(s["orientation_error"]) for s in steps], lw=1)
+    for k, (tag, steps) in enumerate(berries.items()):
+        t0, colour = steps[0]["t"], f"C{k % 10}"
+        for stage, style in (("initial_placement", "--"), ("fine_positioning", "-")):
+            part = [s for s in steps if s["state"] == stage]
+            t = [s["t"] - t0 for s in part]
+            label = f"tag {tag}" if stage == "fine_positioning" else None
+            ax_p.semilogy(
+                t, [1e3 * s["position_error"] for s in part], style, color=colour, lw=1, label=label
+            )
+            ax_o.plot(t, [np.degrees(s["orientation_error"]) for s in part], style, color=colour)
     ax_p.axhline(1.0, color="k", ls=":", lw=0.8)
-    ax_p.set(ylabel="position error (mm)", title="closed loop: placement, then fine positioning")
+    ax_p.set(
+        ylabel="position error (mm)",
+        title="closed loop: placement (dashed, to the pre-grasp point), fine positioning (solid)",
+    )
     ax_o.set(xlabel="time from the first closed-loop step (s)", ylabel="pointing error (deg)")
     if berries:
         ax_p.legend(fontsize=7, ncol=2)
