@@ -108,3 +108,40 @@ def test_every_fault_transition_is_logged_with_its_reason() -> None:
     assert trans["why"].startswith("unreachable")
     vent = next(r for r in rig.machine.log.records if r["kind"] == "vent")
     assert vent["ok"] is True
+
+
+def test_daq_error_on_the_way_home_vents_and_stops() -> None:
+    rig = make_rig()
+    real = rig.backend.set_pressures
+
+    failed = []
+
+    def flaky(psi: np.ndarray) -> None:
+        if rig.machine.state is S.RETURN_HOME and not failed:
+            failed.append(psi)
+            raise HardwareError("DAQmx error -50103: resource reserved")
+        real(psi)
+
+    rig.backend.set_pressures = flaky  # type: ignore[method-assign]
+    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    assert rig.transitions(1)[-2:] == [S.RETURN_HOME, S.FAULT]
+    assert report.stopped is FaultReason.HARDWARE_ERROR and rig.vented()
+    assert report.berries[1].final_state is S.IDLE  # never attempted
+
+
+def test_a_dead_daq_that_cannot_vent_is_logged_as_such() -> None:
+    rig = make_rig()
+    real = rig.backend.set_pressures
+
+    def dead(psi: np.ndarray) -> None:
+        if rig.clock.t >= 1.0:
+            raise HardwareError("DAQmx error -200279: device removed")
+        real(psi)
+
+    rig.backend.set_pressures = dead  # type: ignore[method-assign]
+    report = rig.machine.run([BerryTarget(1)])
+    assert report.stopped is FaultReason.HARDWARE_ERROR
+    failed = [r for r in rig.machine.log.records if r["kind"] == "vent_failed"]
+    assert failed and "could not vent" in failed[0]["error"]
+    vent = next(r for r in rig.machine.log.records if r["kind"] == "vent")
+    assert vent["ok"] is False  # the log says so: only the hardware e-stop can help now

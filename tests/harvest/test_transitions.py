@@ -94,3 +94,40 @@ def test_report_json_has_one_entry_per_berry_with_the_required_fields() -> None:
         assert b["final_state"] in ("done", "fault")
         assert len(b["target"]) == 3 and b["duration_s"] > 0
     assert data["berries"][1]["fault"] == "unreachable"
+
+
+def test_positioning_only_ends_done_after_fine_positioning() -> None:
+    rig = make_rig()
+    result = rig.machine.run_berry(BerryTarget(1), grasp=False)
+    assert rig.transitions(1) == [S.IDLE, S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.DONE]
+    assert result.final_state is S.DONE and not result.harvested and not rig.gripper.closed
+
+
+class _Planner:
+    """Plans a fixed waypoint and a tilted axis, or nothing."""
+
+    def __init__(self, waypoints, axis) -> None:
+        self.waypoints, self.axis, self.calls = waypoints, axis, 0
+
+    def plan(self, q, berry, current):
+        self.calls += 1
+        return None if self.waypoints is None else (self.waypoints, self.axis)
+
+
+def test_a_plan_is_ramped_to_then_servoed_along_its_axis() -> None:
+    rig = make_rig()
+    planner = _Planner([np.full(3, 0.01)], np.array([0.0, 1.0, 0.0]))
+    rig.machine.planner = planner
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and planner.calls == 1
+    plan = next(r for r in rig.machine.log.records if r["kind"] == "plan")
+    assert plan["q"] == [[0.01, 0.01, 0.01]]
+
+
+def test_no_plan_is_unreachable() -> None:
+    rig = make_rig()
+    rig.machine.planner = _Planner(None, None)
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.UNREACHABLE
+    assert rig.transitions(1) == [S.IDLE, S.INITIAL_PLACEMENT, S.FAULT]
+    assert rig.vented()

@@ -61,11 +61,15 @@ class SimCameras:
     berry_tag: float = 0.03
     scale: float = 1.0
 
+    def size(self, which: int) -> tuple[int, int]:
+        """Image (width, height) of C1 (``which`` = 1) or C2 (2) after ``scale``."""
+        size = self.c1_size if which == 1 else self.c2_size
+        return round(size[0] * self.scale), round(size[1] * self.scale)
+
     def model(self, which: int) -> CameraModel:
         """Intrinsics of C1 (``which`` = 1) or C2 (2), mild barrel distortion."""
-        size, f = (self.c1_size, self.c1_focal) if which == 1 else (self.c2_size, self.c2_focal)
-        w, h = round(size[0] * self.scale), round(size[1] * self.scale)
-        return CameraModel.ideal(f * self.scale, w, h, [-0.05, 0.01, 0.0, 0.0, 0.0])
+        f = self.c1_focal if which == 1 else self.c2_focal
+        return CameraModel.ideal(f * self.scale, *self.size(which), [-0.05, 0.01, 0.0, 0.0, 0.0])
 
 
 def sim_vision(
@@ -82,8 +86,9 @@ def sim_vision(
     no berry tag is drawn (a leaf in front of the berry)."""
     hide = hidden or (lambda t: False)
     m1, m2 = cams.model(1), cams.model(2)
-    c1 = SyntheticCamera(m1, *m1.image_size, noise_std=cams.noise_std, supersample=2, seed=seed)
-    c2 = SyntheticCamera(m2, *m2.image_size, noise_std=cams.noise_std, supersample=2, seed=seed + 1)
+    (w1, h1), (w2, h2) = cams.size(1), cams.size(2)
+    c1 = SyntheticCamera(m1, w1, h1, noise_std=cams.noise_std, supersample=2, seed=seed)
+    c2 = SyntheticCamera(m2, w2, h2, noise_std=cams.noise_std, supersample=2, seed=seed + 1)
     cube = MarkerCube.standard(cams.cube_marker)
     T_c1_base = invert(cams.T_base_c1)
 
