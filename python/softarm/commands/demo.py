@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import time
 from pathlib import Path
 
@@ -30,6 +31,8 @@ def run(args: argparse.Namespace) -> int:
     from softarm.harvest.plots import plot_run
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
+    # Vents are logged by the safety layer (softarm.hardware.safety): show them tidily.
+    logging.basicConfig(level=logging.WARNING, format="  [%(name)s] %(message)s")
     args.out.mkdir(parents=True, exist_ok=True)
     log = args.out / "harvest_log.jsonl"
     log.unlink(missing_ok=True)

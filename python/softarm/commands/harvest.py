@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 import time
 from pathlib import Path
@@ -32,6 +33,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def run(args: argparse.Namespace) -> int:
     """Run the harvest; exit status 0 when every berry ended DONE, 1 otherwise, 2 when
     the hardware is absent."""
+    # Vents are logged by the safety layer (softarm.hardware.safety): show them tidily.
+    logging.basicConfig(level=logging.WARNING, format="  [%(name)s] %(message)s")
     if args.sim:
         return _run_sim(args)
     return _run_hardware(args)
