@@ -133,8 +133,11 @@ class Servo:
                 frozen=berry,
             )
         except Fault as fault:
-            if fault.reason is not FaultReason.TIMEOUT:
+            # Backing out is best effort: the berry is already in the fingers, and the
+            # ramp home is open loop anyway.
+            if fault.reason not in (FaultReason.TIMEOUT, FaultReason.UNREACHABLE):
                 raise
+            self.log.event("retreat_incomplete", t=self.clock.now(), detail=str(fault))
         return self.ramp(q, home, start + c.home_timeout)
 
     def ramp(
