@@ -12,7 +12,16 @@ np.float64(0.534)
 import importlib
 from types import ModuleType
 
-from softarm._core import ArcChain, Section, SoftArm, __version__
+from softarm._core import (
+    ArcChain,
+    Gains,
+    Resolver,
+    Section,
+    SoftArm,
+    Solution,
+    StepResult,
+    __version__,
+)
 from softarm.errors import (
     ConfigError,
     HardwareError,
@@ -32,6 +41,7 @@ from softarm.errors import (
 __all__ = [
     "ArcChain",
     "ConfigError",
+    "Gains",
     "HardwareError",
     "HardwareUnavailableError",
     "InputError",
@@ -39,11 +49,14 @@ __all__ = [
     "OutOfRangeError",
     "ParameterError",
     "PoseError",
+    "Resolver",
     "SafetyError",
     "Section",
     "ShapeError",
     "SoftArm",
     "SoftarmError",
+    "Solution",
+    "StepResult",
     "UnreachableError",
     "VisionError",
     "__version__",

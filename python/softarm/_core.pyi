@@ -92,3 +92,169 @@ class ArcChain(_Kinematics):
     @property
     def lengths(self) -> _F64: ...
     def straight(self) -> _F64: ...
+
+@final
+class Gains:
+    """Tuning parameters of :class:`Resolver` (redundancy paper eq. 7, 13, 20, 23-25).
+
+    Keyword-only constructor; every field defaults to the blackberry preset
+    (``Gains.default_for(arm)``). Units: every ``*_alpha`` and the task weights
+    ``hybrid_position`` (gamma_6) and ``hybrid_orientation`` (gamma_4) are dimensionless
+    fractions per step. The joint-limit weights ``position_gamma`` (gamma_2),
+    ``orientation_gamma`` (gamma_3) and ``hybrid_gamma`` (gamma_5) multiply grad H, which is
+    in 1/m, so they are in m^2 and must be <= 0 (descend H). Switch distances are in m
+    (position, hybrid) or rad (orientation). ``schedule`` is "step" (eq. 23-25) or
+    "smooth" (gamma * e^2 / (e^2 + d^2), the default). ``axis_mask`` selects the controlled
+    orientation axes (x, y, z) of the base frame; the paper controls x and z.
+    ``max_step`` (m) caps the task part of one increment (the joint-limit part at half).
+    """
+
+    def __new__(
+        cls,
+        *,
+        conventional_alpha: float = ...,
+        position_alpha: float = ...,
+        position_gamma: float = ...,
+        position_switch: float = ...,
+        orientation_alpha: float = ...,
+        orientation_gamma: float = ...,
+        orientation_switch: float = ...,
+        hybrid_alpha: float = ...,
+        hybrid_position: float = ...,
+        hybrid_orientation: float = ...,
+        hybrid_gamma: float = ...,
+        hybrid_switch: float = ...,
+        schedule: str = ...,
+        axis_mask: tuple[bool, bool, bool] | list[bool] = ...,
+        damping: float = ...,
+        singular_threshold: float = ...,
+        limit_margin: float = ...,
+        max_step: float = ...,
+    ) -> Gains: ...
+    @staticmethod
+    def paper() -> Gains:
+        """The paper's printed gains, eq. (23)-(25), read in the units above."""
+    @staticmethod
+    def default_for(arm: SoftArm) -> Gains:
+        """Gains that converge for ``arm`` (the blackberry-tuned preset)."""
+    def replace(self, **changes: object) -> Gains:
+        """A copy with some fields changed (same keywords as the constructor)."""
+    def as_dict(self) -> dict[str, object]: ...
+    @property
+    def conventional_alpha(self) -> float: ...
+    @property
+    def position_alpha(self) -> float: ...
+    @property
+    def position_gamma(self) -> float: ...
+    @property
+    def position_switch(self) -> float: ...
+    @property
+    def orientation_alpha(self) -> float: ...
+    @property
+    def orientation_gamma(self) -> float: ...
+    @property
+    def orientation_switch(self) -> float: ...
+    @property
+    def hybrid_alpha(self) -> float: ...
+    @property
+    def hybrid_position(self) -> float: ...
+    @property
+    def hybrid_orientation(self) -> float: ...
+    @property
+    def hybrid_gamma(self) -> float: ...
+    @property
+    def hybrid_switch(self) -> float: ...
+    @property
+    def schedule(self) -> str: ...
+    @property
+    def axis_mask(self) -> tuple[bool, bool, bool]: ...
+    @property
+    def damping(self) -> float: ...
+    @property
+    def singular_threshold(self) -> float: ...
+    @property
+    def limit_margin(self) -> float: ...
+    @property
+    def max_step(self) -> float: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+
+@final
+class StepResult:
+    """What ``Resolver.step`` returns: the next command and what happened.
+
+    A small object rather than a bare array so that saturation and the errors at the
+    input state come with the command; ``unclamped`` is what an unconstrained controller
+    would send (used to count infeasible commands).
+    """
+
+    @property
+    def q(self) -> _F64:
+        """The next command (n,), always inside [lower, upper]."""
+    @property
+    def unclamped(self) -> _F64:
+        """q + dq before any clamping (n,)."""
+    @property
+    def saturated(self) -> bool:
+        """True when a coordinate had to be held at a limit."""
+    @property
+    def position_error(self) -> float:
+        """||e_p|| (m) at the input state."""
+    @property
+    def orientation_error(self) -> float:
+        """Masked ||e_zeta|| (rad) at the input state; 0 for a point target."""
+
+@final
+class Solution:
+    """What ``Resolver.solve`` returns (read-only)."""
+
+    @property
+    def q(self) -> _F64:
+        """The best configuration found (n,), inside the limits."""
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def position_error(self) -> float:
+        """||e_p|| at q (m)."""
+    @property
+    def orientation_error(self) -> float:
+        """Masked ||e_zeta|| at q (rad)."""
+
+@final
+class Resolver:
+    """Gain-scheduled task-priority resolver for a :class:`SoftArm`.
+
+    ``mode``: "conventional" (eq. 7; full Jacobian for a pose target, position Jacobian
+    for a point), "position" / "orientation" (eq. 13, over joint-limit avoidance) or
+    "hybrid" (eq. 20). ``gains=None`` uses ``Gains.default_for(arm)``.
+    """
+
+    def __new__(
+        cls, arm: SoftArm, mode: str = "hybrid", gains: Gains | None = None
+    ) -> Resolver: ...
+    @property
+    def mode(self) -> str: ...
+    @property
+    def gains(self) -> Gains: ...
+    @property
+    def arm(self) -> SoftArm: ...
+    def step(
+        self, q: _ArrayLike, target: _ArrayLike, current: _ArrayLike | None = None
+    ) -> StepResult:
+        """One step from ``q`` towards ``target`` ((4, 4) pose, or (3,) point in
+        "position"/"conventional" mode); ``current`` is the measured pose (closed loop)
+        or None (the model's forward kinematics)."""
+    def solve(
+        self,
+        q0: _ArrayLike,
+        target: _ArrayLike,
+        max_steps: int = 1000,
+        position_tolerance: float = 0.0001,
+        orientation_tolerance: float = ...,
+    ) -> Solution:
+        """Steps on the model until the controlled errors are within tolerance (m, rad;
+        default 0.1 mm and 0.1 deg) or ``max_steps``; an unreachable target returns
+        ``converged=False`` with the best error. Releases the GIL."""

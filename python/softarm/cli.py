@@ -16,6 +16,7 @@ from softarm.errors import SoftarmError
 COMMANDS: dict[str, str] = {
     "demo": "softarm.commands.demo",
     "harvest": "softarm.commands.harvest",
+    "experiment": "softarm.commands.experiment",
 }
 
 

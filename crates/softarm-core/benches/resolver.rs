@@ -17,6 +17,16 @@ fn bench_steps(c: &mut Criterion) {
         Ok(t) => Target::Pose(t),
         Err(e) => panic!("{e}"),
     };
+    // A mid-range state: no coordinate reaches a limit (the usual step).
+    let mid = [
+        0.016, 0.012, 0.020, 0.018, 0.015, 0.014, 0.017, 0.019, 0.013,
+    ];
+    let near = match arm.forward(&[
+        0.017, 0.013, 0.019, 0.019, 0.014, 0.015, 0.016, 0.020, 0.012,
+    ]) {
+        Ok(t) => Target::Pose(t),
+        Err(e) => panic!("{e}"),
+    };
     for mode in [Mode::Hybrid, Mode::Position, Mode::Orientation] {
         let Ok(res) = Resolver::new(arm.clone(), mode, Gains::blackberry()) else {
             panic!("gains")
@@ -24,6 +34,19 @@ fn bench_steps(c: &mut Criterion) {
         let mut ws = res.workspace();
         let mut out = [0.0; 9];
         c.bench_function(&format!("resolver/{}_step", mode.name()), |b| {
+            b.iter(|| res.step_into(&mut ws, black_box(&mid), black_box(&near), None, &mut out))
+        });
+    }
+    // Next to the limits with a far target: coordinates saturate and the step is
+    // recomputed without them (saturation in the null space).
+    {
+        let mode = Mode::Hybrid;
+        let Ok(res) = Resolver::new(arm.clone(), mode, Gains::blackberry()) else {
+            panic!("gains")
+        };
+        let mut ws = res.workspace();
+        let mut out = [0.0; 9];
+        c.bench_function(&format!("resolver/{}_step_saturating", mode.name()), |b| {
             b.iter(|| res.step_into(&mut ws, black_box(&q), black_box(&target), None, &mut out))
         });
     }
@@ -31,7 +54,7 @@ fn bench_steps(c: &mut Criterion) {
         panic!("gains")
     };
     c.bench_function("resolver/hybrid_step_allocating", |b| {
-        b.iter(|| res.step(black_box(&q), black_box(&target), None))
+        b.iter(|| res.step(black_box(&mid), black_box(&near), None))
     });
 }
 

@@ -15,7 +15,7 @@
 //! `f2 = (1 − cos t)/t²` (see [`crate::math::ArcFunctions`]). The straight arc is then an
 //! ordinary point: no perturbation, no special case, exact limits.
 
-use crate::math::{ArcFunctions, Frame, Mat3, Vec3};
+use crate::math::{f1_f2, ArcFunctions, Frame, Mat3, Vec3};
 
 /// Arc parameters in the smooth parametrisation: length and bending vector.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,10 +74,9 @@ impl ArcParams {
     /// Position of the point at fraction `s` (planning paper eq. 5, smooth form).
     #[inline]
     pub fn point(&self, s: f64) -> Vec3 {
-        let x = s * s * (self.ux * self.ux + self.uy * self.uy);
-        let f = ArcFunctions::at(x);
+        let (f1, f2) = f1_f2(s * s * (self.ux * self.ux + self.uy * self.uy));
         let ls = self.length * s;
-        Vec3::new(ls * s * f.f2 * self.ux, ls * s * f.f2 * self.uy, ls * f.f1)
+        Vec3::new(ls * s * f2 * self.ux, ls * s * f2 * self.uy, ls * f1)
     }
 
     /// Position at fraction `s` with its derivatives with respect to (L, ux, uy) and s.
@@ -121,19 +120,12 @@ impl ArcParams {
     #[inline]
     pub fn frame(&self, s: f64) -> Frame {
         let (wx, wy) = (-self.uy * s, self.ux * s);
-        let f = ArcFunctions::at(wx * wx + wy * wy);
-        Frame {
-            rot: rodrigues(wx, wy, f.f1, f.f2),
-            pos: self.position_from(s, wx, wy, &f),
-        }
-    }
-
-    /// Position at fraction `s` given ω = (wx, wy, 0) = s (−uy, ux, 0) and the functions
-    /// at |ω|² (shared with the rotation to evaluate them once).
-    #[inline]
-    fn position_from(&self, s: f64, wx: f64, wy: f64, f: &ArcFunctions) -> Vec3 {
+        let (f1, f2) = f1_f2(wx * wx + wy * wy);
         let ls = self.length * s;
-        Vec3::new(ls * f.f2 * wy, -ls * f.f2 * wx, ls * f.f1)
+        Frame {
+            rot: rodrigues(wx, wy, f1, f2),
+            pos: Vec3::new(ls * f2 * wy, -ls * f2 * wx, ls * f1),
+        }
     }
 
     /// Frame at fraction `s`, plus the derivatives of the frame with respect to

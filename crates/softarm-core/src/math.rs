@@ -90,6 +90,26 @@ pub struct ArcFunctions {
     pub g2: f64,
 }
 
+/// `(f1, f2)` alone at `x = t²`: all that a pose needs (see [`ArcFunctions`]).
+#[inline]
+pub fn f1_f2(x: f64) -> (f64, f64) {
+    if x < SERIES_BELOW {
+        let f1 = 1.0
+            + x * (-1.0 / 6.0
+                + x * (1.0 / 120.0
+                    + x * (-1.0 / 5040.0 + x * (1.0 / 362_880.0 - x / 39_916_800.0))));
+        let f2 = 0.5
+            + x * (-1.0 / 24.0
+                + x * (1.0 / 720.0
+                    + x * (-1.0 / 40_320.0 + x * (1.0 / 3_628_800.0 - x / 479_001_600.0))));
+        (f1, f2)
+    } else {
+        let t = x.sqrt();
+        let (s, c) = t.sin_cos();
+        (s / t, (1.0 - c) / x)
+    }
+}
+
 impl ArcFunctions {
     /// Evaluates all functions at `x = t² ≥ 0`. Exact limits at `x = 0`, no NaN.
     #[inline]
@@ -97,14 +117,7 @@ impl ArcFunctions {
         if x < SERIES_BELOW {
             // Horner forms of the Maclaurin series in x; at x < 0.25 the first omitted
             // term is below 1e-17 relative.
-            let f1 = 1.0
-                + x * (-1.0 / 6.0
-                    + x * (1.0 / 120.0
-                        + x * (-1.0 / 5040.0 + x * (1.0 / 362_880.0 - x / 39_916_800.0))));
-            let f2 = 0.5
-                + x * (-1.0 / 24.0
-                    + x * (1.0 / 720.0
-                        + x * (-1.0 / 40_320.0 + x * (1.0 / 3_628_800.0 - x / 479_001_600.0))));
+            let (f1, f2) = f1_f2(x);
             let f3 = 1.0 / 6.0
                 + x * (-1.0 / 120.0
                     + x * (1.0 / 5040.0

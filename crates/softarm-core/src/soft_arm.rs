@@ -110,6 +110,11 @@ impl SoftArm {
         if sections.is_empty() {
             return Err(Error::shape("sections", "at least one section", "none"));
         }
+        Ok(SoftArm::from_sections(sections))
+    }
+
+    /// Builds the cached per-section data; `sections` is non-empty.
+    fn from_sections(sections: Vec<Section>) -> Self {
         let d_arc = sections
             .iter()
             .map(|s| arc_params_jacobian(s.radius))
@@ -120,13 +125,13 @@ impl SoftArm {
             .collect();
         let lower = sections.iter().flat_map(|s| [s.lower; 3]).collect();
         let upper = sections.iter().flat_map(|s| [s.upper; 3]).collect();
-        Ok(SoftArm {
+        SoftArm {
             sections,
             d_arc,
             twist_cs,
             lower,
             upper,
-        })
+        }
     }
 
     /// The blackberry-harvesting arm of the redundancy paper, with the dimensions the
@@ -165,11 +170,7 @@ impl SoftArm {
                 twist: 0.0,
             },
         ];
-        match SoftArm::new(sections) {
-            Ok(arm) => arm,
-            // The list above is non-empty, so `new` cannot fail.
-            Err(_) => unreachable!("blackberry arm has three sections"),
-        }
+        SoftArm::from_sections(sections)
     }
 
     /// The sections, proximal first.

@@ -64,15 +64,15 @@ pub fn vector(obj: &Bound<'_, PyAny>, arg: &str, len: usize) -> PyResult<Vec<f64
     Ok(ro.as_slice()?.to_vec())
 }
 
-/// Reads an array of the given shape (`None` = any extent) as a flat row-major Vec,
-/// returning it with its actual shape.
-pub fn array(
-    obj: &Bound<'_, PyAny>,
+/// A float64, C-contiguous array of the given shape (`None` = any extent), without
+/// copying when `obj` already is one.
+pub fn array_view<'py>(
+    obj: &Bound<'py, PyAny>,
     arg: &str,
     shape: &[Option<usize>],
-) -> PyResult<(Vec<f64>, Vec<usize>)> {
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = as_array(obj, arg)?;
-    let actual = a.shape().to_vec();
+    let actual = a.shape();
     let ok = actual.len() == shape.len()
         && actual
             .iter()
@@ -86,11 +86,22 @@ pub fn array(
         return Err(ShapeError::new_err(format!(
             "{arg}: expected shape ({}), got {}",
             want.join(", "),
-            shape_str(&actual)
+            shape_str(actual)
         )));
     }
+    Ok(a)
+}
+
+/// Reads an array of the given shape (`None` = any extent) as a flat row-major Vec,
+/// returning it with its actual shape.
+pub fn array(
+    obj: &Bound<'_, PyAny>,
+    arg: &str,
+    shape: &[Option<usize>],
+) -> PyResult<(Vec<f64>, Vec<usize>)> {
+    let a = array_view(obj, arg, shape)?;
     let ro = a.readonly();
-    Ok((ro.as_slice()?.to_vec(), actual))
+    Ok((ro.as_slice()?.to_vec(), a.shape().to_vec()))
 }
 
 /// A 4×4 matrix as a new (4, 4) float64 array.

@@ -1,14 +1,14 @@
 //! `SoftArm`, `Section` and `ArcChain` for Python. Both arm classes get the same
 //! kinematic methods from one macro, so the two can never drift apart.
 
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use softarm_core::chain::{forward_jacobian_into, forward_unchecked, SectionModel};
 use softarm_core::{self as core, Kinematics};
 
 use crate::convert::{
-    array, dmatrix_out, mat4_out, matrix3x_out, points_out, vec3_out, vector, write_dmatrix,
-    write_mat4,
+    array, array_view, dmatrix_out, mat4_out, matrix3x_out, points_out, vec3_out, vector,
+    write_dmatrix, write_mat4,
 };
 use crate::errors::{IntoPyResult, OutOfRangeError};
 
@@ -26,12 +26,13 @@ fn section_index<M: SectionModel>(model: &M, section: i64) -> PyResult<usize> {
         })
 }
 
-/// Reads an (N, n) batch of configurations, checking every value is finite.
-fn batch_input<M: SectionModel>(model: &M, qs: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, usize)> {
-    let n = model.n_dofs();
-    let (flat, shape) = array(qs, "qs", &[None, Some(n)])?;
-    core::error::check_finite("qs", &flat).py()?;
-    Ok((flat, shape[0]))
+/// An (N, n) batch of configurations as a C-contiguous float64 array (no copy when it
+/// already is one).
+fn batch_input<'py, M: SectionModel>(
+    model: &M,
+    qs: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    array_view(qs, "qs", &[None, Some(model.n_dofs())])
 }
 
 macro_rules! kinematic_methods {
@@ -131,8 +132,12 @@ macro_rules! kinematic_methods {
 
             /// Poses of a batch of configurations: (N, n) → (N, 4, 4). Releases the GIL.
             fn forward_batch<'py>(&self, py: Python<'py>, qs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-                let (flat, rows) = batch_input(&self.inner, qs)?;
+                let input = batch_input(&self.inner, qs)?;
+                let ro = input.readonly();
+                let flat = ro.as_slice()?;
+                core::error::check_finite("qs", flat).py()?;
                 let n = self.inner.n_dofs();
+                let rows = flat.len() / n;
                 let out = PyArray3::<f64>::zeros(py, [rows, 4, 4], false);
                 {
                     let mut rw = out.readwrite();
@@ -149,8 +154,12 @@ macro_rules! kinematic_methods {
 
             /// Jacobians of a batch of configurations: (N, n) → (N, 6, n). Releases the GIL.
             fn jacobian_batch<'py>(&self, py: Python<'py>, qs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-                let (flat, rows) = batch_input(&self.inner, qs)?;
+                let input = batch_input(&self.inner, qs)?;
+                let ro = input.readonly();
+                let flat = ro.as_slice()?;
+                core::error::check_finite("qs", flat).py()?;
                 let n = self.inner.n_dofs();
+                let rows = flat.len() / n;
                 let out = PyArray3::<f64>::zeros(py, [rows, 6, n], false);
                 {
                     let mut rw = out.readwrite();

@@ -102,7 +102,7 @@ def closed_loop(
     q = np.asarray(q0, dtype=np.float64).copy()
     measured = plant.reset(q)
     trace = Trace()
-    for k in range(int(round(duration / period))):
+    for k in range(round(duration / period)):
         r = resolver.step(q, pose_target, measured)
         command = r.q if constrained else r.unclamped
         trace.saturated += int(r.saturated)

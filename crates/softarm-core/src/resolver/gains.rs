@@ -228,7 +228,7 @@ impl Gains {
                 "must be > 0 (∇H is infinite at a limit)",
             ));
         }
-        if !(self.max_step > 0.0) {
+        if self.max_step.is_nan() || self.max_step <= 0.0 {
             return Err(Error::parameter("max_step", self.max_step, "must be > 0"));
         }
         Ok(())

@@ -60,7 +60,11 @@ mod tests {
             p[k] += h;
             m[k] -= h;
             let fd = (cost(&p, &lo, &hi) - cost(&m, &lo, &hi)) / (2.0 * h);
-            assert!((g[k] - fd).abs() <= 1e-5 * fd.abs().max(1.0), "{k}: {} {fd}", g[k]);
+            assert!(
+                (g[k] - fd).abs() <= 1e-5 * fd.abs().max(1.0),
+                "{k}: {} {fd}",
+                g[k]
+            );
         }
     }
 

@@ -65,7 +65,16 @@ pub fn normal_inverse3(gram: &Mat3, active: [bool; 3], threshold: f64, damping: 
             g[(i, i)] = big;
         }
     }
-    let lambda2 = damping_squared(min_eigenvalue_sym3(&g), threshold, damping);
+    // For a positive definite 3×3 matrix λ_min ≥ det / (λ₂λ₃) ≥ 4·det / trace²: when that
+    // bound already clears the threshold the damping is zero and the eigenvalue is not
+    // needed (the common, well-conditioned case).
+    let tr = g.trace();
+    let bound = 4.0 * g.determinant() / (tr * tr);
+    let lambda2 = if tr > 0.0 && bound >= threshold * threshold {
+        0.0
+    } else {
+        damping_squared(min_eigenvalue_sym3(&g), threshold, damping)
+    };
     for i in 0..3 {
         if active[i] {
             g[(i, i)] += lambda2;
@@ -124,9 +133,8 @@ mod tests {
 
     #[test]
     fn closed_form_eigenvalue_matches_nalgebra() {
-        let m = nalgebra::Matrix3x4::new(
-            1.0, 2.0, 0.5, -1.0, 0.3, -0.7, 2.0, 0.1, 0.0, 1.0, 1.0, 3.0,
-        );
+        let m =
+            nalgebra::Matrix3x4::new(1.0, 2.0, 0.5, -1.0, 0.3, -0.7, 2.0, 0.1, 0.0, 1.0, 1.0, 3.0);
         let g = m * m.transpose();
         let e = g.symmetric_eigenvalues();
         assert_relative_eq!(min_eigenvalue_sym3(&g), e.min(), epsilon = 1e-12);
@@ -138,7 +146,18 @@ mod tests {
     fn fast_and_svd_paths_agree_also_when_damped() {
         for scale in [1.0, 1e-3] {
             let j = nalgebra::Matrix3x4::new(
-                1.0, 2.0, 0.5, -1.0, 0.3, -0.7, 2.0, 0.1, 0.0, 1.0, 1.0, 3.0 * scale,
+                1.0,
+                2.0,
+                0.5,
+                -1.0,
+                0.3,
+                -0.7,
+                2.0,
+                0.1,
+                0.0,
+                1.0,
+                1.0,
+                3.0 * scale,
             );
             let j = j.fixed_rows::<3>(0) * 1.0;
             let p = normal_inverse3(&(j * j.transpose()), [true; 3], 0.5, 0.1);
@@ -165,7 +184,9 @@ mod tests {
     fn inactive_rows_are_ignored() {
         let g = Mat3::new(2.0, 0.0, 0.3, 0.0, 0.0, 0.0, 0.3, 0.0, 1.0);
         let p = normal_inverse3(&g, [true, false, true], 0.01, 0.0);
-        let sub = nalgebra::Matrix2::new(2.0, 0.3, 0.3, 1.0).try_inverse().unwrap();
+        let sub = nalgebra::Matrix2::new(2.0, 0.3, 0.3, 1.0)
+            .try_inverse()
+            .unwrap();
         assert_relative_eq!(p[(0, 0)], sub[(0, 0)], epsilon = 1e-14);
         assert_relative_eq!(p[(2, 0)], sub[(1, 0)], epsilon = 1e-14);
         assert_eq!(p[(1, 1)], 0.0);

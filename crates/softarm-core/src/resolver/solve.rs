@@ -65,8 +65,16 @@ impl<K: Kinematics> Resolver<K> {
             (Mode::Hybrid | Mode::Conventional, _) => (true, true),
         };
         let score = |ep: f64, eo: f64| {
-            let a = if use_p { ep / opts.position_tolerance } else { 0.0 };
-            let b = if use_o { eo / opts.orientation_tolerance } else { 0.0 };
+            let a = if use_p {
+                ep / opts.position_tolerance
+            } else {
+                0.0
+            };
+            let b = if use_o {
+                eo / opts.orientation_tolerance
+            } else {
+                0.0
+            };
             a.max(b)
         };
         let mut ws = self.workspace();
