@@ -14,13 +14,21 @@ from types import ModuleType
 
 from softarm._core import (
     ArcChain,
+    Closest,
     Gains,
+    Plan,
+    PointCloud,
+    PolynomialCurve,
+    PotentialFieldPlanner,
     Resolver,
     Section,
+    Segment,
     SoftArm,
     Solution,
     StepResult,
+    TriangleMesh,
     __version__,
+    closest,
 )
 from softarm.errors import (
     ConfigError,
@@ -40,6 +48,7 @@ from softarm.errors import (
 
 __all__ = [
     "ArcChain",
+    "Closest",
     "ConfigError",
     "Gains",
     "HardwareError",
@@ -48,23 +57,30 @@ __all__ = [
     "NonFiniteError",
     "OutOfRangeError",
     "ParameterError",
+    "Plan",
+    "PointCloud",
+    "PolynomialCurve",
     "PoseError",
+    "PotentialFieldPlanner",
     "Resolver",
     "SafetyError",
     "Section",
+    "Segment",
     "ShapeError",
     "SoftArm",
     "SoftarmError",
     "Solution",
     "StepResult",
+    "TriangleMesh",
     "UnreachableError",
     "VisionError",
     "__version__",
+    "closest",
 ]
 
 #: Subpackages imported on first attribute access: vision pulls in OpenCV, and the
 #: kinematics should not pay for that.
-_LAZY_SUBPACKAGES = frozenset({"vision", "sim", "hardware", "harvest", "config"})
+_LAZY_SUBPACKAGES = frozenset({"vision", "sim", "hardware", "harvest", "config", "planning"})
 
 
 def __getattr__(name: str) -> ModuleType:

@@ -27,17 +27,23 @@
 pub mod arc;
 pub mod arc_chain;
 pub mod chain;
+pub mod distance;
 pub mod error;
 pub mod kinematics;
 pub mod math;
+pub mod planner;
 pub mod pneumatic;
 pub mod soft_arm;
 
 pub use arc::ArcParams;
 pub use arc_chain::ArcChain;
+pub use distance::{
+    closest, Closest, Obstacle, PointCloud, PolynomialCurve, Segment, TriangleMesh,
+};
 pub use error::{Error, Result};
 pub use kinematics::Kinematics;
 pub use math::{Frame, Mat3, Mat4, Vec3};
+pub use planner::{Plan, PlannerOptions, PotentialFieldPlanner, Termination};
 pub use soft_arm::{Section, SoftArm};
 pub mod resolver;
 pub use resolver::{Gains, Mode, Resolver, Schedule, Solution, SolveOptions, Target};

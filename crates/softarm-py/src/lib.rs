@@ -3,9 +3,11 @@
 //! around batch work; all math lives in softarm-core.
 
 mod convert;
+mod distance;
 mod errors;
 mod kinematics;
 mod resolver;
+mod planner;
 
 use pyo3::prelude::*;
 
@@ -15,5 +17,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     kinematics::register(m)?;
     resolver::register(m)?;
+    distance::register(m)?;
+    planner::register(m)?;
     Ok(())
 }

@@ -1,0 +1,248 @@
+//! Obstacles of every kind, and the closest pair between an arm and one obstacle.
+
+use super::arc_cloud::PointCloud;
+use super::arc_curve::{closest_arc_curve, closest_arc_curve_within};
+use super::arc_mesh::TriangleMesh;
+use super::arc_point::PlacedArc;
+use super::polynomial::{PolynomialCurve, Segment};
+use crate::chain::{check_q, section_arc_unchecked};
+use crate::error::Result;
+use crate::kinematics::Kinematics;
+use crate::math::Vec3;
+
+/// An obstacle: a curve (eq. 10), a segment, a point, a point cloud or a triangle mesh.
+#[derive(Debug, Clone)]
+pub enum Obstacle {
+    /// A parametric polynomial curve.
+    Curve(PolynomialCurve),
+    /// A line segment.
+    Segment(Segment),
+    /// A single point.
+    Point(Vec3),
+    /// A point cloud (parry BVH).
+    Cloud(PointCloud),
+    /// A triangle mesh (parry TriMesh, chord approximation of the arc).
+    Mesh(TriangleMesh),
+}
+
+impl From<PolynomialCurve> for Obstacle {
+    fn from(c: PolynomialCurve) -> Self {
+        Obstacle::Curve(c)
+    }
+}
+impl From<Segment> for Obstacle {
+    fn from(s: Segment) -> Self {
+        Obstacle::Segment(s)
+    }
+}
+impl From<PointCloud> for Obstacle {
+    fn from(c: PointCloud) -> Self {
+        Obstacle::Cloud(c)
+    }
+}
+impl From<TriangleMesh> for Obstacle {
+    fn from(m: TriangleMesh) -> Self {
+        Obstacle::Mesh(m)
+    }
+}
+
+/// The closest pair between an arm and an obstacle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    /// Distance (m); 0 when they touch or cross. For a mesh, a conservative lower bound
+    /// (see [`super::arc_mesh`]).
+    pub distance: f64,
+    /// Section holding the arm point (0 = proximal).
+    pub section: usize,
+    /// Fraction along that section.
+    pub s: f64,
+    /// Obstacle parameter: `u` of a curve, the fraction along a segment, the index of a
+    /// cloud's point or of a mesh's triangle, 0 for a point.
+    pub u: f64,
+    /// Closest arm point (base frame).
+    pub arm_point: Vec3,
+    /// Closest obstacle point (base frame).
+    pub obstacle_point: Vec3,
+}
+
+/// Every section's arc at configuration `q` (which must already be checked).
+pub fn placed_arcs<K: Kinematics + ?Sized>(model: &K, q: &[f64]) -> Vec<PlacedArc> {
+    (0..model.n_sections())
+        .map(|i| {
+            let (frame, params) = section_arc_unchecked(model, q, i);
+            PlacedArc::new(frame, params)
+        })
+        .collect()
+}
+
+/// Closest pair between one arc (section `section`) and `obstacle`.
+pub fn closest_to_arc(arc: &PlacedArc, section: usize, obstacle: &Obstacle) -> Closest {
+    match obstacle {
+        Obstacle::Curve(c) => {
+            let h = closest_arc_curve(arc, c);
+            Closest {
+                distance: h.distance,
+                section,
+                s: h.s,
+                u: h.u,
+                arm_point: h.arc_point,
+                obstacle_point: h.curve_point,
+            }
+        }
+        Obstacle::Segment(seg) => {
+            let h = closest_arc_curve(arc, seg.as_curve());
+            Closest {
+                distance: h.distance,
+                section,
+                s: h.s,
+                u: h.u,
+                arm_point: h.arc_point,
+                obstacle_point: h.curve_point,
+            }
+        }
+        Obstacle::Point(p) => {
+            let (s, a, d) = arc.closest_to_point(p);
+            Closest {
+                distance: d,
+                section,
+                s,
+                u: 0.0,
+                arm_point: a,
+                obstacle_point: *p,
+            }
+        }
+        Obstacle::Cloud(cloud) => {
+            let (d, s, i) = cloud
+                .closest_to_arc(arc, f64::MAX)
+                .unwrap_or_else(|| cloud.closest_to_arc_brute_force(arc));
+            Closest {
+                distance: d,
+                section,
+                s,
+                u: i as f64,
+                arm_point: arc.point(s),
+                obstacle_point: cloud.points()[i],
+            }
+        }
+        Obstacle::Mesh(mesh) => {
+            let h = mesh.closest_to_arc(arc);
+            Closest {
+                distance: h.distance,
+                section,
+                s: h.s,
+                u: h.triangle as f64,
+                arm_point: h.arc_point,
+                obstacle_point: h.mesh_point,
+            }
+        }
+    }
+}
+
+/// Closest pair between all `arcs` and `obstacle`. For a cloud, later sections reuse the
+/// best distance so far to prune the hierarchy.
+pub fn closest_to_arcs(arcs: &[PlacedArc], obstacle: &Obstacle) -> Closest {
+    let mut best: Option<Closest> = None;
+    for (i, arc) in arcs.iter().enumerate() {
+        let hit = match (obstacle, &best) {
+            (Obstacle::Cloud(cloud), Some(b)) => match cloud.closest_to_arc(arc, b.distance) {
+                Some((d, s, k)) => Closest {
+                    distance: d,
+                    section: i,
+                    s,
+                    u: k as f64,
+                    arm_point: arc.point(s),
+                    obstacle_point: cloud.points()[k],
+                },
+                None => continue,
+            },
+            _ => closest_to_arc(arc, i, obstacle),
+        };
+        if best.is_none_or(|b| hit.distance < b.distance) {
+            best = Some(hit);
+        }
+    }
+    best.unwrap_or(Closest {
+        distance: f64::INFINITY,
+        section: 0,
+        s: 0.0,
+        u: 0.0,
+        arm_point: Vec3::zeros(),
+        obstacle_point: Vec3::zeros(),
+    })
+}
+
+/// [`closest_to_arcs`] when the distance is below `cutoff`, else `None`. Exact; curves and
+/// segments skip far arcs by bounding spheres and prune against the best so far.
+pub fn closest_to_arcs_within(
+    arcs: &[PlacedArc],
+    obstacle: &Obstacle,
+    cutoff: f64,
+) -> Option<Closest> {
+    let curve = match obstacle {
+        Obstacle::Curve(c) => c,
+        Obstacle::Segment(s) => s.as_curve(),
+        Obstacle::Cloud(cloud) => {
+            // The hierarchy prunes against the cutoff, then against the best so far.
+            let mut best: Option<Closest> = None;
+            let mut limit = cutoff;
+            for (i, arc) in arcs.iter().enumerate() {
+                if let Some((d, s, k)) = cloud.closest_to_arc(arc, limit) {
+                    limit = d;
+                    best = Some(Closest {
+                        distance: d,
+                        section: i,
+                        s,
+                        u: k as f64,
+                        arm_point: arc.point(s),
+                        obstacle_point: cloud.points()[k],
+                    });
+                }
+            }
+            return best;
+        }
+        _ => {
+            let c = closest_to_arcs(arcs, obstacle);
+            return (c.distance < cutoff).then_some(c);
+        }
+    };
+    let mut best: Option<Closest> = None;
+    let mut limit = cutoff;
+    for (i, arc) in arcs.iter().enumerate() {
+        if let Some(h) = closest_arc_curve_within(arc, curve, limit) {
+            limit = h.distance;
+            best = Some(Closest {
+                distance: h.distance,
+                section: i,
+                s: h.s,
+                u: h.u,
+                arm_point: h.arc_point,
+                obstacle_point: h.curve_point,
+            });
+        }
+    }
+    best
+}
+
+/// The closest pair between the arm `model` at configuration `q` and `obstacle`, over
+/// every section (planning paper eq. 12–18: the global minimum over sections, `s` and `u`).
+///
+/// # Errors
+/// [`crate::Error::Shape`] / [`crate::Error::NonFinite`] for a bad `q`.
+///
+/// # Example
+/// ```
+/// use softarm_core::{ArcChain, distance::{closest, Obstacle, Segment}, Vec3};
+/// let chain = ArcChain::new(&[1.0, 1.0, 1.0]).unwrap();
+/// let q = chain.straight();
+/// let seg = Segment::new(Vec3::new(0.5, -1.0, 1.5), Vec3::new(0.5, 1.0, 1.5)).unwrap();
+/// let c = closest(&chain, &q, &Obstacle::Segment(seg)).unwrap();
+/// assert!((c.distance - 0.5).abs() < 1e-12 && c.section == 1);
+/// ```
+pub fn closest<K: Kinematics + ?Sized>(
+    model: &K,
+    q: &[f64],
+    obstacle: &Obstacle,
+) -> Result<Closest> {
+    check_q(model, q)?;
+    Ok(closest_to_arcs(&placed_arcs(model, q), obstacle))
+}

@@ -1,0 +1,385 @@
+//! Obstacles (`PolynomialCurve`, `Segment`, `PointCloud`, `TriangleMesh`), `Closest` and
+//! `closest()` for Python. Each obstacle class holds a core `Obstacle`, so queries borrow
+//! it without copying (a cloud's BVH is built once, in the constructor).
+
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use softarm_core::chain::SectionModel;
+use softarm_core::distance::{self as dist, Obstacle};
+use softarm_core::{self as core, Vec3};
+
+use crate::convert::{array, points_out, reshape, vec3_out, vector};
+use crate::errors::{InputError, IntoPyResult};
+use crate::kinematics::{ArcChain, SoftArm};
+
+/// An arm model taken from Python: a `SoftArm` or an `ArcChain`.
+pub enum Model {
+    /// Actuator space.
+    Soft(core::SoftArm),
+    /// Configuration space.
+    Chain(core::ArcChain),
+}
+
+impl Model {
+    /// Reads `obj` (argument `arg`) as an arm model.
+    pub fn from_py(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Self> {
+        if let Ok(a) = obj.cast::<SoftArm>() {
+            return Ok(Model::Soft(a.get().inner.clone()));
+        }
+        if let Ok(c) = obj.cast::<ArcChain>() {
+            return Ok(Model::Chain(c.get().inner.clone()));
+        }
+        Err(InputError::new_err(format!(
+            "{arg}: expected a SoftArm or an ArcChain, got {}",
+            obj.get_type().name()?
+        )))
+    }
+
+    /// Number of coordinates.
+    pub fn n_dofs(&self) -> usize {
+        match self {
+            Model::Soft(m) => m.n_dofs(),
+            Model::Chain(m) => m.n_dofs(),
+        }
+    }
+}
+
+fn vec3_arg(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec3> {
+    let v = vector(obj, arg, 3)?;
+    Ok(Vec3::new(v[0], v[1], v[2]))
+}
+
+fn points_arg(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<Vec3>> {
+    let (flat, _) = array(obj, arg, &[None, Some(3)])?;
+    Ok(flat
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
+}
+
+/// A polynomial space curve F(u) = Σ c_k u^k over [u_min, u_max] (planning paper eq. 10).
+#[pyclass(module = "softarm._core", frozen)]
+pub struct PolynomialCurve {
+    pub(crate) obstacle: Obstacle,
+    curve: dist::PolynomialCurve,
+}
+
+impl PolynomialCurve {
+    fn curve(&self) -> &dist::PolynomialCurve {
+        &self.curve
+    }
+
+    /// Wraps a core curve.
+    pub fn from_core(curve: dist::PolynomialCurve) -> Self {
+        PolynomialCurve {
+            obstacle: Obstacle::Curve(curve.clone()),
+            curve,
+        }
+    }
+}
+
+#[pymethods]
+impl PolynomialCurve {
+    /// `coeffs` (3, d + 1): ascending powers of u, row 0 is x(u); `u_range` (u_min, u_max).
+    #[new]
+    fn new(coeffs: &Bound<'_, PyAny>, u_range: (f64, f64)) -> PyResult<Self> {
+        let (flat, _) = array(coeffs, "coeffs", &[Some(3), None])?;
+        let c = dist::PolynomialCurve::from_rows(&flat, u_range).py()?;
+        Ok(PolynomialCurve {
+            obstacle: Obstacle::Curve(c.clone()),
+            curve: c,
+        })
+    }
+
+    /// Coefficients (3, d + 1), ascending powers.
+    #[getter]
+    fn coeffs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let c = self.curve().coeffs();
+        let m = c.len();
+        let mut flat = vec![0.0; 3 * m];
+        for (k, v) in c.iter().enumerate() {
+            for r in 0..3 {
+                flat[r * m + k] = v[r];
+            }
+        }
+        reshape(py, flat, [3, m])
+    }
+
+    /// (u_min, u_max).
+    #[getter]
+    fn u_range(&self) -> (f64, f64) {
+        self.curve().u_range()
+    }
+
+    /// Polynomial degree.
+    #[getter]
+    fn degree(&self) -> usize {
+        self.curve().degree()
+    }
+
+    /// Points at the parameters `u` (scalar → (3,), array (N,) → (N, 3)).
+    fn __call__<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        if let Ok(v) = u.extract::<f64>() {
+            return Ok(vec3_out(py, &self.curve().eval(v)).into_any());
+        }
+        let (us, _) = array(u, "u", &[None])?;
+        let pts: Vec<Vec3> = us.iter().map(|&v| self.curve().eval(v)).collect();
+        Ok(points_out(py, &pts)?.into_any())
+    }
+
+    /// `n` points evenly spaced in u (the paper's point model of the curve), (n, 3).
+    fn sample<'py>(&self, py: Python<'py>, n: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        points_out(py, &self.curve().sample(n))
+    }
+
+    fn __repr__(&self) -> String {
+        let (a, b) = self.curve().u_range();
+        format!(
+            "PolynomialCurve(degree={}, u_range=({a}, {b}))",
+            self.curve().degree()
+        )
+    }
+}
+
+/// A line segment from `a` to `b`; its parameter u is the fraction from a to b.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct Segment {
+    pub(crate) obstacle: Obstacle,
+    a: Vec3,
+    b: Vec3,
+}
+
+#[pymethods]
+impl Segment {
+    #[new]
+    fn new(a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (a, b) = (vec3_arg(a, "a")?, vec3_arg(b, "b")?);
+        let s = dist::Segment::new(a, b).py()?;
+        Ok(Segment {
+            obstacle: Obstacle::Segment(s),
+            a,
+            b,
+        })
+    }
+
+    /// First end point, (3,).
+    #[getter]
+    fn a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec3_out(py, &self.a)
+    }
+
+    /// Second end point, (3,).
+    #[getter]
+    fn b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec3_out(py, &self.b)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Segment(a={:?}, b={:?})",
+            self.a.as_slice(),
+            self.b.as_slice()
+        )
+    }
+}
+
+/// A point cloud (N, 3) with a bounding-volume hierarchy (parry3d) built once.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct PointCloud {
+    pub(crate) obstacle: Obstacle,
+}
+
+#[pymethods]
+impl PointCloud {
+    #[new]
+    fn new(points: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let pts = points_arg(points, "points")?;
+        Ok(PointCloud {
+            obstacle: Obstacle::Cloud(dist::PointCloud::new(pts).py()?),
+        })
+    }
+
+    /// The points, (N, 3).
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        match &self.obstacle {
+            Obstacle::Cloud(c) => points_out(py, c.points()),
+            _ => points_out(py, &[]),
+        }
+    }
+
+    fn __len__(&self) -> usize {
+        match &self.obstacle {
+            Obstacle::Cloud(c) => c.len(),
+            _ => 0,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!("PointCloud(n={})", self.__len__())
+    }
+}
+
+/// A triangle mesh (parry3d TriMesh); arcs meet it as chords within `tolerance` (m),
+/// and reported distances are conservative by that bound.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct TriangleMesh {
+    pub(crate) obstacle: Obstacle,
+}
+
+#[pymethods]
+impl TriangleMesh {
+    #[new]
+    #[pyo3(signature = (vertices, triangles, tolerance = 1e-4))]
+    fn new(
+        vertices: &Bound<'_, PyAny>,
+        triangles: &Bound<'_, PyAny>,
+        tolerance: f64,
+    ) -> PyResult<Self> {
+        let verts = points_arg(vertices, "vertices")?;
+        let (flat, _) = array(triangles, "triangles", &[None, Some(3)])?;
+        let mut tris = Vec::with_capacity(flat.len() / 3);
+        for c in flat.chunks_exact(3) {
+            let mut t = [0u32; 3];
+            for (k, &v) in c.iter().enumerate() {
+                if !(v >= 0.0 && v.fract() == 0.0 && v < u32::MAX as f64) {
+                    return Err(InputError::new_err(format!(
+                        "triangles: expected non-negative integer vertex indices, got {v}"
+                    )));
+                }
+                t[k] = v as u32;
+            }
+            tris.push(t);
+        }
+        let m = dist::TriangleMesh::new(&verts, &tris, tolerance).py()?;
+        Ok(TriangleMesh {
+            obstacle: Obstacle::Mesh(m),
+        })
+    }
+
+    /// Chord tolerance (m).
+    #[getter]
+    fn tolerance(&self) -> f64 {
+        match &self.obstacle {
+            Obstacle::Mesh(m) => m.tolerance(),
+            _ => 0.0,
+        }
+    }
+}
+
+/// Reads one obstacle: an obstacle object or a point (3,).
+pub fn obstacle_from(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Obstacle> {
+    if let Ok(c) = obj.cast::<PolynomialCurve>() {
+        return Ok(c.get().obstacle.clone());
+    }
+    if let Ok(s) = obj.cast::<Segment>() {
+        return Ok(s.get().obstacle.clone());
+    }
+    if let Ok(c) = obj.cast::<PointCloud>() {
+        return Ok(c.get().obstacle.clone());
+    }
+    if let Ok(m) = obj.cast::<TriangleMesh>() {
+        return Ok(m.get().obstacle.clone());
+    }
+    match vector(obj, arg, 3) {
+        Ok(v) => Ok(Obstacle::Point(Vec3::new(v[0], v[1], v[2]))),
+        Err(_) => Err(InputError::new_err(format!(
+            "{arg}: expected a PolynomialCurve, Segment, PointCloud, TriangleMesh or a point (3,), got {}",
+            obj.get_type().name()?
+        ))),
+    }
+}
+
+/// Applies `f` to the obstacle held by `obj` without copying it (a point is built).
+fn with_obstacle<R>(obj: &Bound<'_, PyAny>, f: impl FnOnce(&Obstacle) -> R) -> PyResult<R> {
+    if let Ok(c) = obj.cast::<PolynomialCurve>() {
+        return Ok(f(&c.get().obstacle));
+    }
+    if let Ok(s) = obj.cast::<Segment>() {
+        return Ok(f(&s.get().obstacle));
+    }
+    if let Ok(c) = obj.cast::<PointCloud>() {
+        return Ok(f(&c.get().obstacle));
+    }
+    if let Ok(m) = obj.cast::<TriangleMesh>() {
+        return Ok(f(&m.get().obstacle));
+    }
+    let ob = obstacle_from(obj, "obstacle")?;
+    Ok(f(&ob))
+}
+
+/// The closest pair between an arm and an obstacle.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct Closest {
+    inner: dist::Closest,
+}
+
+#[pymethods]
+impl Closest {
+    /// Distance (m); 0 when touching or crossing. Conservative for meshes.
+    #[getter]
+    fn distance(&self) -> f64 {
+        self.inner.distance
+    }
+    /// Section of the arm point (0 = proximal).
+    #[getter]
+    fn section(&self) -> usize {
+        self.inner.section
+    }
+    /// Fraction along the section.
+    #[getter]
+    fn s(&self) -> f64 {
+        self.inner.s
+    }
+    /// Obstacle parameter: curve u, segment fraction, cloud point or mesh triangle index.
+    #[getter]
+    fn u(&self) -> f64 {
+        self.inner.u
+    }
+    /// Arm point (3,).
+    #[getter]
+    fn arm_point<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec3_out(py, &self.inner.arm_point)
+    }
+    /// Obstacle point (3,).
+    #[getter]
+    fn obstacle_point<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec3_out(py, &self.inner.obstacle_point)
+    }
+    fn __repr__(&self) -> String {
+        let c = &self.inner;
+        format!(
+            "Closest(distance={}, section={}, s={}, u={})",
+            c.distance, c.section, c.s, c.u
+        )
+    }
+}
+
+/// Closest pair between the arm `arm` (SoftArm or ArcChain) at `q` and `obstacle`
+/// (planning paper eq. 12–18: global over sections, s and u).
+#[pyfunction]
+fn closest(
+    arm: &Bound<'_, PyAny>,
+    q: &Bound<'_, PyAny>,
+    obstacle: &Bound<'_, PyAny>,
+) -> PyResult<Closest> {
+    let model = Model::from_py(arm, "arm")?;
+    let q = vector(q, "q", model.n_dofs())?;
+    let inner = with_obstacle(obstacle, |ob| match &model {
+        Model::Soft(m) => dist::closest(m, &q, ob),
+        Model::Chain(m) => dist::closest(m, &q, ob),
+    })?
+    .py()?;
+    Ok(Closest { inner })
+}
+
+/// Registers the distance classes and `closest`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PolynomialCurve>()?;
+    m.add_class::<Segment>()?;
+    m.add_class::<PointCloud>()?;
+    m.add_class::<TriangleMesh>()?;
+    m.add_class::<Closest>()?;
+    m.add_function(wrap_pyfunction!(closest, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,232 @@
+//! `PotentialFieldPlanner`, `Plan`, `path_clearance` and the paper's scenarios for Python.
+//! `plan()` runs the whole loop in Rust with the GIL released.
+
+use numpy::PyArray2;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use softarm_core::planner::{self as pl, scenarios};
+use softarm_core::{self as core, Vec3};
+
+use crate::convert::{array, points_out, reshape, vec3_out, vector};
+use crate::distance::{obstacle_from, Model, PolynomialCurve};
+use crate::errors::IntoPyResult;
+
+enum Planner {
+    Soft(pl::PotentialFieldPlanner<core::SoftArm>),
+    Chain(pl::PotentialFieldPlanner<core::ArcChain>),
+}
+
+/// Potential-field planner of the planning paper, eq. (9), on a SoftArm or an ArcChain.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct PotentialFieldPlanner {
+    inner: Planner,
+    options: pl::PlannerOptions,
+    n_dofs: usize,
+}
+
+fn obstacles_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<core::Obstacle>> {
+    let mut out = Vec::new();
+    for (k, item) in obj.try_iter()?.enumerate() {
+        out.push(obstacle_from(&item?, &format!("obstacles[{k}]"))?);
+    }
+    Ok(out)
+}
+
+#[pymethods]
+impl PotentialFieldPlanner {
+    #[new]
+    #[pyo3(signature = (
+        arm, *, attraction_gain = 0.5, max_tip_step = 0.15, repulsion_gain = 3e-5,
+        influence_distance = 0.1, max_step_fraction = 0.04, damping = 0.05,
+        goal_tolerance = 0.01, max_iterations = 500, stall_window = 20,
+        stall_tolerance = 1e-3, arm_samples = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        arm: &Bound<'_, PyAny>,
+        attraction_gain: f64,
+        max_tip_step: f64,
+        repulsion_gain: f64,
+        influence_distance: f64,
+        max_step_fraction: f64,
+        damping: f64,
+        goal_tolerance: f64,
+        max_iterations: usize,
+        stall_window: usize,
+        stall_tolerance: f64,
+        arm_samples: Option<usize>,
+    ) -> PyResult<Self> {
+        let options = pl::PlannerOptions {
+            attraction_gain,
+            max_tip_step,
+            repulsion_gain,
+            influence_distance,
+            max_step_fraction,
+            damping,
+            goal_tolerance,
+            max_iterations,
+            stall_window,
+            stall_tolerance,
+            arm_samples,
+        };
+        let model = Model::from_py(arm, "arm")?;
+        let n_dofs = model.n_dofs();
+        let inner = match model {
+            Model::Soft(m) => Planner::Soft(pl::PotentialFieldPlanner::new(m, options).py()?),
+            Model::Chain(m) => Planner::Chain(pl::PotentialFieldPlanner::new(m, options).py()?),
+        };
+        Ok(PotentialFieldPlanner {
+            inner,
+            options,
+            n_dofs,
+        })
+    }
+
+    /// The options as a dict.
+    #[getter]
+    fn options<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let o = &self.options;
+        let d = PyDict::new(py);
+        d.set_item("attraction_gain", o.attraction_gain)?;
+        d.set_item("max_tip_step", o.max_tip_step)?;
+        d.set_item("repulsion_gain", o.repulsion_gain)?;
+        d.set_item("influence_distance", o.influence_distance)?;
+        d.set_item("max_step_fraction", o.max_step_fraction)?;
+        d.set_item("damping", o.damping)?;
+        d.set_item("goal_tolerance", o.goal_tolerance)?;
+        d.set_item("max_iterations", o.max_iterations)?;
+        d.set_item("stall_window", o.stall_window)?;
+        d.set_item("stall_tolerance", o.stall_tolerance)?;
+        d.set_item("arm_samples", o.arm_samples)?;
+        Ok(d)
+    }
+
+    /// Plans from `q0` to the tip position `goal` (3,) among `obstacles` (any mix of
+    /// curves, segments, point clouds, meshes and points). Releases the GIL.
+    #[pyo3(signature = (q0, goal, obstacles = None))]
+    fn plan(
+        &self,
+        py: Python<'_>,
+        q0: &Bound<'_, PyAny>,
+        goal: &Bound<'_, PyAny>,
+        obstacles: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Plan> {
+        let q0 = vector(q0, "q0", self.n_dofs)?;
+        let g = vector(goal, "goal", 3)?;
+        let goal = Vec3::new(g[0], g[1], g[2]);
+        let obs = match obstacles {
+            Some(o) => obstacles_from(o)?,
+            None => Vec::new(),
+        };
+        let plan = py
+            .detach(|| match &self.inner {
+                Planner::Soft(p) => p.plan(&q0, &goal, &obs),
+                Planner::Chain(p) => p.plan(&q0, &goal, &obs),
+            })
+            .py()?;
+        Ok(Plan { inner: plan })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("PotentialFieldPlanner(n_dofs={})", self.n_dofs)
+    }
+}
+
+/// A planned path.
+#[pyclass(module = "softarm._core", frozen)]
+pub struct Plan {
+    inner: pl::Plan,
+}
+
+#[pymethods]
+impl Plan {
+    /// Configurations along the path, (iterations + 1, n), q0 first.
+    #[getter]
+    fn path<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let rows = self.inner.path.len();
+        let n = self.inner.path.first().map_or(0, Vec::len);
+        reshape(py, self.inner.path.concat(), [rows, n])
+    }
+    /// Tip positions along the path, (iterations + 1, 3).
+    #[getter]
+    fn tip_path<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        points_out(py, &self.inner.tip_path)
+    }
+    /// Whether the tip ended within the goal tolerance.
+    #[getter]
+    fn reached(&self) -> bool {
+        self.inner.reached
+    }
+    /// Number of iterations of eq. (9).
+    #[getter]
+    fn iterations(&self) -> usize {
+        self.inner.iterations
+    }
+    /// Smallest exact distance of the whole backbone to any obstacle along the path (m).
+    #[getter]
+    fn min_clearance(&self) -> f64 {
+        self.inner.min_clearance
+    }
+    /// "reached", "stalled" or "iteration_limit".
+    #[getter]
+    fn termination(&self) -> &'static str {
+        self.inner.termination.name()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Plan(reached={}, iterations={}, min_clearance={}, termination={:?})",
+            self.inner.reached,
+            self.inner.iterations,
+            self.inner.min_clearance,
+            self.inner.termination.name()
+        )
+    }
+}
+
+/// Exact clearance of the arm along `path` (N, n) to `obstacles`, also checking
+/// `substeps - 1` interpolated configurations between consecutive rows.
+#[pyfunction]
+#[pyo3(signature = (arm, path, obstacles, substeps = 1))]
+fn path_clearance(
+    py: Python<'_>,
+    arm: &Bound<'_, PyAny>,
+    path: &Bound<'_, PyAny>,
+    obstacles: &Bound<'_, PyAny>,
+    substeps: usize,
+) -> PyResult<f64> {
+    let model = Model::from_py(arm, "arm")?;
+    let n = model.n_dofs();
+    let (flat, _) = array(path, "path", &[None, Some(n)])?;
+    let rows: Vec<Vec<f64>> = flat.chunks_exact(n.max(1)).map(<[f64]>::to_vec).collect();
+    let obs = obstacles_from(obstacles)?;
+    let substeps = substeps.max(1);
+    py.detach(|| match &model {
+        Model::Soft(m) => pl::path_clearance(m, &rows, &obs, substeps),
+        Model::Chain(m) => pl::path_clearance(m, &rows, &obs, substeps),
+    })
+    .py()
+}
+
+/// The planning paper's simulation `name` ("line", "curve", "tree"): (goal (3,), curves).
+#[pyfunction]
+fn paper_scenario<'py>(
+    py: Python<'py>,
+    name: &str,
+) -> PyResult<(Bound<'py, numpy::PyArray1<f64>>, Vec<PolynomialCurve>)> {
+    let sc = scenarios::scenario(name).py()?;
+    let curves = sc
+        .curves
+        .iter()
+        .map(|c| PolynomialCurve::from_core(c.clone()))
+        .collect();
+    Ok((vec3_out(py, &sc.goal), curves))
+}
+
+/// Registers the planner classes and functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PotentialFieldPlanner>()?;
+    m.add_class::<Plan>()?;
+    m.add_function(wrap_pyfunction!(path_clearance, m)?)?;
+    m.add_function(wrap_pyfunction!(paper_scenario, m)?)?;
+    Ok(())
+}
