@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from softarm import SoftArm
+from softarm import PolynomialCurve, SoftArm
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.ik import cone_axes
 from softarm.harvest.targets import align_z, grasp_point, pointing_error, tool_pose
@@ -54,13 +54,17 @@ def test_clearance_is_negative_through_the_arm_and_grows_away_from_it() -> None:
     arm = SoftArm.blackberry()
     q = np.full(9, 0.0167)
     z = arm.forward(q)[2, 3] / 2  # halfway up the straight arm
-    y = np.linspace(-0.1, 0.1, 101)
-    near = Clearance(arm, [np.column_stack([0 * y, y, z + 0 * y])], 0.03)  # through the arm
-    far = Clearance(arm, [np.column_stack([0.2 + 0 * y, y, z + 0 * y])], 0.03)
+    near = Clearance(arm, [_line([0.0, -0.1, z], [0.0, 0.1, z])], 0.03)  # through the arm
+    far = Clearance(arm, [_line([0.2, -0.1, z], [0.2, 0.1, z])], 0.03)
     assert near.gap(q) < 0.0 < far.gap(q)
-    assert far.gap(q) == pytest.approx(0.2 - far.radii.max(), abs=0.02)
+    assert far.gap(q) == pytest.approx(0.2 - max(far.radii), abs=0.02)
     assert Clearance(arm, [], 0.03).gap(q) == np.inf
     assert far.path_gap(q, np.zeros(9)) <= min(far.gap(q), far.gap(np.zeros(9)))
+
+
+def _line(a: list[float], b: list[float]) -> PolynomialCurve:
+    a_, b_ = np.array(a), np.array(b)
+    return PolynomialCurve(np.column_stack([a_, b_ - a_]), (0.0, 1.0))
 
 
 def test_bush_is_deterministic_reachable_and_its_canes_clear_the_approaches() -> None:

@@ -145,7 +145,7 @@ def build_sim_rig(
         limits=(np.zeros_like(true_upper), true_upper),
     )  # fmt: skip
     on_bush = list(bush.berries)
-    canes = [b.points(120) for b in bush.branches]
+    canes = [b.curve() for b in bush.branches]
     watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
     clock = SimClock([plant.advance, watch.sample])
     bank = SafePressureBank(

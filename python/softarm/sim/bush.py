@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from softarm._core import PolynomialCurve
 from softarm.errors import ParameterError
 from softarm.harvest.ik import cone_axes
 
@@ -55,6 +56,10 @@ class Branch:
     (the layout of ``softarm.PolynomialCurve``)."""
 
     coeffs: FloatArray
+
+    def curve(self) -> PolynomialCurve:
+        """The cane as a ``softarm.PolynomialCurve`` obstacle (planning paper eq. 10)."""
+        return PolynomialCurve(self.coeffs, (0.0, 1.0))
 
     def points(self, n: int = 50) -> FloatArray:
         """(n, 3) points at evenly spaced u."""
