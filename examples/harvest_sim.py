@@ -20,9 +20,15 @@ import numpy as np
 from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
 
-def one_seed(seed: int, berries: int, out: Path) -> dict:
+def one_seed(seed: int, berries: int, out: Path, avoid: bool, gain: float | None) -> dict:
     """Run one bush and save its report; returns the report as a dict."""
-    opts = SimRigOptions(n_berries=berries, seed=seed, log_path=out / f"seed{seed}.jsonl")
+    opts = SimRigOptions(
+        n_berries=berries,
+        seed=seed,
+        log_path=out / f"seed{seed}.jsonl",
+        avoid_canes=avoid,
+        joint_limit_gain=gain,
+    )
     report = build_sim_rig(opts).run().to_dict()
     (out / f"seed{seed}.json").write_text(json.dumps(report, indent=2))
     return report
@@ -34,10 +40,17 @@ def main() -> None:
     ap.add_argument("--berries", type=int, default=8)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("out/eval"))
+    ap.add_argument("--no-avoid", action="store_true", help="no cane repulsion in closed loop")
+    ap.add_argument("--joint-limit-gain", type=float, help="closed-loop resolver γ (eq. 20)")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     with ProcessPoolExecutor(args.jobs) as pool:
-        futures = [pool.submit(one_seed, s, args.berries, args.out) for s in args.seeds]
+        futures = [
+            pool.submit(
+                one_seed, s, args.berries, args.out, not args.no_avoid, args.joint_limit_gain
+            )
+            for s in args.seeds
+        ]
         reports = [f.result() for f in futures]
     rows = [b for r in reports for b in r["berries"]]
     errors = [b["true_position_error_mm"] for b in rows if b["harvested"]]

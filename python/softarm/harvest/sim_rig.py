@@ -17,6 +17,7 @@ import softarm
 from softarm._core import Resolver
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator
+from softarm.harvest.avoidance import CaneRepulsion
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
@@ -41,7 +42,9 @@ class SimRigOptions:
     """Knobs of the simulated rig.
 
     ``scale`` shrinks both images (and focal lengths) for speed; ``hidden`` occludes the
-    selected berry from both cameras at the times it returns True (a leaf).
+    selected berry from both cameras at the times it returns True (a leaf);
+    ``avoid_canes`` adds the canes' repulsion (planning paper eq. 9) in the resolver's
+    null space; ``joint_limit_gain`` overrides the closed-loop resolver's γ of eq. (20).
     """
 
     n_berries: int = 5
@@ -52,6 +55,8 @@ class SimRigOptions:
     config: HarvestConfig = field(default_factory=HarvestConfig)
     log_path: str | Path | None = None
     hidden: Callable[[float], bool] | None = None
+    avoid_canes: bool = True
+    joint_limit_gain: float | None = None
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -157,9 +162,14 @@ def build_sim_rig(
         seed=o.seed, hidden=o.hidden,
     )  # fmt: skip
     gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
-    resolver = Resolver(model, mode="hybrid")
     if controller is None:
-        controller = ResolverController(resolver)
+        resolver = (
+            Resolver(model, mode="hybrid")
+            if o.joint_limit_gain is None
+            else planning_resolver(model, o.joint_limit_gain)
+        )
+        avoid = CaneRepulsion(model, canes) if o.avoid_canes else None
+        controller = ResolverController(resolver, avoid)
     machine = HarvestMachine(
         clock,
         vision,
