@@ -68,6 +68,7 @@ class Servo:
         self._last_fix: BerryFix | None = None
         #: The approach axis of the current berry (the planner may tilt it).
         self.axis = config.approach_axis
+        self._waypoints = []
 
     def begin(self, berry: BerryTarget, result: BerryResult) -> None:
         """Start a new berry: forget what was seen."""
@@ -75,6 +76,7 @@ class Servo:
         self._pose_seen = self._fix_seen = self.clock.now()
         self._last_fix = None
         self.axis = self.cfg.approach_axis
+        self._waypoints: list[FloatArray] = []
 
     # -- stages ---------------------------------------------------------------------
 
@@ -105,6 +107,7 @@ class Servo:
             if plan is None:
                 raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
             waypoints, self.axis = plan
+            self._waypoints = list(waypoints)
             self.log.event("plan", t=seen.t, q=waypoints, axis=self.axis, berry=seen.fix.position)
             for q_way in waypoints:
                 q = self.ramp(q, q_way, observe=True)
@@ -119,7 +122,7 @@ class Servo:
 
     def go_home(self, q: FloatArray, home: FloatArray) -> FloatArray:
         """RETURN_HOME: back out to the pre-grasp pose (the approach line is free of
-        branches), then ramp the elongations to ``home`` in actuator space."""
+        branches), ramp back through the placement plan's waypoints, then to ``home``."""
         c = self.cfg
         start = self.clock.now()
         berry = self._last_fix.position if self._last_fix is not None else None
@@ -138,6 +141,9 @@ class Servo:
             if fault.reason not in (FaultReason.TIMEOUT, FaultReason.UNREACHABLE):
                 raise
             self.log.event("retreat_incomplete", t=self.clock.now(), detail=str(fault))
+        # Leave by the planned way in (checked against the known canes), reversed.
+        for q_way in reversed(self._waypoints):
+            q = self.ramp(q, q_way, start + c.home_timeout)
         return self.ramp(q, home, start + c.home_timeout)
 
     def ramp(

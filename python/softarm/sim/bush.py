@@ -87,7 +87,7 @@ class Bush:
         max_tilt_deg: float = 20.0,
         min_spacing: float = 0.06,
         corridor: float = 0.15,
-        branch_clearance: float = 0.035,
+        branch_clearance: float = 0.045,
         first_tag: int = 10,
         unripe_fraction: float = 0.0,
         cone_deg: float = 20.0,
@@ -101,7 +101,8 @@ class Bush:
         Generating elongations lie 10 % of the range inside the limits. A berry is
         accepted when its gripper axis is within ``max_tilt_deg`` of +Y and it
         is at least ``min_spacing`` from the others. Each gets one cane behind it, kept
-        ``branch_clearance`` away from every berry's approach corridor (``corridor``
+        ``branch_clearance`` (centre line to centre line: the 25 mm gripper and a 5 mm cane
+        leave 15 mm) away from every berry's approach corridor (``corridor``
         m in front of the berry to 2 cm behind it, along +Y and every axis within
         ``cone_deg`` of it). With a ``view_point`` (the eye-to-hand camera), no two berries
         are within ``min_view_angle_deg`` of each other as seen from it: none hides
@@ -156,10 +157,10 @@ def _cane(
     corridors: list[tuple[FloatArray, FloatArray]],
     clearance: float,
 ) -> Branch | None:
-    """A gently curved cane 4–7 cm behind ``berry`` (along +Y), roughly in the XZ plane,
+    """A gently curved cane 5–8 cm behind ``berry`` (along +Y), roughly in the XZ plane,
     away from every approach corridor; None if 50 tries fail."""
     for _ in range(50):
-        centre = berry.position + PLUS_Y * rng.uniform(0.04, 0.07)
+        centre = berry.position + PLUS_Y * rng.uniform(0.05, 0.08)
         angle = rng.uniform(0, np.pi)
         direction = np.array([np.cos(angle), 0.0, np.sin(angle)])
         length = rng.uniform(0.15, 0.3)
