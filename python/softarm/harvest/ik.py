@@ -62,7 +62,10 @@ class ModelIK:
         starts: how many of the best-scored ones are refined (plus the current command).
         seed: seed of the random configurations.
         clearance: the model arm's gap to the known canes; None = no obstacles.
-        margin: smallest gap (m) accepted along the planned motions.
+        margin: smallest gap (m) accepted on the final approach (closed loop, on the
+            approach line).
+        ramp_margin: smallest gap (m) accepted along the open-loop ramps: before the loop
+            closes the true arm is off the model by up to a few cm.
         via: how much further back (m) than the pre-grasp pose the via point lies.
         limit_room: smallest distance (m) of the grasp solution to the joint limits, so
             that the true arm (gains and geometry a few % off the model) can still reach
@@ -78,6 +81,7 @@ class ModelIK:
         seed: int = 0,
         clearance: Clearance | None = None,
         margin: float = 0.01,
+        ramp_margin: float = 0.025,
         via: float = 0.1,
         limit_room: float = 0.001,
     ) -> None:
@@ -87,6 +91,7 @@ class ModelIK:
         self.samples, self.starts = samples, starts
         self.rng = np.random.default_rng(seed)
         self.clearance, self.margin, self.via = clearance, margin, via
+        self.ramp_margin = ramp_margin
         self.limit_room = limit_room
 
     def plan(
@@ -94,13 +99,19 @@ class ModelIK:
     ) -> tuple[list[FloatArray], FloatArray] | None:
         """``(waypoints, axis)`` for the squarest reachable approach whose ramp is clear:
         straight to the pre-grasp pose if possible, else via a pose ``via`` further back
-        on the approach line (the arm then enters the bush along that line). Plans whose
-        grasp is three times ``limit_room`` from the joint limits, and whose pre-grasp pose
-        is ``limit_room`` from them, are preferred."""
-        for room in (3 * self.limit_room, self.limit_room):
+        on the approach line (the arm then enters the bush along that line). Preferred:
+        grasps three times ``limit_room`` from the joint limits (pre-grasp ``limit_room``)
+        and ramps ``ramp_margin`` from the canes; then ``limit_room``; then ramps only
+        ``margin`` from the canes."""
+        passes = [  # (joint-limit room at the grasp, gap along the open-loop ramps)
+            (3 * self.limit_room, self.ramp_margin),
+            (self.limit_room, self.ramp_margin),
+            (self.limit_room, self.margin),  # last resort: the closed loop must correct
+        ]
+        for room, ramp in passes:
             for via in (None, self.via):
                 for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
-                    path = self._path(q, berry, current, axis, via, room)
+                    path = self._path(q, berry, current, axis, via, room, ramp)
                     if path is not None:
                         return path, axis
         return None
@@ -113,6 +124,7 @@ class ModelIK:
         axis: FloatArray,
         via: float | None,
         room: float,
+        ramp: float,
     ) -> list[FloatArray] | None:
         c = self.cfg
         pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
@@ -123,15 +135,15 @@ class ModelIK:
                 continue  # the true arm differs by a few %: grasp away from the limits
             if room > self.limit_room and self._room(q_pre) < self.limit_room:
                 continue
-            if not self._clear(q_pre, q_grasp[0], 5):
+            if not self._clear(q_pre, q_grasp[0], 5, self.margin):
                 continue
             if via is None:
-                if self._clear(q, q_pre):
+                if self._clear(q, q_pre, 12, ramp):
                     return [q_pre]
                 continue
             back = approach_pose(current, berry, axis, c.grasp_offset + c.standoff + via)
             for q_via in self.solve(q_pre, back, sample=False) + self.solve(q, back):
-                if self._clear(q, q_via) and self._clear(q_via, q_pre, 6):
+                if self._clear(q, q_via, 12, ramp) and self._clear(q_via, q_pre, 6, ramp):
                     return [q_via, q_pre]
         return None
 
@@ -139,10 +151,15 @@ class ModelIK:
         """Distance (m) of ``q`` to the nearest joint limit."""
         return float(min(np.min(q - self.arm.lower), np.min(self.arm.upper - q)))
 
-    def _clear(self, q0: FloatArray, q1: FloatArray, steps: int = 12) -> bool:
+    def _clear(
+        self, q0: FloatArray, q1: FloatArray, steps: int = 12, margin: float | None = None
+    ) -> bool:
+        """Whether the model arm keeps ``margin`` (default: the open-loop ``ramp_margin``)
+        from the canes along the actuator-space line from ``q0`` to ``q1``."""
         if self.clearance is None:
             return True
-        return self.clearance.path_gap(q0, q1, steps) >= self.margin
+        need = self.ramp_margin if margin is None else margin
+        return self.clearance.path_gap(q0, q1, steps) >= need
 
     def solve(self, q: FloatArray, target: FloatArray, sample: bool = True) -> list[FloatArray]:
         """Elongations reaching ``target`` (4, 4) on the model from each start that
