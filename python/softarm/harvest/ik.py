@@ -101,12 +101,12 @@ class ModelIK:
         straight to the pre-grasp pose if possible, else via a pose ``via`` further back
         on the approach line (the arm then enters the bush along that line). Preferred:
         grasps three times ``limit_room`` from the joint limits (pre-grasp ``limit_room``)
-        and ramps ``ramp_margin`` from the canes; then ``limit_room``; then ramps only
-        ``margin`` from the canes."""
+        and ramps ``ramp_margin`` from the canes; then grasps ``limit_room`` from the
+        limits. A berry with no such plan is UNREACHABLE: brushing a cane open loop is
+        not worth one berry."""
         passes = [  # (joint-limit room at the grasp, gap along the open-loop ramps)
             (3 * self.limit_room, self.ramp_margin),
             (self.limit_room, self.ramp_margin),
-            (self.limit_room, self.margin),  # last resort: the closed loop must correct
         ]
         for room, ramp in passes:
             for via in (None, self.via):
