@@ -15,6 +15,7 @@ from softarm.errors import SoftarmError
 #: Subcommand name -> module implementing it.
 COMMANDS: dict[str, str] = {
     "demo": "softarm.commands.demo",
+    "harvest": "softarm.commands.harvest",
     "experiment": "softarm.commands.experiment",
     "plan": "softarm.commands.plan",
 }

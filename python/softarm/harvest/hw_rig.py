@@ -1,0 +1,123 @@
+"""The hardware rig: the same state machine on the real devices, from a TOML config.
+
+Devices are opened in the order of the bring-up (pressure outputs behind the safety
+layer, the Arduino for gripper and ripeness sensor, both cameras); if one is missing
+everything opened so far is vented and closed again and
+:class:`~softarm.errors.HardwareUnavailableError` says which device and why.
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import ExitStack
+from dataclasses import dataclass
+
+import numpy as np
+
+from softarm._core import Gains, Resolver, Section, SoftArm
+from softarm.config import CameraConfig, Config
+from softarm.errors import ConfigError
+from softarm.hardware.arduino import ArduinoLink
+from softarm.hardware.arduino_devices import ArduinoGripper, ArduinoRipenessSensor
+from softarm.hardware.camera import OpenCVCamera
+from softarm.hardware.daq import NidaqPressureBank
+from softarm.hardware.pressure_map import ElongationMap, VoltageMap
+from softarm.hardware.safety import SafePressureBank
+from softarm.harvest.actuator import SafeActuator
+from softarm.harvest.config import HarvestConfig
+from softarm.harvest.controller import ResolverController
+from softarm.harvest.ik import ModelIK, planning_resolver
+from softarm.harvest.log import HarvestLog
+from softarm.harvest.machine import HarvestMachine
+from softarm.harvest.vision_loop import CameraVision
+from softarm.vision import CameraModel, MarkerCube
+from softarm.vision.poses import invert
+
+__all__ = ["HardwareRig", "MonotonicClock", "build_hardware_rig"]
+
+#: The marker cube in the end-effector frame: 5 cm behind the gripper frame, as built.
+#: Not in the TOML config yet (see docs/harvest.md).
+T_EE_CUBE = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.05], [0, 0, 0, 1]])
+BERRY_TAG = 0.012  # the paper's 12 mm berry tag (section III-D)
+
+
+class MonotonicClock:
+    """Wall-clock time; ``sleep`` waits for the next control period boundary."""
+
+    def __init__(self) -> None:
+        self._next = time.monotonic()
+
+    def now(self) -> float:
+        """Seconds since an arbitrary origin."""
+        return time.monotonic()
+
+    def sleep(self, dt: float) -> None:
+        """Wait until ``dt`` after the previous deadline (no drift when a step is slow)."""
+        self._next = max(self._next + dt, time.monotonic())
+        time.sleep(max(0.0, self._next - time.monotonic()))
+
+
+@dataclass
+class HardwareRig:
+    """The machine and the devices it runs on; ``close()`` vents and releases them."""
+
+    machine: HarvestMachine
+    devices: ExitStack
+
+    def close(self) -> None:
+        """Vent the arm and release every device."""
+        self.devices.close()
+
+
+def _camera_model(cam: CameraConfig, name: str) -> CameraModel:
+    if cam.file is not None:
+        return CameraModel.load(cam.file)
+    if cam.matrix is None:
+        raise ConfigError(f"calibration.{name}: no intrinsics (matrix or file) in the config")
+    return CameraModel(np.array(cam.matrix), np.array(cam.distortion or [0.0] * 5))
+
+
+def build_hardware_rig(
+    config: Config, harvest: HarvestConfig | None = None, log: HarvestLog | None = None
+) -> HardwareRig:
+    """Open every device of ``config`` and wire the machine.
+
+    Raises:
+        HardwareUnavailableError: a device (or its driver) is absent.
+        ConfigError: the calibration needed by the vision loop is missing.
+    """
+    cfg = harvest or HarvestConfig()
+    cal, ch = config.calibration, config.channels
+    if cal.T_C1_base is None or cal.T_C2_EE is None:
+        raise ConfigError("calibration.T_C1_base and calibration.T_C2_EE must be set to harvest")
+    model1, model2 = _camera_model(cal.c1, "c1"), _camera_model(cal.c2, "c2")
+    arm = SoftArm([Section(**vars(s)) for s in config.arm.sections])
+    gains = Gains(**config.gains.values) if config.gains.values else None
+    resolver = Resolver(arm, mode="hybrid", gains=gains)
+    with ExitStack() as stack:
+        daq = NidaqPressureBank(ch.names, VoltageMap(ch.full_scale_psi, *ch.voltage_range))
+        stack.callback(daq.close)
+        bank = SafePressureBank(daq, ch.p_max, ch.max_rate_psi_per_s, ch.watchdog_timeout_s)
+        stack.callback(bank.close)
+        s = config.serial
+        link = ArduinoLink(
+            s.port, s.baud, s.timeout_s, s.retries, startup_delay_s=s.startup_delay_s
+        )
+        stack.callback(link.close)
+        cam1, cam2 = OpenCVCamera(cal.c1.source), OpenCVCamera(cal.c2.source)
+        stack.callback(cam1.close)
+        stack.callback(cam2.close)
+        vision = CameraVision(
+            lambda t: cam1.read(), lambda t: cam2.read(), model1, model2,
+            invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)), T_EE_CUBE,
+            MarkerCube.standard(), BERRY_TAG, cfg.grasp_offset,
+        )  # fmt: skip
+        gripper = ArduinoGripper(link)
+        machine = HarvestMachine(
+            MonotonicClock(), vision, vision, ResolverController(resolver),
+            SafeActuator(bank, ElongationMap(ch.p_max, ch.metres_per_psi)), gripper,
+            ArduinoRipenessSensor(link), arm.n_actuators, cfg, log,
+            planner=ModelIK(planning_resolver(arm), cfg),
+        )  # fmt: skip
+        return HardwareRig(machine, stack.pop_all())
+    raise AssertionError("unreachable")  # pragma: no cover  (the with block returns)

@@ -1,0 +1,183 @@
+"""Placement planning on the controller's model, before the loop closes on the cameras.
+
+The resolver is a local method: from the straight ready pose, a target 90° away (the
+gripper turns from +Z to face the bush along +Y) can leave it stuck on the joint limits,
+and not every berry can be faced exactly along +Y. So placement first solves on the model:
+for approach axes in a cone around +Y (squarest first), from several starts (the current
+command and the best of a seeded batch of random configurations, scored by forward
+kinematics), it looks for elongations reaching the pre-grasp pose AND the grasp pose.
+The machine ramps the actuators to that solution, then servos on the cameras (eq. 22).
+
+With known canes (curve obstacles, as in the planning paper) a solution is kept only if
+the model arm clears them by ``margin`` all along the straight actuator-space ramp to it,
+along the final approach to the berry and at the grasp.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import Resolver, SoftArm
+from softarm.harvest.clearance import Clearance
+from softarm.harvest.config import HarvestConfig
+from softarm.harvest.targets import approach_pose
+
+__all__ = ["ModelIK", "cone_axes", "planning_resolver"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def planning_resolver(model: SoftArm, joint_limit_gain: float = -1e-3) -> Resolver:
+    """A hybrid resolver for planning on ``model``: the default gains with a joint-limit
+    gain (γ₅ of eq. 20, on the cost of eq. 14) 500 times the closed-loop one, so solutions
+    sit mid-range, where the true arm (a few % off the model) can still reach them."""
+    gains = Resolver(model, mode="hybrid").gains.replace(hybrid_gamma=joint_limit_gain)
+    return Resolver(model, mode="hybrid", gains=gains)
+
+
+def cone_axes(axis: FloatArray, cone_deg: float, rings: int = 2, per_ring: int = 8) -> FloatArray:
+    """(1 + rings * per_ring, 3) unit axes: ``axis``, then rings at growing angles up to
+    ``cone_deg`` around it."""
+    a = axis / np.linalg.norm(axis)
+    u = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    out = [a]
+    for k in range(1, rings + 1):
+        t = np.radians(cone_deg) * k / rings
+        for phi in np.linspace(0, 2 * np.pi, per_ring, endpoint=False):
+            out.append(np.cos(t) * a + np.sin(t) * (np.cos(phi) * u + np.sin(phi) * v))
+    return np.array(out)
+
+
+class ModelIK:
+    """Implements :class:`~softarm.harvest.interfaces.PlacementPlanner`.
+
+    Args:
+        resolver: a ``softarm.Resolver`` on the model (its ``solve`` refines each start),
+            best from :func:`planning_resolver`.
+        config: the machine's configuration (approach axis and cone, offsets).
+        samples: random configurations scored per axis.
+        starts: how many of the best-scored ones are refined (plus the current command).
+        seed: seed of the random configurations.
+        clearance: the model arm's gap to the known canes; None = no obstacles.
+        margin: smallest gap (m) accepted on the final approach (closed loop, on the
+            approach line).
+        ramp_margin: smallest gap (m) accepted along the open-loop ramps: before the loop
+            closes the true arm is off the model by up to a few cm.
+        via: how much further back (m) than the pre-grasp pose the via point lies.
+        limit_room: smallest distance (m) of the grasp solution to the joint limits, so
+            that the true arm (gains and geometry a few % off the model) can still reach
+            the berry within a millimetre in closed loop.
+    """
+
+    def __init__(
+        self,
+        resolver: object,
+        config: HarvestConfig,
+        samples: int = 3000,
+        starts: int = 4,
+        seed: int = 0,
+        clearance: Clearance | None = None,
+        margin: float = 0.01,
+        ramp_margin: float = 0.025,
+        via: float = 0.1,
+        limit_room: float = 0.001,
+    ) -> None:
+        self.resolver = resolver
+        self.arm = resolver.arm  # type: ignore[attr-defined]
+        self.cfg = config
+        self.samples, self.starts = samples, starts
+        self.rng = np.random.default_rng(seed)
+        self.clearance, self.margin, self.via = clearance, margin, via
+        self.ramp_margin = ramp_margin
+        self.limit_room = limit_room
+
+    def plan(
+        self, q: FloatArray, berry: FloatArray, current: FloatArray
+    ) -> tuple[list[FloatArray], FloatArray] | None:
+        """``(waypoints, axis)`` for the squarest reachable approach whose ramp is clear:
+        straight to the pre-grasp pose if possible, else via a pose ``via`` further back
+        on the approach line (the arm then enters the bush along that line). Preferred:
+        grasps three times ``limit_room`` from the joint limits (pre-grasp ``limit_room``)
+        and ramps ``ramp_margin`` from the canes; then grasps ``limit_room`` from the
+        limits. A berry with no such plan is UNREACHABLE: brushing a cane open loop is
+        not worth one berry."""
+        passes = [  # (joint-limit room at the grasp, gap along the open-loop ramps)
+            (3 * self.limit_room, self.ramp_margin),
+            (self.limit_room, self.ramp_margin),
+        ]
+        for room, ramp in passes:
+            for via in (None, self.via):
+                for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
+                    path = self._path(q, berry, current, axis, via, room, ramp)
+                    if path is not None:
+                        return path, axis
+        return None
+
+    def _path(
+        self,
+        q: FloatArray,
+        berry: FloatArray,
+        current: FloatArray,
+        axis: FloatArray,
+        via: float | None,
+        room: float,
+        ramp: float,
+    ) -> list[FloatArray] | None:
+        c = self.cfg
+        pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
+        grasp = approach_pose(current, berry, axis, c.grasp_offset)
+        for q_pre in self.solve(q, pre):
+            q_grasp = self.solve(q_pre, grasp, sample=False)
+            if not q_grasp or self._room(q_grasp[0]) < room:
+                continue  # the true arm differs by a few %: grasp away from the limits
+            if room > self.limit_room and self._room(q_pre) < self.limit_room:
+                continue
+            if not self._clear(q_pre, q_grasp[0], 5, self.margin):
+                continue
+            if via is None:
+                if self._clear(q, q_pre, 12, ramp):
+                    return [q_pre]
+                continue
+            back = approach_pose(current, berry, axis, c.grasp_offset + c.standoff + via)
+            for q_via in self.solve(q_pre, back, sample=False) + self.solve(q, back):
+                if self._clear(q, q_via, 12, ramp) and self._clear(q_via, q_pre, 6, ramp):
+                    return [q_via, q_pre]
+        return None
+
+    def _room(self, q: FloatArray) -> float:
+        """Distance (m) of ``q`` to the nearest joint limit."""
+        return float(min(np.min(q - self.arm.lower), np.min(self.arm.upper - q)))
+
+    def _clear(
+        self, q0: FloatArray, q1: FloatArray, steps: int = 12, margin: float | None = None
+    ) -> bool:
+        """Whether the model arm keeps ``margin`` (default: the open-loop ``ramp_margin``)
+        from the canes along the actuator-space line from ``q0`` to ``q1``."""
+        if self.clearance is None:
+            return True
+        need = self.ramp_margin if margin is None else margin
+        return self.clearance.path_gap(q0, q1, steps) >= need
+
+    def solve(self, q: FloatArray, target: FloatArray, sample: bool = True) -> list[FloatArray]:
+        """Elongations reaching ``target`` (4, 4) on the model from each start that
+        converges, nearest to ``q`` first; [] when none does."""
+        starts = [q]
+        if sample:
+            lo, hi = self.arm.lower, self.arm.upper
+            qs = self.rng.uniform(lo, hi, size=(self.samples, lo.size))
+            poses = self.arm.forward_batch(qs)  # (N, 4, 4)
+            pos_err = np.linalg.norm(poses[:, :3, 3] - target[:3, 3], axis=1)
+            cos = np.clip(poses[:, :3, 2] @ target[:3, 2], -1.0, 1.0)
+            score = pos_err + 0.05 * np.arccos(cos)  # 5 cm per rad: both matter
+            starts += list(qs[np.argsort(score)[: self.starts]])
+        found = []
+        for q0 in starts:
+            sol = self.resolver.solve(  # type: ignore[attr-defined]
+                q0, target, max_steps=1500, position_tolerance=1e-3, orientation_tolerance=0.02
+            )
+            if sol.converged:
+                found.append(np.asarray(sol.q, dtype=np.float64))
+        return sorted(found, key=lambda x: float(np.linalg.norm(x - q)))

@@ -1,0 +1,153 @@
+"""What the harvesting state machine depends on, as structural ``Protocol`` classes.
+
+The machine never talks to a camera, a DAQ board or the simulated arm directly: the
+simulated rig (:mod:`softarm.harvest.sim_rig`), the hardware rig and the test fakes each
+provide these few objects.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Protocol
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "BerryFix",
+    "BerryLocator",
+    "BerryTarget",
+    "Camera",
+    "Clock",
+    "Controller",
+    "EndEffectorTracker",
+    "GripperDevice",
+    "GroundTruth",
+    "PlacementPlanner",
+    "PressureActuator",
+    "RipenessProbe",
+]
+
+FloatArray = npt.NDArray[np.float64]
+#: Which camera the berry position came from; ``held`` = the most recent one, kept while
+#: the berry is hidden (section III-D).
+Camera = Literal["eye_to_hand", "eye_in_hand", "held"]
+
+
+@dataclass(frozen=True)
+class BerryTarget:
+    """A berry to harvest: the id of the ArUco tag that marks it (section IV-E) and an
+    optional label for the logs."""
+
+    tag_id: int
+    label: str = ""
+
+
+@dataclass(frozen=True)
+class BerryFix:
+    """A berry position ``position`` (3,) in the base frame, the ``camera`` it came from
+    and its ``age`` (s since it was measured; 0 for a fresh measurement)."""
+
+    position: FloatArray
+    camera: Camera
+    age: float = 0.0
+
+
+class Clock(Protocol):
+    """Time of the control loop. On hardware ``sleep`` waits for the next period; in the
+    simulator it advances the simulated arm."""
+
+    def now(self) -> float:
+        """Seconds, monotonic."""
+        ...
+
+    def sleep(self, dt: float) -> None:
+        """Let ``dt`` seconds pass."""
+        ...
+
+
+class EndEffectorTracker(Protocol):
+    """Eye-to-hand tracking of the end-effector marker cube (eq. 22)."""
+
+    def track(self, time: float) -> FloatArray | None:
+        """``T_base_ee`` (4, 4) at ``time``, or None when the cube is not seen."""
+        ...
+
+
+class BerryLocator(Protocol):
+    """The berry position from both cameras: eye-to-hand far away, eye-in-hand (eq. 21)
+    within the 6 cm hand-over distance, the most recent fix held while the berry is
+    hidden, up to an age limit (section III-D, fig. 4)."""
+
+    def select(self, berry: BerryTarget) -> None:
+        """Track ``berry`` from now on, forgetting any held fix."""
+        ...
+
+    def locate(self, time: float, T_base_ee: FloatArray | None) -> BerryFix | None:
+        """The berry at ``time`` given the tracked end-effector pose, or None."""
+        ...
+
+
+class Controller(Protocol):
+    """One resolved-rate step towards a target pose (the hybrid resolver, eq. 20)."""
+
+    def step(
+        self, q: FloatArray, target: FloatArray, current: FloatArray | None
+    ) -> tuple[FloatArray, bool]:
+        """``(q_next, saturated)``: the next elongations (m) from ``q`` towards the 4x4
+        ``target``, with ``current`` the measured pose (None = use the model), and whether
+        a joint limit clipped the step."""
+        ...
+
+
+class PlacementPlanner(Protocol):
+    """Plans initial placement on the controller's model before the loop closes."""
+
+    def plan(
+        self, q: FloatArray, berry: FloatArray, current: FloatArray
+    ) -> tuple[list[FloatArray], FloatArray] | None:
+        """``(waypoints, approach_axis)``: elongations (m) to ramp through, the last one
+        putting the gripper at the pre-grasp pose of the berry at ``berry`` (base frame),
+        and the unit axis it approaches along; None when nothing in the allowed cone is
+        reachable (clear of known obstacles)."""
+        ...
+
+
+class PressureActuator(Protocol):
+    """Elongations (m) to pressures (psi) through the safety layer."""
+
+    def send(self, q: FloatArray) -> None:
+        """Command elongations ``q`` (m); raises HardwareError/SafetyError on a fault."""
+        ...
+
+    def vent(self, reason: str) -> None:
+        """Exhaust every channel now (the safe state)."""
+        ...
+
+
+class GripperDevice(Protocol):
+    """The soft gripper."""
+
+    def open(self) -> None:
+        """Open the fingers."""
+        ...
+
+    def close(self) -> None:
+        """Close the fingers."""
+        ...
+
+
+class RipenessProbe(Protocol):
+    """The NIR ripeness sensor in the palm."""
+
+    def read(self) -> float:
+        """Ripeness index in [0, 1]."""
+        ...
+
+
+class GroundTruth(Protocol):
+    """Simulation only: true errors, to report what vision cannot see."""
+
+    def grasp_errors(self, berry: BerryTarget, axis: FloatArray) -> tuple[float, float]:
+        """True (grasp point to ``berry`` in m, gripper axis to ``axis`` in rad) now."""
+        ...

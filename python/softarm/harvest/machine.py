@@ -1,0 +1,210 @@
+"""The harvesting state machine (paper section III-D, fig. 4).
+
+Per berry::
+
+    IDLE → INITIAL_PLACEMENT → FINE_POSITIONING → GRASP → RETURN_HOME → DONE
+      └──────────────┴────────────────┴────────────┴──────────┴──→ FAULT (vented)
+
+* IDLE: select the berry's tag; ramp to the ready pose; wait until the cube and the berry
+  are both seen.
+* INITIAL_PLACEMENT: eye-to-hand feedback (eq. 22) drives the gripper to a pre-grasp pose
+  ``standoff`` short of the berry, facing it along ``approach``.
+* FINE_POSITIONING: the berry position from the eye-in-hand camera (eq. 21), held while
+  hidden, drives the grasp point onto the berry.
+* GRASP: close, read the ripeness; an unripe berry is released and skipped.
+* RETURN_HOME: back out along the approach axis, then ramp to the ready pose.
+
+Every transition is logged (and fsync'd) with its reason. A fault vents every channel at
+once, logs the reason, and ends the berry in FAULT; :data:`~softarm.harvest.states.
+FAULTS_THAT_STOP` also end the run, the others go on with the next berry.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from softarm.errors import HardwareError, NonFiniteError, SafetyError
+from softarm.harvest.config import HarvestConfig
+from softarm.harvest.interfaces import (
+    BerryLocator,
+    BerryTarget,
+    Clock,
+    Controller,
+    EndEffectorTracker,
+    FloatArray,
+    GripperDevice,
+    GroundTruth,
+    PlacementPlanner,
+    PressureActuator,
+    RipenessProbe,
+)
+from softarm.harvest.log import HarvestLog
+from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.servo import Fault, Servo
+from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+
+__all__ = ["HarvestMachine"]
+
+S = HarvestState
+
+
+class HarvestMachine:
+    """Harvests berries one at a time with the devices given (see module docstring).
+
+    Args:
+        clock, tracker, locator, controller, actuator, gripper, ripeness: the
+            :mod:`softarm.harvest.interfaces` the machine runs on.
+        n_actuators: length of q.
+        config: tuning; defaults follow the paper.
+        log: where steps and transitions go (in memory by default).
+        ground_truth: simulation only, to report true errors at the grasp.
+        planner: plans placement on the model first (see :mod:`softarm.harvest.ik`);
+            without one the resolver closes the loop from the ready pose directly.
+    """
+
+    def __init__(
+        self,
+        clock: Clock,
+        tracker: EndEffectorTracker,
+        locator: BerryLocator,
+        controller: Controller,
+        actuator: PressureActuator,
+        gripper: GripperDevice,
+        ripeness: RipenessProbe,
+        n_actuators: int = 9,
+        config: HarvestConfig | None = None,
+        log: HarvestLog | None = None,
+        ground_truth: GroundTruth | None = None,
+        planner: PlacementPlanner | None = None,
+    ) -> None:
+        self.clock = clock
+        self.locator = locator
+        self.actuator = actuator
+        self.gripper = gripper
+        self.ripeness = ripeness
+        self.config = config or HarvestConfig()
+        self.log = log or HarvestLog()
+        self.ground_truth = ground_truth
+        self.state = S.IDLE
+        #: Commanded elongations (m): the soft arm has no joint sensors, so the resolver's
+        #: Jacobian is evaluated at the command, and the measured pose closes the loop.
+        self.q: FloatArray = np.zeros(n_actuators)
+        #: The ready pose between berries: straight, every actuator at ``home_elongation``,
+        #: away from the lower limits where the resolver's steps would be clipped.
+        self.home: FloatArray = np.full(n_actuators, self.config.home_elongation)
+        self.servo = Servo(clock, tracker, locator, controller, actuator, self.config, self.log)
+        self.planner = planner
+
+    def run(self, berries: Sequence[BerryTarget]) -> HarvestReport:
+        """Harvest ``berries`` in order; stop early after a fault in FAULTS_THAT_STOP."""
+        report = HarvestReport()
+        for i, berry in enumerate(berries):
+            result = self.run_berry(berry)
+            report.berries.append(result)
+            if result.fault in FAULTS_THAT_STOP:
+                report.stopped = result.fault
+                self.log.event("run_stopped", reason=result.fault, remaining=len(berries) - i - 1)
+                report.berries += [BerryResult(b.tag_id) for b in berries[i + 1 :]]
+                break
+        self.log.event("run_done", success_rate=report.success_rate)
+        return report
+
+    def run_berry(self, berry: BerryTarget, grasp: bool = True) -> BerryResult:
+        """Take one berry through the whole workflow; never raises for a device fault.
+
+        With ``grasp=False`` the machine stops after fine positioning (DONE with the
+        gripper on the berry): visual servoing only, e.g. to check a calibration.
+        """
+        result = BerryResult(berry.tag_id)
+        start = self.clock.now()
+        self.servo.begin(berry, result)
+        self._transition(S.IDLE, berry, "new berry")
+        try:
+            self.locator.select(berry)
+            self.q = self.servo.ramp(self.q, self.home)
+            self.servo.wait_visible(self.q)
+            self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
+            self.q = self.servo.place(self.q, self.planner)
+            self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
+            self.q = self.servo.fine(self.q)
+            self._record_grasp_errors(berry, result)
+            if not grasp:
+                self._transition(S.DONE, berry, "positioned; no grasp requested")
+                return self._finish(result, start)
+            self._transition(S.GRASP, berry, "berry within the grasp workspace")
+            self._grasp(result)
+            self._transition(S.RETURN_HOME, berry, "grasp finished")
+            self.q = self.servo.go_home(self.q, self.home)
+            if result.harvested:
+                self.gripper.open()  # drop the berry at the rest pose
+            self._transition(S.DONE, berry, "harvested" if result.harvested else "skipped")
+        except Fault as fault:
+            self._fault(berry, result, fault.reason, str(fault))
+        except SafetyError as exc:
+            self._fault(berry, result, FaultReason.SAFETY_STOP, repr(exc))
+        except NonFiniteError as exc:
+            self._fault(berry, result, FaultReason.NAN_MEASUREMENT, repr(exc))
+        except HardwareError as exc:
+            self._fault(berry, result, FaultReason.HARDWARE_ERROR, repr(exc))
+        except BaseException as exc:
+            # A bug or Ctrl-C: still leave the arm vented and the log synced, then re-raise.
+            self._vent(f"unexpected {exc!r}")
+            self.log.event("crash", berry=berry.tag_id, error=repr(exc))
+            raise
+        return self._finish(result, start)
+
+    def _finish(self, result: BerryResult, start: float) -> BerryResult:
+        result.final_state = self.state
+        result.duration_s = self.clock.now() - start
+        self.log.event("berry_result", **result.to_dict())
+        return result
+
+    def _grasp(self, result: BerryResult) -> None:
+        self.gripper.close()
+        ripeness = float(self.ripeness.read())
+        if not np.isfinite(ripeness):
+            raise Fault(FaultReason.NAN_MEASUREMENT, f"ripeness reading {ripeness!r}")
+        self.log.event("ripeness", value=ripeness, threshold=self.config.ripeness_threshold)
+        if ripeness < self.config.ripeness_threshold:
+            self.gripper.open()
+            result.skipped_unripe = True
+        else:
+            result.harvested = True
+
+    def _record_grasp_errors(self, berry: BerryTarget, result: BerryResult) -> None:
+        if self.ground_truth is None:
+            return
+        pos, ang = self.ground_truth.grasp_errors(berry, self.servo.axis)
+        result.true_position_error_mm = 1e3 * pos
+        result.true_orientation_error_deg = float(np.degrees(ang))
+
+    def _transition(self, new: HarvestState, berry: BerryTarget, reason: str) -> None:
+        old, self.state = self.state, new
+        self.servo.state = new
+        self.log.event(
+            "transition", t=self.clock.now(), berry=berry.tag_id, old=old, new=new, why=reason
+        )
+
+    def _fault(
+        self, berry: BerryTarget, result: BerryResult, reason: FaultReason, detail: str
+    ) -> None:
+        result.fault = reason
+        result.harvested = False
+        self._vent(f"{reason.value}: {detail}")
+        self.log.event(
+            "fault", t=self.clock.now(), berry=berry.tag_id, reason=reason, detail=detail
+        )
+        self._transition(S.FAULT, berry, f"{reason.value}: {detail}")
+
+    def _vent(self, reason: str) -> None:
+        """The safe state: every channel exhausted; the arm relaxes to its rest shape."""
+        try:
+            self.actuator.vent(reason)
+            vented = True
+        except Exception as exc:  # a dead driver must not hide the original fault
+            self.log.event("vent_failed", error=repr(exc))
+            vented = False
+        self.q = np.zeros_like(self.q)
+        self.log.event("vent", t=self.clock.now(), reason=reason, ok=vented)

@@ -1,0 +1,89 @@
+"""Per-berry results and the harvest report written as JSON."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from softarm.harvest.log import _plain
+from softarm.harvest.states import FaultReason, HarvestState
+
+__all__ = ["BerryResult", "HarvestReport"]
+
+
+@dataclass
+class BerryResult:
+    """What happened to one berry.
+
+    Attributes:
+        tag_id: the berry's tag.
+        target: last berry position measured (base frame, m), or None if never seen.
+        harvested: grasped, ripe, and brought home.
+        final_state: DONE, or FAULT.
+        fault: why it faulted, if it did.
+        skipped_unripe: grasped but found unripe, released.
+        position_error_mm: at the end of fine positioning, grasp point to berry, as
+            measured by the cameras (what the controller sees).
+        orientation_error_deg: angle between the gripper's approach axis and the desired one.
+        true_position_error_mm: the same against ground truth (simulation only).
+        true_orientation_error_deg: the same against ground truth (simulation only).
+        duration_s: clock time from IDLE to the end.
+        steps: control steps.
+        cameras: control steps per berry source (eye_to_hand, eye_in_hand, held).
+    """
+
+    tag_id: int
+    target: list[float] | None = None
+    harvested: bool = False
+    final_state: HarvestState = HarvestState.IDLE
+    fault: FaultReason | None = None
+    skipped_unripe: bool = False
+    position_error_mm: float = math.nan
+    orientation_error_deg: float = math.nan
+    true_position_error_mm: float | None = None
+    true_orientation_error_deg: float | None = None
+    duration_s: float = 0.0
+    steps: int = 0
+    cameras: dict[str, int] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN → null, enums → their values)."""
+        return dict(_plain(asdict(self)))
+
+
+@dataclass
+class HarvestReport:
+    """The results of a run, in berry order, and anything the rig adds in ``extra``
+    (seed, minimum branch clearance, ...)."""
+
+    berries: list[BerryResult] = field(default_factory=list)
+    stopped: FaultReason | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def success_rate(self) -> float:
+        """Harvested berries over berries attempted or pending (0 when there are none)."""
+        return sum(b.harvested for b in self.berries) / len(self.berries) if self.berries else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """The report as a JSON-ready dict."""
+        return dict(
+            _plain(
+                {
+                    "success_rate": self.success_rate,
+                    "harvested": sum(b.harvested for b in self.berries),
+                    "attempted": len(self.berries),
+                    "stopped": self.stopped,
+                    "berries": [b.to_dict() for b in self.berries],
+                    **self.extra,
+                }
+            )
+        )
+
+    def save(self, path: str | Path) -> None:
+        """Write the report as indented JSON."""
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n")

@@ -1,0 +1,193 @@
+"""The full simulated harvest: bush → synthetic cameras → vision → fusion → resolver →
+safety layer → simulated pneumatic arm, on a simulated clock.
+
+:func:`build_sim_rig` wires it; :meth:`SimRig.run` harvests every berry of the bush and
+returns the report with ground-truth errors and the arm's clearance to the canes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import softarm
+from softarm._core import Resolver
+from softarm.hardware import SafePressureBank, SimulatedPressureBank
+from softarm.harvest.actuator import SafeActuator
+from softarm.harvest.avoidance import CaneRepulsion
+from softarm.harvest.clearance import Clearance
+from softarm.harvest.config import HarvestConfig
+from softarm.harvest.controller import ResolverController
+from softarm.harvest.ik import ModelIK, planning_resolver
+from softarm.harvest.interfaces import BerryTarget, Controller
+from softarm.harvest.log import HarvestLog
+from softarm.harvest.machine import HarvestMachine
+from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
+from softarm.harvest.sim_plant import ArmPlant
+from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
+from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
+from softarm.harvest.vision_loop import CameraVision
+from softarm.sim.bush import Bush
+from softarm.sim.pressure import MAX_PSI
+
+__all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
+
+
+@dataclass
+class SimRigOptions:
+    """Knobs of the simulated rig.
+
+    ``scale`` shrinks both images (and focal lengths) for speed; ``hidden`` occludes the
+    selected berry from both cameras at the times it returns True (a leaf);
+    ``avoid_canes`` adds the canes' repulsion (planning paper eq. 9) in the resolver's
+    null space; ``joint_limit_gain`` overrides the closed-loop resolver's γ of eq. (20).
+    """
+
+    n_berries: int = 5
+    seed: int = 0
+    scale: float = 1.0
+    noise_std: float = 2.0
+    unripe_fraction: float = 0.0
+    config: HarvestConfig = field(default_factory=HarvestConfig)
+    log_path: str | Path | None = None
+    hidden: Callable[[float], bool] | None = None
+    avoid_canes: bool = True
+    joint_limit_gain: float | None = None
+
+
+def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
+    """C1 about 1 m from the workspace, looking across it from +X/-Y so that it sees the
+    cube's side faces, the base tag and the berry tags (section II-C); C2 at the centre
+    of the gripper (3 cm behind its frame) looking along its axis; the cube 5 cm behind
+    the gripper frame."""
+    centre = np.array([0.0, 0.25, 0.3])
+    eye = np.array([0.7, -0.45, 0.55])
+    tag = np.eye(4)
+    tag_pos = np.array([0.15, -0.05, 0.2])  # on a bracket of the chassis
+    # The base tag faces the camera, its y axis up.
+    tag[:3, :3] = look_at(tag_pos, eye)[:3, :3] @ np.diag([-1.0, -1.0, 1.0])
+    tag[:3, 3] = tag_pos
+    cube = np.eye(4)
+    cube[2, 3] = -0.05
+    c2 = np.eye(4)
+    c2[2, 3] = -0.03  # in the palm, 6 cm behind the grasp point: the whole tag stays in view
+    return SimCameras(
+        T_base_c1=look_at(eye, centre),
+        T_ee_c2=c2,
+        T_ee_cube=cube,
+        T_base_tag=tag,
+        noise_std=noise_std,
+        scale=scale,
+    )
+
+
+@dataclass
+class SimRig:
+    """Everything wired (see :func:`build_sim_rig`)."""
+
+    bush: Bush
+    model: softarm.SoftArm
+    plant: ArmPlant
+    clock: SimClock
+    bank: SafePressureBank
+    vision: CameraVision
+    gripper: SimGripper
+    watch: ArmWatch
+    machine: HarvestMachine
+
+    def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
+        """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
+
+        A berry lost from view (MARKER_LOST) is tried once more after the others: from the
+        eye-to-hand camera a berry tag can hide behind another berry's until that one is
+        picked. The report keeps each berry's last attempt.
+        """
+        report = HarvestReport()
+        order = [b.tag_id for b in self.bush.berries]
+        results: dict[int, BerryResult] = {}
+        for tags in (order, None):
+            if tags is None:  # second pass: the berries lost from view
+                tags = [t for t in order if results[t].fault is FaultReason.MARKER_LOST]
+            for tag in tags:
+                results[tag] = self.machine.run_berry(BerryTarget(tag))
+                if on_berry is not None:
+                    on_berry(order.index(tag), results[tag])
+                if results[tag].fault in FAULTS_THAT_STOP:
+                    report.stopped = results[tag].fault
+                    break
+            if report.stopped is not None:
+                break
+        report.berries = [results.get(t, BerryResult(t)) for t in order]
+        report.extra.update(
+            seed=self.bush.seed,
+            min_branch_gap_m=self.watch.min_gap,
+            branch_contact_steps=self.watch.contacts,
+            sim_time_s=self.clock.now(),
+        )
+        self.machine.log.close()
+        return report
+
+
+def build_sim_rig(
+    options: SimRigOptions | None = None, controller: Controller | None = None
+) -> SimRig:
+    """A simulated rig for ``options`` (a fresh bush, plant and cameras from the seed);
+    ``controller`` defaults to the hybrid ``softarm.Resolver`` on the nominal arm model."""
+    o = options or SimRigOptions()
+    cfg = o.config
+    model = softarm.SoftArm.blackberry()
+    plant = ArmPlant.seeded(model, o.seed + 1000)
+    cams = default_cameras(o.scale, o.noise_std)
+    # The true actuators' range: 0-70 psi through each one's true elongation per psi.
+    true_upper = MAX_PSI * plant.sim.metres_per_psi
+    bush = Bush.generate(
+        plant.arm, o.n_berries, o.seed, grasp_offset=cfg.grasp_offset,
+        unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],
+        limits=(np.zeros_like(true_upper), true_upper),
+    )  # fmt: skip
+    on_bush = list(bush.berries)
+    canes = [b.curve() for b in bush.branches]
+    watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
+    clock = SimClock([plant.advance, watch.sample])
+    bank = SafePressureBank(
+        SimulatedPressureBank(plant, plant.arm.n_actuators), 70.0, 100.0, 0.5, clock.now,
+        watchdog_thread=False,
+    )  # fmt: skip
+    vision = sim_vision(
+        cams, plant.pose, lambda: on_bush, cfg.grasp_offset,
+        seed=o.seed, hidden=o.hidden,
+    )  # fmt: skip
+    gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    if controller is None:
+        resolver = (
+            Resolver(model, mode="hybrid")
+            if o.joint_limit_gain is None
+            else planning_resolver(model, o.joint_limit_gain)
+        )
+        avoid = CaneRepulsion(model, canes) if o.avoid_canes else None
+        controller = ResolverController(resolver, avoid)
+    machine = HarvestMachine(
+        clock,
+        vision,
+        vision,
+        controller,
+        SafeActuator(bank),
+        gripper,
+        gripper,
+        n_actuators=model.n_actuators,
+        config=cfg,
+        log=HarvestLog(o.log_path),
+        ground_truth=gripper,
+        # The canes are known obstacles (mapped), as the curve obstacles of the planning paper.
+        planner=ModelIK(
+            planning_resolver(model),
+            cfg,
+            seed=o.seed,
+            clearance=Clearance(model, canes, cfg.grasp_offset),
+        ),
+    )
+    return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)

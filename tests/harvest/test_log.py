@@ -1,0 +1,57 @@
+"""The JSON-lines log survives a crash: every record up to the last parses."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from softarm.harvest import BerryTarget, HarvestLog, read_log
+
+from .fakes import make_rig
+
+
+def test_crash_mid_run_vents_and_leaves_a_complete_log(tmp_path) -> None:
+    path = tmp_path / "run.jsonl"
+    rig = make_rig(HarvestLog(path))
+    rig.tracker.crash_after = 1.0
+    with pytest.raises(RuntimeError, match="simulated bug"):
+        rig.machine.run([BerryTarget(1)])
+    # No close(): the process "died" here. Every line written so far must parse.
+    lines = path.read_text().splitlines()
+    records = [json.loads(line) for line in lines]
+    assert len(records) == len(rig.machine.log.records)
+    assert records[-1]["kind"] == "crash"
+    assert sum(r["kind"] == "step" for r in records) > 10
+    assert records == rig.machine.log.records  # nothing lost, nothing extra
+    transitions = [r["new"] for r in records if r["kind"] == "transition"]
+    assert transitions[:2] == ["idle", "initial_placement"] and "done" not in transitions
+    assert rig.vented()
+
+
+def test_step_records_hold_the_documented_fields(tmp_path) -> None:
+    rig = make_rig(HarvestLog(tmp_path / "run.jsonl"))
+    rig.machine.run([BerryTarget(1)])
+    rig.machine.log.close()
+    steps = [r for r in read_log(tmp_path / "run.jsonl") if r["kind"] == "step"]
+    placing = [r for r in steps if r["state"] == "initial_placement"]
+    assert placing
+    for key in ("t", "q", "pose", "target", "goal", "position_error", "camera", "saturated"):
+        assert key in placing[0]
+    assert len(placing[0]["q"]) == 3 and len(placing[0]["pose"]) == 4
+
+
+def test_read_log_skips_only_a_truncated_last_line(tmp_path) -> None:
+    path = tmp_path / "cut.jsonl"
+    path.write_text('{"kind": "step", "t": 0.0}\n{"kind": "step", "t": 0.05}\n{"kind": "st')
+    assert [r["t"] for r in read_log(path)] == [0.0, 0.05]
+    path.write_text('{"kind": "step"}\n{"kind": \n{"kind": "step"}\n')
+    with pytest.raises(json.JSONDecodeError):
+        list(read_log(path))
+
+
+def test_nan_is_written_as_null(tmp_path) -> None:
+    log = HarvestLog(tmp_path / "nan.jsonl")
+    log.event("x", value=float("nan"))
+    log.close()
+    assert next(read_log(tmp_path / "nan.jsonl"))["value"] is None
