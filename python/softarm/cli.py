@@ -18,6 +18,7 @@ COMMANDS: dict[str, str] = {
     "harvest": "softarm.commands.harvest",
     "experiment": "softarm.commands.experiment",
     "plan": "softarm.commands.plan",
+    "bench": "softarm.commands.bench",
 }
 
 
