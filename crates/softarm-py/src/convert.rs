@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyDict;
-use softarm_core::{Mat4, Vec3};
+use softarm_core::{Frame, Mat4, Vec3};
 
 use crate::errors::{InputError, ShapeError};
 
@@ -124,6 +124,18 @@ pub fn write_mat4(m: &Mat4, out: &mut [f64]) {
             out[4 * r + c] = m[(r, c)];
         }
     }
+}
+
+/// Writes a rigid frame as a row-major 4×4 homogeneous matrix into `out[..16]`.
+#[inline]
+pub fn write_frame(f: &Frame, out: &mut [f64]) {
+    for r in 0..3 {
+        out[4 * r] = f.rot[(r, 0)];
+        out[4 * r + 1] = f.rot[(r, 1)];
+        out[4 * r + 2] = f.rot[(r, 2)];
+        out[4 * r + 3] = f.pos[r];
+    }
+    out[12..16].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
 }
 
 /// Writes an r×c column-major nalgebra matrix row-major into `out`.

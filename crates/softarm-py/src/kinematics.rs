@@ -8,7 +8,7 @@ use softarm_core::{self as core, Kinematics};
 
 use crate::convert::{
     array, array_view, dmatrix_out, mat4_out, matrix3x_out, points_out, vec3_out, vector,
-    write_dmatrix, write_mat4,
+    write_dmatrix, write_frame, write_mat4,
 };
 use crate::errors::{IntoPyResult, OutOfRangeError};
 
@@ -145,7 +145,7 @@ macro_rules! kinematic_methods {
                     let model = &self.inner;
                     py.detach(|| {
                         for (q, dst) in flat.chunks_exact(n).zip(o.chunks_exact_mut(16)) {
-                            write_mat4(&forward_unchecked(model, q).to_matrix(), dst);
+                            write_frame(&forward_unchecked(model, q), dst);
                         }
                     });
                 }
