@@ -1,5 +1,5 @@
 # ruff: noqa: E501
-"""Accuracy table of the vision path on synthetic images (docs/vision-benchmarks.md).
+"""Accuracy table of the vision path on synthetic images (BENCHMARKS.md).
 
 Eye-to-hand: 1280x720, f = 900 px, mild distortion, the standard 80 mm marker cube about
 1 m away in random poses, pixel noise 2 gray levels. Compares softarm's MarkerCube with
