@@ -131,3 +131,22 @@ def test_no_plan_is_unreachable() -> None:
     assert result.fault is FaultReason.UNREACHABLE
     assert rig.transitions(1) == [S.IDLE, S.INITIAL_PLACEMENT, S.FAULT]
     assert rig.vented()
+
+
+def test_placement_held_by_a_joint_limit_hands_over_to_fine_positioning() -> None:
+    """Placed in position but a limit holds the pointing 20° off: not a fault; fine
+    positioning takes over and grasps inside the gripper's ±1 cm (III-D)."""
+    rig = make_rig()
+    true_pose = rig.plant.pose
+    tilt = np.eye(4)
+    c, s = np.cos(np.radians(20.0)), np.sin(np.radians(20.0))
+    tilt[1:3, 1:3] = [[c, -s], [s, c]]
+    rig.plant.pose = lambda: true_pose() @ tilt  # type: ignore[method-assign]
+    controller = rig.machine.servo.controller
+    step = controller.step
+    controller.step = lambda q, t, cur: (step(q, t, cur)[0], True)  # type: ignore[method-assign]
+    result = rig.machine.run_berry(BerryTarget(1))
+    events = [r["kind"] for r in rig.machine.log.records]
+    assert "placement_limit" in events
+    assert rig.transitions(1)[:3] == [S.IDLE, S.INITIAL_PLACEMENT, S.FINE_POSITIONING]
+    assert result.fault is None and result.harvested

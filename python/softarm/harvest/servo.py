@@ -232,8 +232,15 @@ class Servo:
                     # On a joint limit but inside the gripper's ±1 cm: grasp (III-D).
                     self.log.event("limit_grasp", t=seen.t, error=err)
                     return q
+                if self.state is HarvestState.INITIAL_PLACEMENT and err <= tol:
+                    # Placed, but a joint limit holds the pointing: fine positioning, on
+                    # the eye-in-hand camera, decides whether the berry can be reached.
+                    self.log.event("placement_limit", t=seen.t, error=err, pointing=ang)
+                    return q
                 raise Fault(
-                    FaultReason.UNREACHABLE, f"{self.state.value}: saturated at error {err:.4f} m"
+                    FaultReason.UNREACHABLE,
+                    f"{self.state.value}: saturated at error {err:.4f} m, "
+                    f"pointing {np.degrees(ang):.1f} deg",
                 )
             self._log_step(seen, q_next, goal, (err, ang), saturated)
             self.actuator.send(q_next)
