@@ -29,6 +29,12 @@ pub struct SectionState {
 }
 
 impl SectionState {
+    /// The frame after this section, given the frame `f` at its base.
+    #[inline]
+    fn advance(&self, f: &Frame) -> Frame {
+        f.compose(&self.tip_then_tail(&self.arc.frame(1.0)))
+    }
+
     /// `tip · tail` with the z rotation applied by mixing two columns instead of a full
     /// 3×3 product.
     #[inline]
@@ -90,7 +96,7 @@ pub fn frames_unchecked<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Vec<F
     out.push(f);
     for i in 0..n {
         let st = state(model, q, i);
-        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
+        f = st.advance(&f);
         out.push(f);
     }
     out
@@ -102,7 +108,7 @@ pub fn forward_unchecked<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Fram
     let mut f = Frame::identity();
     for i in 0..model.n_sections() {
         let st = state(model, q, i);
-        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
+        f = st.advance(&f);
     }
     f
 }
@@ -201,7 +207,7 @@ pub fn backbone_unchecked<M: SectionModel + ?Sized>(
             let s = if samples == 1 { 1.0 } else { j as f64 / denom };
             out.push(f.pos + f.rot * st.arc.point(s));
         }
-        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
+        f = st.advance(&f);
     }
     out
 }
@@ -216,7 +222,7 @@ pub fn section_arc_unchecked<M: SectionModel + ?Sized>(
     let mut f = Frame::identity();
     for i in 0..section {
         let st = state(model, q, i);
-        f = f.compose(&st.tip_then_tail(&st.arc.frame(1.0)));
+        f = st.advance(&f);
     }
     (f, state(model, q, section).arc)
 }

@@ -492,20 +492,11 @@ impl Query {
         if ga.signum() != gb.signum() || ga == 0.0 {
             return false;
         }
-        let w = b.u - a.u;
-        let d_max = a.d[k].min(b.d[k]) + bo.speed * w;
-        let foot_speed = match k {
-            0 => {
-                let ratio_min = Self::ratio_min(a, b, bo);
-                if ratio_min <= 0.0 {
-                    return false;
-                }
-                bo.speed / ratio_min
-            }
-            _ => 0.0,
+        // |g_k'| ≤ M on [a, b]: g cannot cross zero if the endpoint values outweigh it.
+        let Some(m) = Self::curvature_bound(a, b, k, bo) else {
+            return false;
         };
-        let m = bo.speed * bo.speed + bo.speed * foot_speed + d_max * bo.accel;
-        0.5 * (ga.abs() + gb.abs() - m * w) > 0.0
+        0.5 * (ga.abs() + gb.abs() - m * (b.u - a.u)) > 0.0
     }
 
     /// Certify, or search, branch `k` on an interval without a − → + sign change.
