@@ -15,6 +15,7 @@ import numpy as np
 
 import softarm
 from softarm._core import Resolver
+from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator
 from softarm.harvest.avoidance import CaneRepulsion
@@ -31,6 +32,7 @@ from softarm.harvest.sim_plant import ArmPlant
 from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
 from softarm.harvest.vision_loop import CameraVision
+from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.pressure import MAX_PSI
 
@@ -57,6 +59,8 @@ class SimRigOptions:
     hidden: Callable[[float], bool] | None = None
     avoid_canes: bool = True
     joint_limit_gain: float | None = None
+    #: The simulated plant's parameters (``--plant FILE``, :mod:`softarm.sim.plant_file`).
+    plant: PlantConfig = field(default_factory=PlantConfig)
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -140,10 +144,16 @@ def build_sim_rig(
     o = options or SimRigOptions()
     cfg = o.config
     model = softarm.SoftArm.blackberry()
-    plant = ArmPlant.seeded(model, o.seed + 1000)
+    if o.plant.model != "pcc":
+        raise ParameterError(
+            f"plant.model = {o.plant.model!r}: this rig builds only the 'pcc' plant"
+        )
+    # softarm identify --sim --seed S identifies this same plant (seed S + 1000).
+    plant = ArmPlant(SimulatedArm(model, o.plant, seed=o.seed + 1000))
     cams = default_cameras(o.scale, o.noise_std)
-    # The true actuators' range: 0-70 psi through each one's true elongation per psi.
-    true_upper = MAX_PSI * plant.sim.metres_per_psi
+    # The true actuators' range: 0-70 psi (or less if the regulators saturate lower)
+    # through each one's true elongation per psi.
+    true_upper = min(MAX_PSI, o.plant.max_psi) * plant.sim.metres_per_psi
     bush = Bush.generate(
         plant.arm, o.n_berries, o.seed, grasp_offset=cfg.grasp_offset,
         unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],

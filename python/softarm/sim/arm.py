@@ -13,7 +13,9 @@ a given seed and runs in simulated time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -21,6 +23,7 @@ import numpy.typing as npt
 from softarm._core import Section, SoftArm
 from softarm.errors import ParameterError, ShapeError
 from softarm.sim.hysteresis import PlayHysteresis
+from softarm.sim.plant_file import plant_from_mapping, validate_plant_value
 from softarm.sim.pressure import MAX_PSI, METRES_PER_PSI, PressureDynamics, to_psi
 from softarm.sim.tracker import PoseTracker
 
@@ -29,7 +32,14 @@ F64 = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class PlantConfig:
-    """Parameters of the simulated plant (SI units unless the name says psi)."""
+    """Parameters of the simulated plant (SI units unless the name says psi).
+
+    Every field is checked against its range in
+    :data:`softarm.sim.plant_file.PLANT_KEYS` (a bad one raises
+    :class:`~softarm.errors.ParameterError` naming it); :meth:`from_mapping` builds one
+    from a ``[plant]`` table and :func:`softarm.sim.plant_file.load_plant_file` from a
+    TOML file (``--plant FILE``).
+    """
 
     #: Relative spread (uniform, +-) of radii, rest lengths and plate offsets.
     geometry_spread: float = 0.03
@@ -48,14 +58,22 @@ class PlantConfig:
     angle_noise: float = math.radians(0.1)
     #: Tracker low-pass cut-off (rad/s), the paper's 10 rad/s.
     cutoff: float = 10.0
+    #: Which physics simulates the arm: "pcc" (constant-curvature arcs) or "cosserat".
+    model: str = "pcc"
+    #: Gravity in the base frame (m/s^2); the constant-curvature plant ignores it.
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
 
     def __post_init__(self) -> None:
-        for name in ("geometry_spread", "twist_spread", "gain_spread", "hysteresis_psi"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and 0.0 <= v):
-                raise ParameterError(f"{name} = {v}: must be finite and >= 0")
-        if self.geometry_spread >= 0.5 or self.gain_spread >= 0.5:
-            raise ParameterError("geometry_spread and gain_spread must be < 0.5")
+        for f in fields(self):
+            value = validate_plant_value(f.name, getattr(self, f.name), where="PlantConfig")
+            object.__setattr__(self, f.name, value)
+
+    @classmethod
+    def from_mapping(cls, mapping: Mapping[str, Any], *, where: str = "plant") -> PlantConfig:
+        """A plant from a ``[plant]`` table (see :mod:`softarm.sim.plant_file`); keys left
+        out keep their defaults. Unknown keys, wrong types and out-of-range values raise
+        :class:`~softarm.errors.ParameterError` naming ``where.key``."""
+        return plant_from_mapping(mapping, where=where)
 
 
 def perturbed_arm(nominal: SoftArm, rng: np.random.Generator, config: PlantConfig) -> SoftArm:
