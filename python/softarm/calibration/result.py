@@ -1,0 +1,183 @@
+"""The fitted model (:class:`Calibration`) and its TOML file (``model.toml``).
+
+``model.toml`` holds the fitted sections in the same ``[[arm.sections]]`` layout as the
+installation config (so its arm can be pasted into ``hw.toml``), the actuator gains and
+the residual statistics on the fit data::
+
+    format = 1
+    [[arm.sections]]
+    radius = 0.0281
+    ...
+    [actuators]
+    gain = [1.02, 0.97, ...]   # true elongation = gain x command
+    [fit]
+    samples = 80
+    position_median_mm = 0.11
+    ...
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import Section, SoftArm
+from softarm.calibration.metrics import PoseErrorStats
+from softarm.errors import ConfigError, NonFiniteError, ShapeError, SoftarmError
+
+__all__ = ["Calibration", "load_calibration", "load_model"]
+
+F64 = npt.NDArray[np.float64]
+
+FORMAT = 1
+_SECTION_KEYS = ("radius", "rest_length", "lower", "upper", "offset", "twist")
+
+
+@dataclass
+class Calibration:
+    """A fitted arm model: ``predict(commands) = arm.forward(actuator_gain * commands)``.
+
+    Attributes:
+        arm: the fitted geometry (elongation limits scaled by the gains).
+        actuator_gain: (n,) true elongation / commanded elongation.
+        fit: residual statistics on the fit data (mm, deg).
+        parameters: fitted deviations from the nominal arm by name (see ``ParameterMap``).
+        parameter_std: their standard deviations from the fit's covariance.
+        converged: the solver's success flag; ``message`` its reason.
+    """
+
+    arm: SoftArm
+    actuator_gain: F64
+    fit: PoseErrorStats
+    parameters: dict[str, float] = field(default_factory=dict)
+    parameter_std: dict[str, float] = field(default_factory=dict)
+    converged: bool = True
+    message: str = ""
+
+    def _commands(self, commands: npt.ArrayLike) -> F64:
+        c = np.asarray(commands, dtype=np.float64)
+        n = self.arm.n_actuators
+        if c.ndim != 2 or c.shape[1] != n:
+            raise ShapeError(f"commands: expected shape (N, {n}), got {c.shape}")
+        if not np.all(np.isfinite(c)):
+            raise NonFiniteError("commands: contains NaN or inf")
+        return c
+
+    def elongations(self, commands: npt.ArrayLike) -> F64:
+        """True elongations (N, n) the fitted model expects for ``commands``."""
+        return self._commands(commands) * self.actuator_gain
+
+    def commands_for(self, elongations: npt.ArrayLike) -> F64:
+        """Commands that give ``elongations`` (m) on the fitted arm: elongation / gain."""
+        e = np.asarray(elongations, dtype=np.float64)
+        if e.shape[-1:] != (self.arm.n_actuators,) or not np.all(np.isfinite(e)):
+            raise ShapeError(f"elongations: expected finite (..., {self.arm.n_actuators})")
+        return e / self.actuator_gain
+
+    def predict(self, commands: npt.ArrayLike) -> F64:
+        """End-effector poses (N, 4, 4) the fitted model predicts for ``commands``."""
+        return self.arm.forward_batch(self.elongations(commands))
+
+    def evaluate(self, commands: npt.ArrayLike, poses: npt.ArrayLike) -> PoseErrorStats:
+        """Prediction errors against measured ``poses`` (N, 4, 4), e.g. held-out data."""
+        pred = self.predict(commands)
+        meas = np.asarray(poses, dtype=np.float64)
+        if meas.shape != pred.shape:
+            raise ShapeError(f"poses: expected shape {pred.shape}, got {meas.shape}")
+        return PoseErrorStats.of(pred, meas)
+
+    # --- model.toml -----------------------------------------------------------------
+
+    def to_toml(self) -> str:
+        """The text of ``model.toml``."""
+        out = [
+            "# softarm fitted arm model (softarm calibrate). SI units: metres, radians.",
+            "# true elongation = actuators.gain x commanded elongation.",
+            f"format = {FORMAT}",
+            f"converged = {'true' if self.converged else 'false'}",
+            "",
+        ]
+        for s in self.arm.sections:
+            out += ["[[arm.sections]]"] + [f"{k} = {getattr(s, k)!r}" for k in _SECTION_KEYS]
+            out.append("")
+        out += ["[actuators]", f"gain = {[float(g) for g in self.actuator_gain]!r}", ""]
+        out += ["[fit]"] + [f"{k} = {v!r}" for k, v in self.fit.as_dict().items()] + [""]
+        out += ["[parameters]"]
+        out += [f"{json.dumps(k)} = {float(v)!r}" for k, v in self.parameters.items()]
+        return "\n".join(out) + "\n"
+
+    def save(self, path: str | Path) -> None:
+        """Write ``model.toml``."""
+        Path(path).write_text(self.to_toml())
+
+    @classmethod
+    def load(cls, path: str | Path) -> Calibration:
+        """Read a ``model.toml``; :class:`~softarm.errors.ConfigError` naming the key
+        when it is missing or malformed."""
+        p = Path(path)
+        try:
+            data = tomllib.loads(p.read_text())
+        except FileNotFoundError:
+            raise ConfigError(f"{p}: no such model file") from None
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            raise ConfigError(f"{p}: cannot read the model: {exc}") from None
+        return cls.from_dict(data, str(p))
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], source: str = "<model>") -> Calibration:
+        """A Calibration from the parsed TOML of :meth:`to_toml`."""
+        if data.get("format") != FORMAT:
+            raise ConfigError(f"{source}: format = {data.get('format')!r}, expected {FORMAT}")
+        raw = data.get("arm", {}).get("sections")
+        if not isinstance(raw, list) or not raw:
+            raise ConfigError(f"{source}: arm.sections: missing or empty")
+        sections = []
+        for i, s in enumerate(raw):
+            key = f"{source}: arm.sections[{i}]"
+            if not isinstance(s, dict) or set(s) != set(_SECTION_KEYS):
+                raise ConfigError(f"{key}: expected exactly the keys {', '.join(_SECTION_KEYS)}")
+            vals = {k: s[k] for k in _SECTION_KEYS}
+            if not all(isinstance(v, int | float) and math.isfinite(v) for v in vals.values()):
+                raise ConfigError(f"{key}: every value must be a finite number")
+            try:
+                sections.append(Section(**vals))
+            except SoftarmError as exc:
+                raise ConfigError(f"{key}: {exc}") from None
+        arm = SoftArm(sections)
+        gain = np.asarray(data.get("actuators", {}).get("gain", []), dtype=object)
+        if gain.shape != (arm.n_actuators,) or not all(
+            isinstance(g, int | float) and math.isfinite(g) and g > 0 for g in gain
+        ):
+            raise ConfigError(
+                f"{source}: actuators.gain: expected {arm.n_actuators} positive finite numbers"
+            )
+        fit_d = data.get("fit", {})
+        names = [f.name for f in fields(PoseErrorStats)]
+        if set(fit_d) != set(names):
+            raise ConfigError(f"{source}: fit: expected exactly the keys {', '.join(names)}")
+        return cls(
+            arm=arm,
+            actuator_gain=gain.astype(np.float64),
+            fit=PoseErrorStats(**fit_d),
+            parameters={str(k): float(v) for k, v in data.get("parameters", {}).items()},
+            converged=bool(data.get("converged", True)),
+        )
+
+
+def load_calibration(path: str | Path) -> Calibration:
+    """The :class:`Calibration` saved in ``path`` (a ``model.toml``)."""
+    return Calibration.load(path)
+
+
+def load_model(path: str | Path) -> SoftArm:
+    """The fitted arm of a ``model.toml``. Its elongations are *true* elongations: send
+    ``calibration.commands_for(q)`` (q / gain) to the actuators, or accept the gains'
+    few-percent error where the loop is closed on the measured pose."""
+    return Calibration.load(path).arm
