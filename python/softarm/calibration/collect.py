@@ -1,0 +1,99 @@
+"""Drive an arm through an excitation set and measure its end-effector poses.
+
+The same driver runs the simulated plant and the hardware: it needs only ``send(q)``
+(elongation command, m), ``sleep(dt)`` (let time pass: the simulated clock or the wall
+clock) and ``measure()`` (the tracker's ``T_base_ee``, or None when the markers are not
+seen). For every pose it
+
+1. ramps from the previous command at no more than ``rate`` (m/s of elongation; the
+   safety layer's 100 psi/s is 0.048 m/s, we stay at half of it by default),
+2. first to ``command - approach`` and then up to ``command``: every actuator reaches
+   its command from below, so the play hysteresis (``softarm.sim.hysteresis``, the braid's
+   friction on the real muscle) leaves the same offset on every pose instead of a
+   direction-dependent one, and a constant offset is absorbed by the fitted rest lengths,
+3. waits ``settle`` seconds (regulator lag 0.08 s, tracker low-pass 0.1 s: 1 s is over
+   five time constants of both),
+4. averages the poses measured over ``average`` seconds (the mean rotation on SO(3)).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+import numpy.typing as npt
+from scipy.spatial.transform import Rotation
+
+from softarm.errors import ParameterError, VisionError
+
+__all__ = ["collect"]
+
+F64 = npt.NDArray[np.float64]
+
+
+def _mean_pose(poses: list[F64]) -> F64:
+    out = np.eye(4)
+    out[:3, 3] = np.mean([p[:3, 3] for p in poses], axis=0)
+    out[:3, :3] = Rotation.from_matrix(np.stack([p[:3, :3] for p in poses])).mean().as_matrix()
+    return out
+
+
+def collect(
+    commands: F64,
+    send: Callable[[F64], None],
+    sleep: Callable[[float], None],
+    measure: Callable[[], F64 | None],
+    *,
+    dt: float = 0.05,
+    rate: float = 0.024,
+    approach: float = 0.002,
+    settle: float = 1.0,
+    average: float = 0.5,
+    on_pose: Callable[[int, F64], None] | None = None,
+) -> tuple[F64, F64]:
+    """Drive through ``commands`` (N, n) and return the commands that were measured and
+    their mean measured poses (M, 4, 4), M <= N (a pose never seen is left out).
+
+    Raises:
+        ParameterError: a non-positive ``dt``, ``rate``, ``settle`` or ``average``.
+        VisionError: fewer than half of the poses were seen.
+    """
+    for name, v in (("dt", dt), ("rate", rate), ("settle", settle), ("average", average)):
+        if not (math.isfinite(v) and v > 0.0):
+            raise ParameterError(f"{name} = {v!r}: must be positive and finite")
+    c = np.asarray(commands, dtype=np.float64)
+    here = np.zeros(c.shape[1])
+    kept_c, kept_p = [], []
+
+    def ramp_to(goal: F64) -> None:
+        nonlocal here
+        steps = max(1, math.ceil(float(np.abs(goal - here).max()) / (rate * dt)))
+        for t in np.linspace(0.0, 1.0, steps + 1)[1:]:
+            send(here + t * (goal - here))
+            sleep(dt)
+        here = goal.copy()
+
+    for k, cmd in enumerate(c):
+        ramp_to(np.maximum(cmd - approach, 0.0))
+        ramp_to(cmd)
+        for _ in range(math.ceil(settle / dt)):
+            send(cmd)
+            sleep(dt)
+        seen = []
+        for _ in range(max(1, math.ceil(average / dt))):
+            send(cmd)
+            sleep(dt)
+            pose = measure()
+            if pose is not None:
+                seen.append(pose)
+        if seen:
+            kept_c.append(cmd)
+            kept_p.append(_mean_pose(seen))
+            if on_pose is not None:
+                on_pose(k, kept_p[-1])
+    if 2 * len(kept_c) < len(c):
+        raise VisionError(
+            f"the end effector was seen at only {len(kept_c)} of {len(c)} calibration poses"
+        )
+    return np.array(kept_c), np.array(kept_p)

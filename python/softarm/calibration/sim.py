@@ -1,0 +1,86 @@
+"""Calibration on the simulated rig's plant: the same plant ``softarm harvest --sim
+--seed S`` runs on (seed S + 1000, the ``[plant]`` table of ``--plant FILE``), measured
+by the simulated tracker (its noise and 10 rad/s low-pass, from the plant config)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import SoftArm
+from softarm.calibration.collect import collect
+from softarm.calibration.excitation import excitation_set
+from softarm.calibration.fit import calibrate
+from softarm.calibration.result import Calibration
+from softarm.sim.arm import PlantConfig
+from softarm.sim.pressure import METRES_PER_PSI
+from softarm.sim.tracker import PoseTracker
+
+__all__ = ["PlantDriver", "build_plant", "calibrate_plant"]
+
+F64 = npt.NDArray[np.float64]
+
+
+def build_plant(model: SoftArm, config: PlantConfig, seed: int) -> object:
+    """The simulated plant of ``config.model`` ("pcc" or "cosserat") drawn from ``seed``
+    (the harvest rig uses ``seed + 1000``), starting vented."""
+    if config.model == "cosserat":
+        from softarm.sim.cosserat import CosseratPlant
+
+        return CosseratPlant(model, config, seed=seed)
+    from softarm.harvest.sim_plant import ArmPlant
+    from softarm.sim.arm import SimulatedArm
+
+    return ArmPlant(SimulatedArm(model, config, seed=seed))
+
+
+@dataclass
+class PlantDriver:
+    """``send``/``sleep``/``measure`` of :func:`~softarm.calibration.collect.collect` on
+    a simulated plant (anything with ``command_pressures``, ``advance`` and ``pose``)."""
+
+    plant: object
+    tracker: PoseTracker | None
+
+    def __post_init__(self) -> None:
+        self.last: F64 | None = None
+
+    def send(self, q: F64) -> None:
+        self.plant.command_pressures(np.asarray(q) / METRES_PER_PSI)  # type: ignore[attr-defined]
+
+    def sleep(self, dt: float) -> None:
+        self.plant.advance(dt)  # type: ignore[attr-defined]
+        pose = self.plant.pose()  # type: ignore[attr-defined]
+        self.last = pose if self.tracker is None else self.tracker.measure(pose, dt)
+
+    def measure(self) -> F64 | None:
+        return self.last
+
+
+def calibrate_plant(
+    plant: object,
+    config: PlantConfig,
+    nominal: SoftArm,
+    *,
+    n_poses: int = 80,
+    seed: int = 0,
+    on_pose: Callable[[int, F64], None] | None = None,
+) -> tuple[Calibration, F64, F64]:
+    """Drive ``plant`` through ``n_poses`` excitation poses measured by a tracker with
+    ``config``'s noise, and fit; returns the calibration and the data (commands, poses)."""
+    tracker = PoseTracker(
+        np.random.default_rng(seed), config.position_noise, config.angle_noise, config.cutoff
+    )
+    drv = PlantDriver(plant, tracker)
+    commands = excitation_set(nominal, n_poses, seed=seed)
+    c, p = collect(commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose)
+    return calibrate(nominal, c, p), c, p
+
+
+def true_poses(plant: object, commands: F64) -> F64:
+    """The plant's noise-free settled poses at ``commands`` (driven as in the fit)."""
+    drv = PlantDriver(plant, None)
+    return collect(commands, drv.send, drv.sleep, drv.measure)[1]

@@ -1,0 +1,37 @@
+"""``softarm calibrate --sim``: drives the simulated plant, writes a model.toml the
+harvest can load."""
+
+import argparse
+
+import numpy as np
+import pytest
+
+from softarm.calibration import Calibration, load_model
+from softarm.commands import calibrate as command
+from softarm.errors import ParameterError
+
+
+def _run(*argv: str) -> int:
+    parser = argparse.ArgumentParser()
+    command.add_parser(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["calibrate", *argv])
+    return int(args.run(args))
+
+
+def test_sim_calibration_writes_a_model(tmp_path, capsys) -> None:
+    out = tmp_path / "model.toml"
+    assert _run("--sim", "--seed", "3", "--poses", "30", "--out", str(out)) == 0
+    cal = Calibration.load(out)
+    assert cal.fit.samples == 30
+    assert cal.fit.position_median_mm < 0.3
+    assert load_model(out).n_actuators == 9
+    assert np.all(np.abs(cal.actuator_gain - 1.0) < 0.1)
+    captured = capsys.readouterr()
+    assert "pose 30/30" in captured.err and "model:" in captured.out
+
+
+def test_bad_options(tmp_path) -> None:
+    with pytest.raises(ParameterError, match="--poses"):
+        _run("--sim", "--poses", "5")
+    with pytest.raises(ParameterError, match="--plant"):
+        _run("--config", "hw.toml", "--plant", "p.toml")
