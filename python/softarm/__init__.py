@@ -48,6 +48,7 @@ from softarm.errors import (
 
 __all__ = [
     "ArcChain",
+    "Calibration",
     "Closest",
     "ConfigError",
     "Gains",
@@ -75,15 +76,24 @@ __all__ = [
     "UnreachableError",
     "VisionError",
     "__version__",
+    "calibrate",
     "closest",
 ]
 
 #: Subpackages imported on first attribute access: vision pulls in OpenCV, and the
 #: kinematics should not pay for that.
-_LAZY_SUBPACKAGES = frozenset({"vision", "sim", "hardware", "harvest", "config", "planning"})
+_LAZY_SUBPACKAGES = frozenset(
+    {"vision", "sim", "hardware", "harvest", "config", "planning", "calibration"}
+)
+
+
+#: Functions and classes re-exported lazily: their subpackage imports scipy.optimize.
+_LAZY_NAMES = {"calibrate": "softarm.calibration", "Calibration": "softarm.calibration"}
 
 
 def __getattr__(name: str) -> ModuleType:
+    if name in _LAZY_NAMES:
+        return getattr(importlib.import_module(_LAZY_NAMES[name]), name)  # type: ignore[no-any-return]
     if name in _LAZY_SUBPACKAGES:
         return importlib.import_module(f"softarm.{name}")
     raise AttributeError(f"module 'softarm' has no attribute {name!r}")

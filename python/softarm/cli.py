@@ -19,6 +19,7 @@ COMMANDS: dict[str, str] = {
     "experiment": "softarm.commands.experiment",
     "plan": "softarm.commands.plan",
     "bench": "softarm.commands.bench",
+    "calibrate": "softarm.commands.calibrate",
 }
 
 
