@@ -10,8 +10,11 @@ np.float64(0.534)
 """
 
 import importlib
+import importlib.metadata
+import pkgutil
 from types import ModuleType
 
+from softarm import _core
 from softarm._core import (
     ArcChain,
     Closest,
@@ -27,7 +30,6 @@ from softarm._core import (
     Solution,
     StepResult,
     TriangleMesh,
-    __version__,
     closest,
 )
 from softarm.errors import (
@@ -80,11 +82,30 @@ __all__ = [
     "closest",
 ]
 
-#: Subpackages imported on first attribute access: vision pulls in OpenCV, and the
-#: kinematics should not pay for that.
+try:
+    #: The installed distribution's version (pyproject.toml), as ``softarm --version``.
+    __version__: str = importlib.metadata.version("softarm")
+except importlib.metadata.PackageNotFoundError:  # run from a source tree, not installed
+    __version__ = _core.__version__
+
+#: Public subpackages and modules, imported on first attribute access: vision pulls in
+#: OpenCV, and the kinematics should not pay for that.
 _LAZY_SUBPACKAGES = frozenset(
-    {"vision", "sim", "hardware", "harvest", "config", "planning", "calibration"}
+    m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")
 )
+
+
+def _attach_python_side() -> None:
+    """Docstrings from the stub (see :mod:`softarm._stubdocs`) and the Python-side
+    constructors of the native classes."""
+    from softarm._arm_config import from_config
+    from softarm._stubdocs import apply_stub_docstrings
+
+    apply_stub_docstrings(_core)
+    SoftArm.from_config = classmethod(from_config)  # type: ignore[attr-defined]
+
+
+_attach_python_side()
 
 
 #: Functions and classes re-exported lazily: their subpackage imports scipy.optimize.
@@ -97,3 +118,8 @@ def __getattr__(name: str) -> ModuleType:
     if name in _LAZY_SUBPACKAGES:
         return importlib.import_module(f"softarm.{name}")
     raise AttributeError(f"module 'softarm' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    # The lazily imported subpackages are part of the API: list them beside the names.
+    return sorted({*__all__, *_LAZY_SUBPACKAGES})

@@ -1,10 +1,13 @@
 """Type stubs for the native module ``softarm._core`` (kept honest by mypy.stubtest)."""
 
 from collections.abc import Sequence
+from pathlib import Path
 from typing import final
 
 import numpy as np
 import numpy.typing as npt
+
+from softarm.config import ArmConfig, Config
 
 __version__: str
 
@@ -73,6 +76,10 @@ class SoftArm(_Kinematics):
     def __new__(cls, sections: list[Section]) -> SoftArm: ...
     @staticmethod
     def blackberry() -> SoftArm: ...
+    @classmethod
+    def from_config(cls, config: str | Path | Config | ArmConfig) -> SoftArm:
+        """The arm of a TOML configuration's ``[arm]`` section (a path, a loaded Config
+        or its ArmConfig); defined in Python (``softarm._arm_config``)."""
     @property
     def n_actuators(self) -> int: ...
     @property

@@ -1,7 +1,12 @@
 """The ``softarm`` command line. Each subcommand lives in ``softarm.commands.<name>`` as a
-module with ``add_parser(subparsers)`` and ``run(args) -> int``; modules are imported
-lazily so that ``softarm --help`` stays fast and a missing optional dependency only
-affects its own command."""
+module with ``add_parser(subparsers)`` and ``run(args) -> int``; a module imports its heavy
+dependencies inside ``run``, so that ``softarm --help`` stays fast and a missing optional
+dependency only affects its own command.
+
+Every parser is a :class:`softarm.commands._args.Parser`: help shows the defaults, and a
+usage error is one line naming the option, exit status 2. A :class:`SoftarmError` raised
+by a command is one line too (exit 2), and so is a stop by SIGINT/SIGTERM (exit 130/143).
+``python -m softarm`` runs the same entry point."""
 
 from __future__ import annotations
 
@@ -10,6 +15,9 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+import softarm
+from softarm.commands._args import Parser
+from softarm.commands._signals import Interrupted
 from softarm.errors import SoftarmError
 
 #: Subcommand name -> module implementing it.
@@ -19,20 +27,42 @@ COMMANDS: dict[str, str] = {
     "experiment": "softarm.commands.experiment",
     "plan": "softarm.commands.plan",
     "bench": "softarm.commands.bench",
+    "config": "softarm.commands.config",
+    "completion": "softarm.commands.completion",
+    "sweep": "softarm.commands.sweep",
+    "tune": "softarm.commands.tune",
     "calibrate": "softarm.commands.calibrate",
 }
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand registered."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="softarm",
         description="Soft robotic harvesting arm: kinematics, control, planning, vision.",
     )
+    parser.add_argument("--version", action="version", version=f"softarm {softarm.__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for module in COMMANDS.values():
-        importlib.import_module(module).add_parser(sub)
+    for name, module in COMMANDS.items():
+        try:
+            importlib.import_module(module).add_parser(sub)
+        except ImportError as exc:
+            _unavailable(sub, name, exc)
     return parser
+
+
+def _unavailable(sub: argparse._SubParsersAction[Parser], name: str, exc: ImportError) -> None:
+    """A command whose module cannot be imported (a missing optional dependency) is
+    listed and says why when run; the other commands keep working."""
+    reason = f"unavailable: {exc}"
+    p = sub.add_parser(name, help=f"({reason})", description=reason)
+    p.add_argument("args", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+
+    def run(args: argparse.Namespace) -> int:
+        print(f"softarm {name}: {reason}", file=sys.stderr)
+        return 2
+
+    p.set_defaults(run=run)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -43,6 +73,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SoftarmError as exc:
         print(f"softarm {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except (Interrupted, KeyboardInterrupt) as exc:
+        # A command that owns hardware handles the signal itself (vent, log); this is the
+        # tidy exit for the others.
+        status = exc.exit_status if isinstance(exc, Interrupted) else 130
+        print(f"softarm {args.command}: {str(exc) or 'interrupted by SIGINT'}", file=sys.stderr)
+        return status
 
 
 if __name__ == "__main__":

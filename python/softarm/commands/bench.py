@@ -6,18 +6,25 @@ recorded in BENCHMARKS.md; this command is a smoke-level check, not a replacemen
 from __future__ import annotations
 
 import argparse
+import json
 import platform
 import time
 from collections.abc import Callable
 
 import numpy as np
 
+from softarm.commands._args import float_range
+from softarm.commands._format import rounded
+
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register the ``bench`` subcommand."""
     p = sub.add_parser("bench", help="time the main operations on this machine")
-    p.add_argument("--seconds", type=float, default=0.3, help="time budget per operation")
+    p.add_argument(
+        "--seconds", type=float_range(0.0, 60.0), default=0.3, help="time budget per operation"
+    )
     p.add_argument("--no-vision", action="store_true", help="skip the OpenCV timings")
+    p.add_argument("--json", action="store_true", help="print the timings as JSON")
     p.set_defaults(run=run)
 
 
@@ -95,10 +102,17 @@ def _cases(with_vision: bool) -> list[tuple[str, Callable[[], object]]]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Time each operation and print a table."""
-    print(
-        f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}"
-    )
+    """Time each operation and print a table (or JSON)."""
+    machine = platform.processor() or platform.machine()
+    if args.json:
+        rows = []
+        for name, fn in _cases(not args.no_vision):
+            median, calls = _median_time(fn, args.seconds)
+            rows.append({"operation": name, "median_s": median, "calls": calls})
+        doc = {"machine": machine, "python": platform.python_version(), "timings": rows}
+        print(json.dumps(rounded(doc, 4), indent=2))
+        return 0
+    print(f"machine: {machine}, python {platform.python_version()}")
     print(f"{'operation':40s} {'median':>12s} {'calls':>8s}")
     for name, fn in _cases(not args.no_vision):
         median, calls = _median_time(fn, args.seconds)

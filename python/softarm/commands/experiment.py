@@ -1,12 +1,19 @@
 """``softarm experiment NAME``: the paper's benchtop experiments (IV-B, IV-C, IV-D) and
-the gain-schedule comparison on the simulated arm."""
+the gain-schedule comparison on the simulated arm. Prints the summaries as JSON (floats
+rounded to 6 significant digits; the files in --out keep full precision)."""
 
 from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
+import time
 from typing import Any
+
+from softarm.commands._args import add_quiet, non_negative_int, output_dir, output_file
+from softarm.commands._format import rounded
+from softarm.commands._progress import Progress
+
+NAMES = ("position", "orientation", "hybrid", "schedule")
 
 
 def add_parser(sub: Any) -> None:
@@ -16,11 +23,12 @@ def add_parser(sub: Any) -> None:
         help="reproduce the paper's benchtop experiments on the simulated arm",
         description=__doc__,
     )
-    p.add_argument("name", choices=["position", "orientation", "hybrid", "schedule", "all"])
-    p.add_argument("--out", type=Path, default=Path("experiments-out"), help="output folder")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("name", choices=[*NAMES, "all"], help="which experiment")
+    p.add_argument("--out", type=output_dir, default="out/experiments", help="output folder")
+    p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the simulated arm")
     p.add_argument("--quick", action="store_true", help="fewer targets, shorter runs")
-    p.add_argument("--report", type=Path, default=None, help="also write a Markdown report")
+    p.add_argument("--report", type=output_file, help="also write a Markdown report")
+    add_quiet(p)
     p.set_defaults(run=run)
 
 
@@ -29,8 +37,16 @@ def run(args: argparse.Namespace) -> int:
     from softarm.experiments import run as run_experiment
     from softarm.experiments.report import write_report
 
-    results = run_experiment(args.name, args.out, seed=args.seed, quick=args.quick)
-    print(json.dumps(results, indent=2, default=str))
+    names = NAMES if args.name == "all" else (args.name,)
+    results: dict[str, Any] = {}
+    with Progress(len(names), "experiments", "experiment", args.quiet) as bar:
+        for name in names:
+            bar.describe(name)
+            start = time.monotonic()
+            results.update(run_experiment(name, args.out, seed=args.seed, quick=args.quick))
+            bar.line(f"{name}: done in {time.monotonic() - start:.1f} s")
+            bar.advance()
+    print(json.dumps(rounded(results), indent=2, default=str))
     if args.report is not None:
         try:
             figures = str(args.out.resolve().relative_to(args.report.parent.resolve()))

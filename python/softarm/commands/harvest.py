@@ -1,4 +1,9 @@
-"""``softarm harvest``: harvest berries with the state machine, simulated or on hardware."""
+"""``softarm harvest``: harvest berries with the state machine, simulated or on hardware.
+
+A progress bar with the ETA runs on stderr (when it is a terminal) and one line per berry
+goes to stdout. SIGINT and SIGTERM stop the run cleanly: the arm is vented, the log gets
+an ``interrupted`` record naming the signal, and the exit status is 130 or 143.
+"""
 
 from __future__ import annotations
 
@@ -7,8 +12,28 @@ import logging
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from softarm.errors import HardwareUnavailableError
+from softarm.commands._args import (
+    add_quiet,
+    config_file,
+    image_file,
+    int_range,
+    non_negative_int,
+    output_file,
+)
+from softarm.commands._progress import Progress
+from softarm.commands._signals import Interrupted, raise_on_signals
+from softarm.errors import ConfigError, HardwareUnavailableError
+
+if TYPE_CHECKING:
+    from softarm.config import Config
+    from softarm.harvest.log import HarvestLog
+    from softarm.harvest.report import HarvestReport
+    from softarm.harvest.sim_rig import SimRig
+
+#: Berries one command may ask for: a bush, not a field.
+MAX_BERRIES = 1000
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -17,49 +42,137 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "harvest",
         help="harvest berries: --sim for the simulated bush, --config for the hardware",
         description="Run the harvesting state machine (paper fig. 4) on a simulated bush "
-        "(--sim) or on the hardware described by a TOML config (--config).",
+        "(--sim) or on the hardware described by a TOML config (--config; write one with "
+        "`softarm config init hw.toml`). Exit status: 0 every berry done, 1 some berry "
+        "faulted, 2 a usage or configuration error or no hardware, 130/143 stopped by "
+        "SIGINT/SIGTERM (the arm is vented).",
     )
     mode = p.add_mutually_exclusive_group(required=True)
     mode.add_argument("--sim", action="store_true", help="simulated arm, cameras and bush")
-    mode.add_argument("--config", type=Path, help="hardware configuration (TOML)")
-    p.add_argument("--berries", type=int, default=5, help="berries to harvest (default 5)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the simulated bush and arm")
-    p.add_argument("--report", type=Path, help="write the JSON report here")
-    p.add_argument("--log", type=Path, help="write the JSON-lines step log here")
-    p.add_argument("--plot", type=Path, help="save a plot of the run (simulation only)")
+    mode.add_argument("--config", type=config_file, help="hardware configuration (TOML)")
+    p.add_argument(
+        "--berries", type=int_range(1, MAX_BERRIES), default=5, help="berries to harvest"
+    )
+    p.add_argument(
+        "--seed", type=non_negative_int, default=0, help="seed of the simulated bush and arm"
+    )
+    p.add_argument("--report", type=output_file, help="write the JSON report here")
+    p.add_argument("--log", type=output_file, help="write the JSON-lines step log here")
+    p.add_argument("--plot", type=image_file, help="save a plot of the run (--sim only)")
+    add_quiet(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the harvest; exit status 0 when every berry ended DONE, 1 otherwise, 2 when
-    the hardware is absent."""
-    # Vents are logged by the safety layer (softarm.hardware.safety): show them tidily.
-    logging.basicConfig(level=logging.WARNING, format="  [%(name)s] %(message)s")
-    if args.sim:
-        return _run_sim(args)
-    return _run_hardware(args)
+    the hardware is absent, 128 + the signal number when stopped by SIGINT/SIGTERM."""
+    if args.plot is not None and not args.sim:
+        print("softarm harvest: error: argument --plot: works with --sim only", file=sys.stderr)
+        return 2
+    configure_logging(args.quiet)
+    with raise_on_signals():
+        try:
+            if args.sim:
+                return run_sim(
+                    args.berries, args.seed, args.log, args.report, args.plot, args.quiet
+                )
+            return _run_hardware(args)
+        except Interrupted as exc:
+            where = f"; log {args.log}" if args.log else ""
+            print(f"softarm harvest: {exc}: arm vented{where}", file=sys.stderr)
+            return exc.exit_status
 
 
-def _run_sim(args: argparse.Namespace) -> int:
+def configure_logging(quiet: bool) -> None:
+    """Vents and refused commands are logged by the safety layer
+    (softarm.hardware.safety) at WARNING: show them tidily, above the progress bar."""
+    logging.basicConfig(
+        level=logging.ERROR if quiet else logging.WARNING, format="  [%(name)s] %(message)s"
+    )
+
+
+def stop(log: HarvestLog, vent: Any, exc: Interrupted) -> None:
+    """The arm vented and the stop recorded (and synced) in the run log."""
+    reason = f"stopped by {exc.name}"
+    try:
+        vent(reason)
+        vented = True
+    except Exception as err:  # a dead driver: still record why the run ended
+        log.event("vent_failed", error=repr(err))
+        vented = False
+    log.event(
+        "interrupted", signal=exc.name, reason=reason, vented=vented, exit_status=exc.exit_status
+    )
+    log.close()
+
+
+def run_sim(
+    berries: int,
+    seed: int,
+    log_path: Path | None,
+    report_path: Path | None,
+    plot_path: Path | None,
+    quiet: bool = False,
+) -> int:
+    """The simulated harvest shared by ``harvest --sim`` and ``demo``."""
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
-    rig = build_sim_rig(SimRigOptions(n_berries=args.berries, seed=args.seed, log_path=args.log))
-    start = time.monotonic()
-
-    def progress(i: int, r: object) -> None:
-        print(_line(i, args.berries, r, time.monotonic() - start), flush=True)
-
-    report = rig.run(progress)
-    print(_summary(report.to_dict()))
-    if args.report:
-        report.save(args.report)
-        print(f"report: {args.report}")
-    if args.plot:
-        from softarm.harvest.plots import plot_run
-
-        plot_run(rig, report, args.plot)
-        print(f"plot: {args.plot}")
+    if not quiet:
+        print(f"simulated harvest: {berries} berries, seed {seed}", flush=True)
+    rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, log_path=log_path))
+    try:
+        report = _harvest(rig, berries, quiet)
+    except Interrupted as exc:
+        stop(rig.machine.log, rig.machine.actuator.vent, exc)
+        raise
+    print(summary(report.to_dict()))
+    if report_path is not None:
+        report.save(report_path)
+        print(f"report: {report_path}")
+    if plot_path is not None:
+        _plot(rig, report, plot_path)
+        print(f"plot: {plot_path}")
+    if log_path is not None:
+        print(f"log: {log_path}")
     return 0 if all(b.final_state.value == "done" for b in report.berries) else 1
+
+
+def _harvest(rig: SimRig, n: int, quiet: bool) -> HarvestReport:
+    seen: set[int] = set()
+    last = time.monotonic()
+    with Progress(n, "harvest", "berry", quiet) as bar:
+
+        def on_berry(i: int, result: object) -> None:
+            nonlocal last
+            now = time.monotonic()
+            retry = i in seen
+            bar.line(line(i, n, result, now - last, retry))
+            last = now
+            if not retry:
+                seen.add(i)
+                bar.advance()
+
+        return rig.run(on_berry)
+
+
+def _plot(rig: SimRig, report: HarvestReport, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from softarm.harvest.plots import plot_run
+
+    plot_run(rig, report, path)
+
+
+def missing_calibration(config: Config) -> list[str]:
+    """Every calibration entry the hardware harvest needs and ``config`` lacks, so that
+    one attempt reports them all."""
+    cal = config.calibration
+    missing = [name for name in ("T_C1_base", "T_C2_EE") if getattr(cal, name) is None]
+    for name, cam in (("c1", cal.c1), ("c2", cal.c2)):
+        if cam.file is None and cam.matrix is None:
+            missing.append(f"c{name[1]}.matrix (or c{name[1]}.file)")
+    return [f"calibration.{m}" for m in missing]
 
 
 def _run_hardware(args: argparse.Namespace) -> int:
@@ -69,9 +182,17 @@ def _run_hardware(args: argparse.Namespace) -> int:
     from softarm.harvest.log import HarvestLog
 
     config = load_config(args.config)
+    missing = missing_calibration(config)
+    if missing:
+        raise ConfigError(
+            f"{args.config}: set {', '.join(missing)} to harvest (see the comments that "
+            "`softarm config init` writes)"
+        )
+    log = HarvestLog(args.log)
     try:
-        rig = build_hardware_rig(config, log=HarvestLog(args.log))
+        rig = build_hardware_rig(config, log=log)
     except HardwareUnavailableError as exc:
+        log.close()
         print(
             f"softarm harvest: hardware not available: {exc}\n"
             "  Check the devices with `python examples/hardware_bringup.py`, "
@@ -82,27 +203,33 @@ def _run_hardware(args: argparse.Namespace) -> int:
     try:
         # On hardware the berries are the tags 10, 11, ... stuck to them (section IV-E).
         report = rig.machine.run([BerryTarget(10 + i) for i in range(args.berries)])
+    except Interrupted as exc:
+        stop(log, rig.machine.actuator.vent, exc)
+        raise
     finally:
-        rig.close()
-    print(_summary(report.to_dict()))
+        rig.close()  # vents and releases every device, whatever happened
+        log.close()
+    print(summary(report.to_dict()))
     if args.report:
         report.save(args.report)
+        print(f"report: {args.report}")
     return 0 if report.stopped is None else 1
 
 
-def _line(i: int, n: int, r: object, wall: float) -> str:
-    """One progress line per berry."""
-    d = r.to_dict()  # type: ignore[attr-defined]
+def line(i: int, n: int, r: Any, wall: float, retry: bool = False) -> str:
+    """One line per berry: its outcome, its error, and its own simulated and wall time."""
+    d = r.to_dict()
     err = d.get("true_position_error_mm") or d.get("position_error_mm")
     what = "harvested" if d["harvested"] else (d["fault"] or "skipped (unripe)")
     err_s = f"{err:.2f} mm" if err is not None else "-"
+    tag = f"tag {d['tag_id']}, retry" if retry else f"tag {d['tag_id']}"
     return (
-        f"berry {i + 1}/{n} (tag {d['tag_id']}): {what:<16} error {err_s:>9}  "
-        f"{d['duration_s']:5.1f} s simulated, {wall:5.1f} s wall"
+        f"berry {i + 1}/{n} ({tag}): {what:<16} error {err_s:>9}  "
+        f"took {d['duration_s']:.1f} s simulated, {wall:.1f} s wall"
     )
 
 
-def _summary(d: dict) -> str:
+def summary(d: dict[str, Any]) -> str:
     """The run summary line."""
     errs = [
         b.get("true_position_error_mm") or b["position_error_mm"]
@@ -116,6 +243,8 @@ def _summary(d: dict) -> str:
             f", min cane gap {1e3 * d['min_branch_gap_m']:.1f} mm, "
             f"{d['branch_contact_steps']} contact steps"
         )
+    if d.get("sim_time_s") is not None:
+        extra += f", {d['sim_time_s']:.1f} s simulated"
     return (
         f"harvested {d['harvested']}/{d['attempted']} ({100 * d['success_rate']:.0f} %), "
         f"mean fine-positioning error {mean}{extra}"

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from softarm.errors import HardwareError, NonFiniteError, SafetyError
+from softarm.errors import HardwareError, NonFiniteError, SafetyError, VisionError
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryLocator,
@@ -148,6 +148,8 @@ class HarvestMachine:
             self._fault(berry, result, FaultReason.NAN_MEASUREMENT, repr(exc))
         except HardwareError as exc:
             self._fault(berry, result, FaultReason.HARDWARE_ERROR, repr(exc))
+        except VisionError as exc:
+            self._fault(berry, result, FaultReason.VISION_ERROR, repr(exc))
         except BaseException as exc:
             # A bug or Ctrl-C: still leave the arm vented and the log synced, then re-raise.
             self._vent(f"unexpected {exc!r}")

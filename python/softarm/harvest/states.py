@@ -41,6 +41,9 @@ class FaultReason(StrEnum):
     NAN_MEASUREMENT = "nan_measurement"
     #: The safety layer refused a command (emergency stop latched, bank closed).
     SAFETY_STOP = "safety_stop"
+    #: A camera frame could not be used (corrupt, empty, wrong size or type). A property
+    #: of that frame, like a lost marker: the run goes on with the next berry.
+    VISION_ERROR = "vision_error"
 
 
 #: Faults after which the whole run stops; the others abandon only the current berry.

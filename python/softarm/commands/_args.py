@@ -1,0 +1,246 @@
+"""Argument types and the parser class shared by every ``softarm`` subcommand.
+
+Each validator is an argparse ``type=``: it runs while the command line is parsed, before
+any work starts, so a bad value costs nothing and is reported as one line naming the
+option (``softarm harvest: error: argument --seed: must be an integer >= 0, got '-5'``)
+with exit status 2. Output paths are checked, not created: a run that will fail to save
+its report must fail before the run, not after it (a failed check creates nothing).
+"""
+
+from __future__ import annotations
+
+import argparse
+import codecs
+import math
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, NoReturn
+
+__all__ = [
+    "DefaultsFormatter",
+    "Parser",
+    "add_quiet",
+    "config_file",
+    "float_range",
+    "image_file",
+    "int_range",
+    "non_negative_int",
+    "output_dir",
+    "output_file",
+    "positive_int",
+]
+
+#: Upper bound of counts typed by a user (berries, repeats, seeds): far beyond any real
+#: run, small enough that a typo (an extra zero or ten) cannot allocate the machine away.
+MAX_COUNT = 1_000_000
+#: Seeds feed ``numpy.random.default_rng``, which takes any non-negative integer; keep
+#: them within 63 bits so they also fit every C ``int64`` they may be passed to.
+MAX_SEED = 2**63 - 1
+
+
+_COMPLETE_FILE = {"bash": "_shtab_compgen_files", "zsh": "_files", "tcsh": "f"}
+_COMPLETE_DIR = {"bash": "_shtab_compgen_dirs", "zsh": "_files -/", "tcsh": "d"}
+
+
+class DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows ``(default: X)`` after every option's help, except where the default says
+    nothing (None, False: a flag that is off, an option that is absent)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        help_ = action.help or ""
+        if action.default in (None, False, argparse.SUPPRESS) or "%(default)" in help_:
+            return help_
+        if not action.option_strings and action.nargs not in ("?", "*"):
+            return help_
+        return f"{help_} (default: %(default)s)" if help_ else "(default: %(default)s)"
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage dump), exit status 2, and
+    whose help shows the defaults. Subparsers inherit the class, so commands registered by
+    ``sub.add_parser(...)`` behave the same without doing anything."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", DefaultsFormatter)
+        super().__init__(*args, **kwargs)
+
+    def _add_action(self, action: argparse.Action) -> argparse.Action:
+        # An option with a default but no help text would hide its default from --help.
+        if (
+            action.help is None
+            and action.option_strings
+            and action.default
+            not in (
+                None,
+                False,
+                argparse.SUPPRESS,
+            )
+        ):
+            action.help = ""
+        # Path options complete file or folder names in `softarm completion` scripts
+        # (shtab reads ``action.complete``; the values are shtab.FILE and DIRECTORY).
+        if action.type in (output_file, image_file, config_file):
+            action.complete = _COMPLETE_FILE  # type: ignore[attr-defined]
+        elif action.type is output_dir:
+            action.complete = _COMPLETE_DIR  # type: ignore[attr-defined]
+        return super()._add_action(action)
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _integer(text: str) -> int:
+    try:
+        return int(text, 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+
+
+def int_range(lo: int, hi: int) -> Callable[[str], int]:
+    """A ``type=`` accepting integers in [lo, hi]."""
+
+    def parse(text: str) -> int:
+        value = _integer(text)
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(
+                f"must be an integer in [{lo}, {hi}], got {text!r}"
+                if hi < MAX_SEED
+                else f"must be an integer >= {lo}, got {text!r}"
+            )
+        return value
+
+    parse.__name__ = f"integer in [{lo}, {hi}]"
+    return parse
+
+
+#: Seeds and other counts that may be zero.
+non_negative_int = int_range(0, MAX_SEED)
+#: Counts of things to do (berries, repeats): at least one.
+positive_int = int_range(1, MAX_COUNT)
+
+
+def float_range(lo: float, hi: float) -> Callable[[str], float]:
+    """A ``type=`` accepting finite numbers in (lo, hi]."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+        if not (math.isfinite(value) and lo < value <= hi):
+            raise argparse.ArgumentTypeError(f"must be a number in ({lo:g}, {hi:g}], got {text!r}")
+        return value
+
+    parse.__name__ = f"number in ({lo:g}, {hi:g}]"
+    return parse
+
+
+def _writable(folder: Path) -> str | None:
+    """None when a file can be created in ``folder``, else why not. A real probe (a
+    temporary file, removed at once): ``os.access`` says yes to root even on /proc or a
+    read-only mount."""
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            return None
+    except OSError as exc:
+        return exc.strerror or str(exc)
+
+
+def _nearest_existing(path: Path) -> Path:
+    for candidate in (path, *path.parents):
+        if candidate.exists():
+            return candidate
+    return Path(".")
+
+
+def output_file(text: str) -> Path:
+    """A ``type=`` for a file the command will write: not a directory, in an existing,
+    writable directory, and writable itself if it exists. Nothing is created."""
+    path = Path(text)
+    if not text or text.endswith(("/", os.sep)) or path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a directory; give a file name")
+    parent = path.parent
+    if not parent.is_dir():
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text!r}: folder {str(parent)!r} does not exist"
+        )
+    if path.exists() and not os.access(path, os.W_OK):
+        raise argparse.ArgumentTypeError(f"cannot write {text!r}: permission denied")
+    why = _writable(parent)
+    if why is not None:
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text!r}: folder {str(parent)!r} is not writable ({why})"
+        )
+    return path
+
+
+#: Formats matplotlib writes without extra packages, by file-name suffix.
+IMAGE_SUFFIXES = frozenset(
+    {".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp"}
+)
+
+
+def image_file(text: str) -> Path:
+    """A ``type=`` for a figure the command will save: :func:`output_file` with a suffix
+    that names a format matplotlib can write."""
+    path = output_file(text)
+    if path.suffix.lower() not in IMAGE_SUFFIXES:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: unknown image format {path.suffix or '(no suffix)'!r}; "
+            f"use one of {', '.join(sorted(IMAGE_SUFFIXES))}"
+        )
+    return path
+
+
+def output_dir(text: str) -> Path:
+    """A ``type=`` for a folder the command will create or fill: an existing writable
+    directory, or a path whose nearest existing ancestor is a writable directory.
+    Nothing is created here (the command creates it once the run is under way)."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} exists and is not a directory")
+    base = _nearest_existing(path)
+    if not base.is_dir():
+        raise argparse.ArgumentTypeError(
+            f"cannot create {text!r}: {str(base)!r} is a file, not a directory"
+        )
+    why = _writable(base)
+    if why is not None:
+        raise argparse.ArgumentTypeError(
+            f"cannot write into {text!r}: {str(base)!r} is not writable ({why})"
+        )
+    return path
+
+
+def config_file(text: str) -> Path:
+    """A ``type=`` for a TOML file the command will read: it must exist and be UTF-8
+    without a byte-order mark (TOML 1.0 requires UTF-8, and a BOM is not TOML)."""
+    path = Path(text)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise argparse.ArgumentTypeError(f"{text!r} does not exist") from None
+    except IsADirectoryError:
+        raise argparse.ArgumentTypeError(f"{text!r} is a directory, not a file") from None
+    except OSError as exc:
+        raise argparse.ArgumentTypeError(f"cannot read {text!r}: {exc.strerror}") from None
+    if data.startswith(codecs.BOM_UTF8):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} starts with a UTF-8 byte-order mark; save it as UTF-8 without BOM"
+        )
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not UTF-8 (byte {data[exc.start]:#04x} at offset {exc.start})"
+        ) from None
+    return path
+
+
+def add_quiet(parser: argparse.ArgumentParser) -> None:
+    """``--quiet``: no progress bar and no per-item lines, only the summary and errors."""
+    parser.add_argument(
+        "-q", "--quiet", action="store_true", help="print only the summary and errors"
+    )

@@ -1,0 +1,68 @@
+"""Progress output of long commands: a tqdm bar with the elapsed time and ETA on stderr,
+and result lines on stdout written through the bar so the two never tear each other.
+
+The bar is drawn only when stderr is a terminal (tqdm's ``disable=None``), so logs and
+pipes get the result lines alone; ``quiet`` silences both.
+"""
+
+from __future__ import annotations
+
+import sys
+from types import TracebackType
+
+from tqdm import tqdm
+
+__all__ = ["Progress"]
+
+
+class Progress:
+    """``with Progress(total, "harvest", "berry", quiet) as p: ... p.line(text); p.advance()``."""
+
+    def __init__(self, total: int | None, desc: str, unit: str = "it", quiet: bool = False):
+        self.quiet = quiet
+        self._bar: tqdm | None = None
+        if not quiet:
+            self._bar = tqdm(
+                total=total,
+                desc=desc,
+                unit=f" {unit}",
+                file=sys.stderr,
+                disable=None,
+                dynamic_ncols=True,
+                leave=False,
+                bar_format="{desc}: {n_fmt}/{total_fmt}{unit} |{bar}| "
+                "{elapsed} elapsed, ETA {remaining}",
+            )
+
+    def line(self, text: str) -> None:
+        """Print a result line above the bar (nothing when quiet)."""
+        if not self.quiet:
+            tqdm.write(text, file=sys.stdout)
+            sys.stdout.flush()
+
+    def advance(self, n: int = 1) -> None:
+        """Count ``n`` more items done."""
+        if self._bar is not None:
+            self._bar.update(n)
+
+    def describe(self, text: str) -> None:
+        """What is running now, shown after the bar."""
+        if self._bar is not None:
+            self._bar.set_postfix_str(text, refresh=True)
+
+    def close(self) -> None:
+        """Remove the bar."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()

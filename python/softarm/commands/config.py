@@ -1,0 +1,106 @@
+"""``softarm config``: write a commented hardware configuration, or check one.
+
+softarm config init hw.toml      # the template: fill in the calibration, then
+softarm config check hw.toml     # says what is still missing before a harvest
+softarm harvest --config hw.toml
+"""
+
+from __future__ import annotations
+
+import argparse
+from importlib import resources
+
+from softarm.commands._args import config_file, output_file
+from softarm.errors import ConfigError
+
+#: Replaces the shipped file's [calibration] tables: every entry the hardware harvest
+#: needs, commented out with a placeholder of the right shape and where its value comes
+#: from. Uncommenting the placeholders gives a file `softarm harvest` accepts as is.
+CALIBRATION = """\
+[calibration]
+# Both poses are 4x4 (rotation block and translation in m). Measure them, replace the
+# identity placeholders and uncomment the two lines:
+#  - T_C1_base is the arm's base in the eye-to-hand camera C1, from the base tag (eq. 22,
+#    softarm.vision.BaseRegistration);
+#  - T_C2_EE is the end effector in the eye-in-hand camera C2, from the hand-eye
+#    calibration (eq. 21).
+# T_C1_base = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+# T_C2_EE = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+
+[calibration.c1]  # eye-to-hand camera (a ZED2 in the paper)
+source = 0  # OpenCV device index, or a video file or stream URL
+# Intrinsics, from a camera calibration: a file written by softarm.vision.CameraModel.save
+# (file = "c1.json") or inline. Replace the placeholders (a 1280x720 camera with f = 900 px
+# and no distortion) and uncomment; distortion is OpenCV's k1, k2, p1, p2, k3.
+# matrix = [[900.0, 0.0, 640.0], [0.0, 900.0, 360.0], [0.0, 0.0, 1.0]]
+# distortion = [0.0, 0.0, 0.0, 0.0, 0.0]
+
+[calibration.c2]  # eye-in-hand camera (a DEPSTECH endoscope in the paper)
+source = 1
+# matrix = [[600.0, 0.0, 320.0], [0.0, 600.0, 240.0], [0.0, 0.0, 1.0]]
+# distortion = [0.0, 0.0, 0.0, 0.0, 0.0]
+
+"""
+
+HEADER = """\
+# softarm hardware configuration, written by `softarm config init`.
+# 1. Fill in [calibration] below (the poses and both cameras' intrinsics).
+# 2. Check the channel names, the serial port and the pressure limits for your rig.
+# 3. `softarm config check THIS_FILE`, then `softarm harvest --config THIS_FILE`.
+# The arm geometry is the blackberry arm of the redundancy paper, as shipped:
+"""
+
+
+def template() -> str:
+    """The commented template: the shipped blackberry configuration with the
+    calibration entries to fill in."""
+    shipped = resources.files("softarm.data").joinpath("blackberry.toml").read_text("utf-8")
+    start, end = shipped.index("\n[calibration]") + 1, shipped.index("\n[channels]") + 1
+    return HEADER + shipped[:start] + CALIBRATION + shipped[end:]
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Register ``config init`` and ``config check``."""
+    p = sub.add_parser(
+        "config",
+        help="write a commented hardware configuration (init) or check one (check)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    actions = p.add_subparsers(dest="action", required=True, metavar="ACTION")
+    init = actions.add_parser("init", help="write the commented template")
+    init.add_argument("path", type=output_file, help="the TOML file to write")
+    init.add_argument("--force", action="store_true", help="overwrite an existing file")
+    init.set_defaults(run=run_init)
+    check = actions.add_parser("check", help="validate a configuration for a harvest")
+    check.add_argument("path", type=config_file, help="the TOML file to check")
+    check.set_defaults(run=run_check)
+
+
+def run_init(args: argparse.Namespace) -> int:
+    """Write the template (refusing to overwrite without --force)."""
+    if args.path.exists() and not args.force:
+        raise ConfigError(f"{args.path} exists; pass --force to overwrite it")
+    args.path.write_text(template(), encoding="utf-8")
+    print(f"wrote {args.path}: fill in [calibration], then `softarm config check {args.path}`")
+    return 0
+
+
+def run_check(args: argparse.Namespace) -> int:
+    """Load and validate; exit 0 when a hardware harvest can start from it, 1 when the
+    calibration is incomplete (each missing entry is named), 2 when it is invalid."""
+    from softarm.commands.harvest import missing_calibration
+    from softarm.config import load_config
+
+    config = load_config(args.path)
+    ch = config.channels
+    print(
+        f"{args.path}: valid; {len(config.arm.sections)} sections, {len(ch.names)} channels, "
+        f"p_max {ch.p_max:g} psi, serial {config.serial.port}"
+    )
+    missing = missing_calibration(config)
+    if missing:
+        print(f"not ready to harvest: set {', '.join(missing)}")
+        return 1
+    print(f"ready: softarm harvest --config {args.path}")
+    return 0
