@@ -9,14 +9,16 @@ from __future__ import annotations
 import os
 import select
 import threading
+import time
 
-from softarm.hardware.serial_protocol import checksum, encode_frame, parse_frame
+from softarm.hardware.serial_protocol import PROTOCOL_VERSION, encode_frame, parse_frame
 
 
 class FakeArduino:
     """Firmware stand-in. Fault switches (counts are consumed one per request):
     ``silent`` ignore requests, ``corrupt`` send replies with a wrong checksum,
-    ``stale`` precede the reply with one for an older sequence number."""
+    ``stale`` precede the reply with one for an older sequence number, ``debug`` precede
+    it with a line of firmware debug text (not a frame)."""
 
     def __init__(self) -> None:
         self.master, self._slave = os.openpty()
@@ -27,6 +29,8 @@ class FakeArduino:
         self.silent = 0
         self.corrupt = 0
         self.stale = 0
+        self.debug = 0
+        self._quiet = threading.Event()
         self.requests: list[tuple[int, list[str]]] = []
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
@@ -43,6 +47,29 @@ class FakeArduino:
                 pass
 
     close = hang_up
+
+    def babble(self, duration_s: float) -> threading.Thread:
+        """Send bytes without a newline for ``duration_s`` s (or until :meth:`stop_babble`)
+        from a thread, returned so a test can see whether it is still babbling."""
+        self._quiet = threading.Event()
+        end = time.monotonic() + duration_s
+
+        def run() -> None:
+            while not self._quiet.is_set() and time.monotonic() < end:
+                _, writable, _ = select.select([], [self.master], [], 0.01)
+                if writable:
+                    try:
+                        os.write(self.master, b"A" * 64)
+                    except OSError:
+                        return
+
+        thread = threading.Thread(target=run, daemon=True)
+        thread.start()
+        return thread
+
+    def stop_babble(self) -> None:
+        """End a :meth:`babble`."""
+        self._quiet.set()
 
     def _run(self) -> None:
         buffer = b""
@@ -67,18 +94,20 @@ class FakeArduino:
         if self.stale > 0:
             self.stale -= 1
             self._send(encode_frame((seq - 1) % 256, "OK", "stale"))
+        if self.debug > 0:
+            self.debug -= 1
+            self._send(b"servo: attached, nir: warm\r\n")
         reply = encode_frame(seq, *self._answer(fields))
         if self.corrupt > 0:
             self.corrupt -= 1
-            good = f"{checksum(reply[1:-4].decode()):02X}".encode()
-            bad = f"{(int(good, 16) ^ 0x5A):02X}".encode()
-            reply = reply[:-3] + bad + b"\n"
+            good = int(reply[-5:-1], 16)
+            reply = reply[:-5] + f"{good ^ 0x5A5A:04X}".encode() + b"\n"
         self._send(reply)
 
     def _answer(self, fields: list[str]) -> list[object]:
         command, args = fields[0], fields[1:]
         if command == "PING":
-            return ["OK", "softarm-fake", 1]
+            return ["OK", "softarm-fake", PROTOCOL_VERSION]
         if command == "GRIP":
             angle = float(args[0])
             if not 0.0 <= angle <= 180.0:

@@ -101,7 +101,7 @@ def test_everything_present(monkeypatch, capsys, arduino: FakeArduino, tmp_path)
     config.write_text(text.replace("startup_delay_s = 2.0", "startup_delay_s = 0.0"))
     assert load_script().main(["--config", str(config), "--port", arduino.path]) == 0
     out = capsys.readouterr().out
-    assert out.count(" ok\n") == 5 and "firmware 'softarm-fake 1'" in out
+    assert out.count(" ok\n") == 5 and "firmware 'softarm-fake 2'" in out
 
 
 def test_present_but_failing_device(monkeypatch, capsys, arduino: FakeArduino, tmp_path) -> None:

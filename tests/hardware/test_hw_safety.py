@@ -109,7 +109,7 @@ def test_late_command_is_preceded_by_a_watchdog_vent(clock: FakeClock) -> None:
 
 def test_watchdog_thread_vents_without_any_call() -> None:
     backend = SimulatedPressureBank(IdealPlant())
-    with SafePressureBank(backend, P_MAX, 1e6, watchdog_timeout_s=0.1) as safe:
+    with SafePressureBank(backend, P_MAX, 1000.0, watchdog_timeout_s=0.1) as safe:
         safe.set_pressures(np.zeros(9))
         time.sleep(0.02)
         safe.set_pressures(np.full(9, 20.0))
@@ -207,8 +207,23 @@ def test_vent_failure_is_a_hardware_error(clock: FakeClock) -> None:
         ({"p_max": 0.0}, "p_max"),
         ({"p_max": 80.0}, "exceeds"),
         ({"p_max": float("nan")}, "p_max"),
+        ({"p_max": 1e300}, "p_max"),
+        ({"p_max": True}, "p_max"),
         ({"max_rate_psi_per_s": -1.0}, "max_rate_psi_per_s"),
         ({"watchdog_timeout_s": float("inf")}, "watchdog_timeout_s"),
+        # Issue 12: safety settings without upper bounds.
+        (
+            {"max_rate_psi_per_s": 1e308},
+            r"max_rate_psi_per_s must be a finite number in \[0.1, 1000\]",
+        ),
+        ({"max_rate_psi_per_s": 0.01}, "max_rate_psi_per_s"),
+        (
+            {"watchdog_timeout_s": 1e308},
+            r"watchdog_timeout_s must be a finite number in \[0.02, 10\]",
+        ),
+        ({"watchdog_timeout_s": 1e-300}, "watchdog_timeout_s"),
+        ({"watchdog_timeout_s": "0.5"}, "watchdog_timeout_s"),
+        ({"watchdog_timeout_s": complex(0.5, 0)}, "watchdog_timeout_s"),
     ],
 )
 def test_bad_parameters(kwargs: dict[str, float], name: str) -> None:

@@ -11,6 +11,7 @@ from softarm.hardware.arduino_devices import (
     ArduinoGripper,
     ArduinoPressureMonitor,
     ArduinoRipenessSensor,
+    ReadingError,
 )
 from softarm.hardware.camera import OpenCVCamera
 from softarm.hardware.daq import NidaqPressureBank
@@ -60,6 +61,7 @@ __all__ = [
     "OpenCVCamera",
     "PressureBank",
     "PressurePlant",
+    "ReadingError",
     "RipenessSensor",
     "SafePressureBank",
     "SerialTimeoutError",

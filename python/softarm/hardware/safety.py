@@ -11,6 +11,8 @@ with its reason and kept in :attr:`SafePressureBank.vent_log`.
 from __future__ import annotations
 
 import logging
+import math
+import numbers
 import threading
 import time
 from collections.abc import Callable
@@ -27,6 +29,7 @@ from softarm.errors import (
     SafetyError,
     ShapeError,
 )
+from softarm.hardware.limits import FULL_SCALE_PSI, MAX_RATE_PSI_PER_S, WATCHDOG_TIMEOUT_S
 from softarm.hardware.protocols import PressureBank
 from softarm.hardware.watchdog import WatchdogThread
 
@@ -36,6 +39,10 @@ FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
 
 _log = logging.getLogger(__name__)
+
+
+def _is_real(value: object) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 @dataclass(frozen=True)
@@ -79,15 +86,25 @@ class SafePressureBank:
 
     Args:
         backend: the pressure bank to protect.
-        p_max: highest pressure (psi) ever forwarded; must not exceed
+        p_max: highest pressure (psi) ever forwarded; in (0, 150] and not above
             ``backend.max_pressure``.
         max_rate_psi_per_s: largest change per channel per second, both directions
-            (a sudden drop whips the arm as much as a sudden rise). Venting is exempt.
-        watchdog_timeout_s: vent when no command has arrived for this long.
+            (a sudden drop whips the arm as much as a sudden rise), in [0.1, 1000].
+            Venting is exempt.
+        watchdog_timeout_s: vent when no command has arrived for this long, in
+            [0.02, 10] s. The ranges and their reasons are in
+            :mod:`softarm.hardware.limits`.
         clock: monotonic time source in seconds; inject a fake one in tests.
         watchdog_thread: run a daemon thread that checks the watchdog every
             ``watchdog_timeout_s / 4`` s. Without it the watchdog is checked only on
             each call and by :meth:`check_watchdog`.
+
+    Raises:
+        ParameterError: a limit is not a finite number inside its range.
+
+    After :meth:`close`, commands and :meth:`read_pressures` raise :class:`SafetyError`;
+    :meth:`vent` and :meth:`emergency_stop` are no-ops (the bank was vented when it
+    closed, and a closed backend must not be called): a stop path never raises.
     """
 
     def __init__(
@@ -100,13 +117,13 @@ class SafePressureBank:
         *,
         watchdog_thread: bool = True,
     ) -> None:
-        for name, value in (
-            ("p_max", p_max),
-            ("max_rate_psi_per_s", max_rate_psi_per_s),
-            ("watchdog_timeout_s", watchdog_timeout_s),
-        ):
-            if not (np.isfinite(value) and value > 0.0):
-                raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
+        rate = MAX_RATE_PSI_PER_S.check(max_rate_psi_per_s)
+        timeout = WATCHDOG_TIMEOUT_S.check(watchdog_timeout_s)
+        if not (_is_real(p_max) and math.isfinite(p_max) and 0.0 < p_max <= FULL_SCALE_PSI.hi):
+            raise ParameterError(
+                f"p_max must be a finite number in (0, {FULL_SCALE_PSI.hi:g}] psi "
+                f"({FULL_SCALE_PSI.why}), got {p_max!r}"
+            )
         if p_max > backend.max_pressure:
             raise ParameterError(
                 f"p_max={p_max!r} psi exceeds the backend's max_pressure="
@@ -114,8 +131,8 @@ class SafePressureBank:
             )
         self._backend = backend
         self._p_max = float(p_max)
-        self._rate = float(max_rate_psi_per_s)
-        self._timeout = float(watchdog_timeout_s)
+        self._rate = rate
+        self._timeout = timeout
         self._clock = clock
         self._lock = threading.RLock()
         self._n = int(backend.channels)
@@ -125,7 +142,7 @@ class SafePressureBank:
         self._latched = False
         self._closed = False
         self.vent_log: list[VentEvent] = []
-        self.vent("startup")
+        self.vent("startup", level=logging.INFO)  # the normal start, not a warning
         self._thread: WatchdogThread | None = None
         if watchdog_thread:
             self._thread = WatchdogThread(
@@ -190,7 +207,11 @@ class SafePressureBank:
                     raise
                 raise HardwareError(f"pressure backend failed: {exc!r}") from exc
             self._last = sent
-            self._last_time = now
+            # Stamp the rate limit *after* the write returns, not at ``now`` (when the
+            # step was decided): the output took effect somewhere inside the write, so
+            # the next command's Δt = its decision time − this stamp never exceeds the
+            # real time between the two outputs, however long a write takes.
+            self._last_time = self._clock()
             self._armed = True
         result = CommandResult(requested, sent.copy(), clamped, rate_limited)
         if clamped.any():
@@ -203,8 +224,14 @@ class SafePressureBank:
         return result
 
     def read_pressures(self) -> FloatArray:
-        """The backend's pressures (psi)."""
+        """The backend's pressures (psi).
+
+        Raises:
+            SafetyError: the bank is closed (the backend is gone).
+        """
         with self._lock:
+            if self._closed:
+                raise SafetyError("pressure bank is closed; cannot read pressures")
             return self._backend.read_pressures()
 
     def check_watchdog(self) -> bool:
@@ -221,16 +248,20 @@ class SafePressureBank:
             self.vent(f"watchdog: no command for {idle:.3f} s (timeout {self._timeout} s)")
             return True
 
-    def vent(self, reason: str = "requested") -> None:
+    def vent(self, reason: str = "requested", *, level: int = logging.WARNING) -> None:
         """Vent every channel now (no rate limit) and log ``reason``.
 
         If the backend's ``vent`` fails, zero pressures are commanded instead; if that
-        fails too, :class:`HardwareError` is raised.
+        fails too, :class:`HardwareError` is raised. After :meth:`close` it does nothing
+        (the bank was vented when it closed; the backend must not be called again).
         """
         with self._lock:
+            if self._closed:
+                _log.info("vent (%s) ignored: the pressure bank is closed and vented", reason)
+                return
             now = self._clock()
             self.vent_log.append(VentEvent(now, reason))
-            _log.warning("venting all %d channels: %s", self._n, reason)
+            _log.log(level, "venting all %d channels: %s", self._n, reason)
             try:
                 self._backend.vent()
             except Exception as exc:
@@ -247,7 +278,7 @@ class SafePressureBank:
 
     def emergency_stop(self, reason: str = "emergency stop") -> None:
         """Vent and latch: every further command raises :class:`SafetyError` until
-        :meth:`reset`."""
+        :meth:`reset`. After :meth:`close` it only latches (see :meth:`vent`)."""
         with self._lock:
             self._latched = True
             self.vent(f"emergency stop: {reason}")

@@ -113,6 +113,7 @@ class SimulatedPressureBank:
         self.writes: list[FloatArray] = []  # every command forwarded, for tests and logs
         self._n = channels
         self._max = max_pressure
+        self.closed = False
 
     @property
     def channels(self) -> int:
@@ -125,7 +126,12 @@ class SimulatedPressureBank:
         return self._max
 
     def set_pressures(self, psi: FloatArray) -> None:
-        """Forward ``psi`` to the plant."""
+        """Forward ``psi`` to the plant.
+
+        Raises:
+            HardwareError: the bank is closed (as a real one would: its task is gone).
+        """
+        self._refuse_if_closed()
         self.faults.check("simulated pressure bank")
         p = np.array(psi, dtype=np.float64)
         if p.shape != (self._n,):
@@ -139,15 +145,22 @@ class SimulatedPressureBank:
 
     def read_pressures(self) -> FloatArray:
         """The plant's pressures (NaN when the ``nan`` fault is set)."""
+        self._refuse_if_closed()
         self.faults.check("simulated pressure bank")
         if self.faults.nan:
             return np.full(self._n, np.nan)
         return np.asarray(self.plant.pressures(), dtype=np.float64)
 
     def close(self) -> None:
-        """Nothing to release; vents if still connected."""
-        if not self.faults.disconnected:
+        """Vent if still connected, then refuse every further call (like a closed DAQ
+        task), so tests see any use after close. Calling it twice is harmless."""
+        if not self.closed and not self.faults.disconnected:
             self.plant.command_pressures(np.zeros(self._n))
+        self.closed = True
+
+    def _refuse_if_closed(self) -> None:
+        if self.closed:
+            raise HardwareError("simulated pressure bank is closed")
 
 
 class SimulatedGripper:

@@ -11,6 +11,8 @@ import logging
 import threading
 from collections.abc import Callable
 
+from softarm.hardware.limits import WATCHDOG_PERIOD_S
+
 __all__ = ["WatchdogThread"]
 
 _log = logging.getLogger(__name__)
@@ -20,12 +22,18 @@ class WatchdogThread:
     """Run ``check()`` every ``period_s`` seconds on a daemon thread.
 
     An exception raised by ``check`` is logged and the thread keeps running: a watchdog
-    that dies on the first error protects nothing.
+    that dies on the first error protects nothing. For the same reason ``period_s`` is
+    bounded (:data:`~softarm.hardware.limits.WATCHDOG_PERIOD_S`): an overflowing period
+    would raise inside ``Event.wait`` (outside the ``try``) and end the thread, a
+    vanishing one would spin.
+
+    Raises:
+        ParameterError: ``period_s`` is not a finite number in [1 ms, 60 s].
     """
 
     def __init__(self, check: Callable[[], object], period_s: float, name: str) -> None:
         self._check = check
-        self._period_s = period_s
+        self._period_s = WATCHDOG_PERIOD_S.check(period_s, "watchdog period_s")
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
 
