@@ -1,0 +1,114 @@
+"""One sweep trial (a plant point harvested on one seed's bush) and its rows of results.
+
+Plain Python, no Ray: the Ray task in :mod:`softarm.sweep.runner` calls
+:func:`run_trial_rows`, which never raises — a trial that fails becomes one row with its
+``error`` — so one bad plant point never stops a sweep.
+"""
+
+from __future__ import annotations
+
+import math
+import socket
+import time
+import traceback
+from typing import Any
+
+from softarm.sweep.spec import TrialSpec
+
+__all__ = ["BERRY_COLUMNS", "error_row", "run_trial", "run_trial_rows"]
+
+#: Per-berry result columns, in table order (after ``trial_id``, ``seed`` and the swept keys).
+BERRY_COLUMNS: tuple[str, ...] = (
+    "berry",
+    "tag_id",
+    "harvested",
+    "true_position_error_mm",
+    "orientation_error_deg",
+    "true_orientation_error_deg",
+    "position_error_mm",
+    "duration_s",
+    "fault",
+    "branch_contact_steps",
+    "min_branch_gap_m",
+    "stopped",
+    "error",
+    "wall_s",
+    "node",
+)
+
+
+def _single_threaded() -> None:
+    """One trial per core: keep OpenCV from spreading one trial's images over every core
+    (it would make the one-core baseline use all of them and scaling look worse)."""
+    try:
+        import cv2
+
+        cv2.setNumThreads(1)
+    except ImportError:  # the rig will say so when it needs it
+        pass
+
+
+def run_trial(trial: TrialSpec) -> Any:
+    """Build the simulated rig for ``trial`` and harvest its bush; returns the report."""
+    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.sweep.gains_file import apply_gains
+    from softarm.sweep.plant_keys import plant_config
+
+    plant = plant_config(trial.plant)
+    options = SimRigOptions(n_berries=trial.berries, seed=trial.seed, plant=plant, **trial.rig)
+    rig = build_sim_rig(options)
+    apply_gains(rig, trial.gains)
+    return rig.run()
+
+
+def _key(trial: TrialSpec) -> dict[str, Any]:
+    from softarm.sweep.plant_keys import column_value
+
+    plant = {k: column_value(v) for k, v in trial.plant.items()}
+    return {"trial_id": trial.trial_id, "seed": trial.seed, **plant}
+
+
+def error_row(trial: TrialSpec, error: str, wall_s: float = math.nan) -> dict[str, Any]:
+    """The single row of a trial that failed (its berries unknown)."""
+    row: dict[str, Any] = dict.fromkeys(BERRY_COLUMNS)
+    row.update(_key(trial), error=error, wall_s=wall_s, node=socket.gethostname())
+    return row
+
+
+def run_trial_rows(trial: TrialSpec) -> list[dict[str, Any]]:
+    """One row per berry of ``trial`` (see :data:`BERRY_COLUMNS`), or one error row."""
+    _single_threaded()
+    start = time.perf_counter()
+    try:
+        report = run_trial(trial).to_dict()
+    except Exception as exc:  # recorded in the table; the sweep goes on
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        where = f" ({last.filename.rsplit('/', 1)[-1]}:{last.lineno})"
+        return [
+            error_row(trial, f"{type(exc).__name__}: {exc}{where}", time.perf_counter() - start)
+        ]
+    wall = time.perf_counter() - start
+    rows = []
+    for i, b in enumerate(report["berries"]):
+        rows.append(
+            {
+                **_key(trial),
+                "berry": i,
+                "tag_id": b["tag_id"],
+                "harvested": bool(b["harvested"]),
+                "true_position_error_mm": b.get("true_position_error_mm"),
+                "orientation_error_deg": b.get("orientation_error_deg"),
+                "true_orientation_error_deg": b.get("true_orientation_error_deg"),
+                "position_error_mm": b.get("position_error_mm"),
+                "duration_s": b.get("duration_s"),
+                "fault": b.get("fault"),
+                # Trial-level figures (the whole bush), repeated on each of its berries.
+                "branch_contact_steps": report.get("branch_contact_steps"),
+                "min_branch_gap_m": report.get("min_branch_gap_m"),
+                "stopped": report.get("stopped"),
+                "error": None,
+                "wall_s": wall,
+                "node": socket.gethostname(),
+            }
+        )
+    return rows
