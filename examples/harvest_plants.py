@@ -16,7 +16,7 @@ import argparse
 import dataclasses
 import json
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -89,8 +89,11 @@ def main() -> None:
     trials = [(t, h, s) for t in args.tau for h in args.hysteresis for s in args.seeds]
     with ProcessPoolExecutor(args.jobs) as pool:
         futures = [pool.submit(one_trial, t, h, s, args.berries) for t, h, s in trials]
-        reports = [f.result() for f in futures]
-    (args.out / "reports.json").write_text(json.dumps(reports, indent=1))
+        reports = []
+        # Written as each bush finishes, so that a run stopped early keeps what it did.
+        for done in as_completed(futures):
+            reports.append(done.result())
+            (args.out / "reports.json").write_text(json.dumps(reports, indent=1))
     rows = summarise(reports)
     (args.out / "summary.json").write_text(json.dumps(rows, indent=1))
     print(
