@@ -43,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"softarm {softarm.__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _UNAVAILABLE.clear()
     for name, module in COMMANDS.items():
         try:
             importlib.import_module(module).add_parser(sub)
@@ -55,19 +56,22 @@ def _unavailable(sub: argparse._SubParsersAction[Parser], name: str, exc: Import
     """A command whose module cannot be imported (a missing optional dependency) is
     listed and says why when run; the other commands keep working."""
     reason = f"unavailable: {exc}"
-    p = sub.add_parser(name, help=f"({reason})", description=reason)
-    p.add_argument("args", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+    sub.add_parser(name, help=f"({reason})", description=reason)
+    _UNAVAILABLE[name] = reason
 
-    def run(args: argparse.Namespace) -> int:
-        print(f"softarm {name}: {reason}", file=sys.stderr)
-        return 2
 
-    p.set_defaults(run=run)
+#: Commands whose module failed to import -> why, filled by :func:`build_parser`.
+_UNAVAILABLE: dict[str, str] = {}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``softarm`` script; returns the exit status."""
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    if argv and argv[0] in _UNAVAILABLE:  # before parsing: its options are unknown
+        print(f"softarm {argv[0]}: {_UNAVAILABLE[argv[0]]}", file=sys.stderr)
+        return 2
+    args = parser.parse_args(argv)
     try:
         return int(args.run(args))
     except SoftarmError as exc:

@@ -20,8 +20,14 @@ import numpy as np
 __all__ = ["HarvestLog", "read_log"]
 
 
+#: Significant digits of the floats in logs and reports: 10 nm on an elongation of a few
+#: cm, 1 ms after 1000 s; the float noise beyond (2.7499999999999982 for 2.75) is gone.
+DIGITS = 7
+
+
 def _plain(value: Any) -> Any:
-    """JSON-ready copy: arrays to lists, NaN/inf to None (strict JSON has no NaN)."""
+    """JSON-ready copy: arrays to lists, NaN/inf to None (strict JSON has no NaN), floats
+    rounded to :data:`DIGITS` significant digits."""
     if isinstance(value, np.ndarray):
         return _plain(value.tolist())
     if isinstance(value, Mapping):
@@ -30,8 +36,8 @@ def _plain(value: Any) -> Any:
         return [_plain(v) for v in value]
     if isinstance(value, np.generic):
         return _plain(value.item())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
+    if isinstance(value, float):
+        return float(f"{value:.{DIGITS}g}") if math.isfinite(value) else None
     if hasattr(value, "value") and isinstance(value.value, str):  # str enums
         return value.value
     return value
