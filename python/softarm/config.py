@@ -20,6 +20,16 @@ from pathlib import Path
 from typing import Any
 
 from softarm.errors import ConfigError
+from softarm.hardware.limits import (
+    BAUD,
+    FULL_SCALE_PSI,
+    MAX_RATE_PSI_PER_S,
+    RETRIES,
+    SERIAL_TIMEOUT_S,
+    STARTUP_DELAY_S,
+    WATCHDOG_TIMEOUT_S,
+    Limit,
+)
 
 __all__ = [
     "ArmConfig",
@@ -195,6 +205,13 @@ class _Table:
             raise self.error(name, "must be > 0" if positive else f"must be >= {lo}")
         return float(value)
 
+    def within(self, name: str, value: Any, limit: Limit) -> Any:
+        """``value`` if it lies in a safety setting's range (``softarm.hardware.limits``,
+        the same check the drivers make), else a ConfigError saying the range and why."""
+        if not limit.contains(value):
+            raise self.error(name, limit.describe())
+        return value
+
     def table(self, name: str, required: bool = False) -> _Table:
         value = self.get(name, ... if required else {})
         if not isinstance(value, dict):
@@ -318,10 +335,22 @@ def _build(root: _Table) -> Config:
     channels = ChannelsConfig(
         names=tuple(names),
         voltage_range=(vr[0], vr[1]),
-        full_scale_psi=ch.number("full_scale_psi", d.full_scale_psi, positive=True),
+        full_scale_psi=ch.within(
+            "full_scale_psi",
+            ch.number("full_scale_psi", d.full_scale_psi, positive=True),
+            FULL_SCALE_PSI,
+        ),
         p_max=ch.number("p_max", d.p_max, positive=True),
-        max_rate_psi_per_s=ch.number("max_rate_psi_per_s", d.max_rate_psi_per_s, positive=True),
-        watchdog_timeout_s=ch.number("watchdog_timeout_s", d.watchdog_timeout_s, positive=True),
+        max_rate_psi_per_s=ch.within(
+            "max_rate_psi_per_s",
+            ch.number("max_rate_psi_per_s", d.max_rate_psi_per_s, positive=True),
+            MAX_RATE_PSI_PER_S,
+        ),
+        watchdog_timeout_s=ch.within(
+            "watchdog_timeout_s",
+            ch.number("watchdog_timeout_s", d.watchdog_timeout_s, positive=True),
+            WATCHDOG_TIMEOUT_S,
+        ),
         metres_per_psi=ch.number("metres_per_psi", d.metres_per_psi, positive=True),
     )
     if channels.p_max > channels.full_scale_psi:
@@ -348,10 +377,16 @@ def _build(root: _Table) -> Config:
         raise se.error("retries", "must be a non-negative integer")
     serial = SerialConfig(
         port,
-        baud,
-        se.number("timeout_s", d2.timeout_s, positive=True),
-        retries,
-        se.number("startup_delay_s", d2.startup_delay_s, lo=0.0),
+        se.within("baud", baud, BAUD),
+        se.within(
+            "timeout_s", se.number("timeout_s", d2.timeout_s, positive=True), SERIAL_TIMEOUT_S
+        ),
+        se.within("retries", retries, RETRIES),
+        se.within(
+            "startup_delay_s",
+            se.number("startup_delay_s", d2.startup_delay_s, lo=0.0),
+            STARTUP_DELAY_S,
+        ),
     )
     se.done()
     root.done()

@@ -9,12 +9,18 @@ import numpy as np
 import pytest
 from fake_arduino import FakeArduino
 
-from softarm.errors import HardwareError, HardwareUnavailableError, OutOfRangeError
+from softarm.errors import (
+    HardwareError,
+    HardwareUnavailableError,
+    OutOfRangeError,
+    ParameterError,
+)
 from softarm.hardware.arduino import ArduinoLink
 from softarm.hardware.arduino_devices import (
     ArduinoGripper,
     ArduinoPressureMonitor,
     ArduinoRipenessSensor,
+    ReadingError,
 )
 from softarm.hardware.serial_protocol import (
     MAX_FRAME_BYTES,
@@ -236,6 +242,80 @@ def test_sensor_values_are_validated(arduino: FakeArduino) -> None:
                 sensor.read()
         with pytest.raises(OutOfRangeError, match="fraction"):
             ArduinoGripper(link).set_position(1.2)
+
+
+@pytest.mark.parametrize(
+    ("angle", "message"),
+    [(-45.0, r"\[0, 180\] deg, got -45.0"), (181.0, r"\[0, 180\]"), (5.0, r"open 10°")],
+)
+def test_gripper_angles_outside_the_servo_or_configured_range_are_faults(
+    arduino: FakeArduino, angle: float, message: str
+) -> None:
+    """Issue 12 item 14: -45° used to read as position -0.34."""
+    with link_to(arduino) as link:
+        gripper = ArduinoGripper(link, open_deg=10.0, closed_deg=170.0)
+        arduino.angle = angle
+        with pytest.raises(ReadingError, match=message):
+            _ = gripper.position
+
+
+def test_gripper_position_within_reporting_resolution_of_an_end_is_clipped(
+    arduino: FakeArduino,
+) -> None:
+    with link_to(arduino) as link:
+        gripper = ArduinoGripper(link, open_deg=10.04, closed_deg=169.96)
+        gripper.open()  # commanded as "10.0": the firmware reports 0.1° steps
+        assert arduino.angle == 10.0 and gripper.position == 0.0
+        gripper.close()
+        assert gripper.position == 1.0
+
+
+@pytest.mark.parametrize(
+    ("raw", "message"),
+    [("-30.0", r"PRES channel 3 .* got -30.0"), ("1e300", "got 1e"), ("146.0", r"145\]")],
+)
+def test_pressure_readings_outside_the_physical_range_are_faults(
+    arduino: FakeArduino, raw: str, message: str
+) -> None:
+    with link_to(arduino) as link:
+        monitor = ArduinoPressureMonitor(link)
+        arduino.pressures[3] = raw
+        with pytest.raises(ReadingError, match=message):
+            monitor.read_pressures()
+        arduino.pressures[3] = "-0.4"  # a gauge offset at rest is fine
+        assert monitor()[3] == -0.4
+
+
+@pytest.mark.parametrize("raw", [" 1.5", "1_0", "infinity", "0x1", "1.", ".5"])
+def test_readings_must_be_plain_decimals(arduino: FakeArduino, raw: str) -> None:
+    with link_to(arduino) as link:
+        arduino.nir = raw
+        with pytest.raises(HardwareError):
+            ArduinoRipenessSensor(link).read()
+
+
+def test_monitor_parameters_are_checked(arduino: FakeArduino) -> None:
+    with link_to(arduino) as link:
+        for kwargs in ({"channels": 0}, {"channels": True}, {"valid_psi": (5.0, 1.0)}):
+            with pytest.raises(ParameterError):
+                ArduinoPressureMonitor(link, **kwargs)  # type: ignore[arg-type]
+
+
+def test_link_settings_are_bounded(arduino: FakeArduino) -> None:
+    """Issue 12 item 12: timeout_s or startup_delay_s = 1e308 raised OverflowError."""
+    for kwargs, name in (
+        ({"timeout_s": 1e308}, "timeout_s"),
+        ({"timeout_s": 1e-9}, "timeout_s"),
+        ({"timeout_s": float("nan")}, "timeout_s"),
+        ({"startup_delay_s": 1e308}, "startup_delay_s"),
+        ({"startup_delay_s": -1.0}, "startup_delay_s"),
+        ({"retries": 10**6}, "retries"),
+        ({"retries": 1.5}, "retries"),
+        ({"retries": True}, "retries"),
+        ({"baud": 10**30}, "baud"),
+    ):
+        with pytest.raises(ParameterError, match=name):
+            ArduinoLink(arduino.path, **kwargs)  # type: ignore[arg-type]
 
 
 def test_missing_port_is_unavailable(tmp_path) -> None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
+from typing import cast
 
 from softarm.errors import ParameterError
 
@@ -78,7 +79,8 @@ class Limit:
         """
         if not self.contains(value):
             raise ParameterError(f"{name or self.name} {self.describe()}, got {value!r}")
-        return int(value) if self.integer else float(value)  # type: ignore[arg-type]
+        number = cast(float, value)  # contains() checked it is a real number
+        return int(number) if self.integer else float(number)
 
 
 WATCHDOG_TIMEOUT_S = Limit(
