@@ -32,6 +32,7 @@ COMMANDS: dict[str, str] = {
     "sweep": "softarm.commands.sweep",
     "tune": "softarm.commands.tune",
     "calibrate": "softarm.commands.calibrate",
+    "identify": "softarm.commands.identify",
 }
 
 
