@@ -8,10 +8,10 @@ export PATH := $(abspath $(VENV))/bin:$(PATH)
 # Non-interactive plotting everywhere (CI, headless machines).
 export MPLBACKEND ?= Agg
 
-.PHONY: help venv dev test test-rust test-python demo lint fmt bench clean
+.PHONY: help venv dev install test test-rust test-python demo lint fmt bench clean
 
 help:
-	@echo "make demo   - simulated harvest with plots (no hardware)"
+	@echo "make demo   - simulated harvest with plots (no hardware, no test tools)"
 	@echo "make test   - set up .venv, build, run cargo test and pytest"
 	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
 	@echo "make bench  - criterion and pytest-benchmark"
@@ -28,6 +28,10 @@ venv: $(VENV)/.stamp
 dev: venv
 	$(VENV)/bin/maturin develop --release --extras test -q
 
+# The same build with the runtime dependencies only: what a user of `make demo` needs.
+install: venv
+	$(VENV)/bin/maturin develop --release -q
+
 test-rust:
 	cargo test --release -p softarm-core
 
@@ -37,7 +41,7 @@ test-python: dev
 test: dev test-rust
 	$(PY) -m pytest -q
 
-demo: dev
+demo: install
 	$(VENV)/bin/softarm demo
 
 lint: dev

@@ -248,3 +248,19 @@ def test_package_surface() -> None:
     import pydoc
 
     assert "Constructor: Gains(" in pydoc.render_doc(softarm.Gains)
+
+
+def test_a_normal_start_logs_no_warning(caplog: pytest.LogCaptureFixture) -> None:
+    """The startup vent is routine (INFO); a vent for a reason stays a WARNING."""
+    import logging
+
+    from softarm.hardware import IdealPlant, SafePressureBank, SimulatedPressureBank
+
+    with caplog.at_level(logging.INFO, logger="softarm"):
+        bank = SafePressureBank(
+            SimulatedPressureBank(IdealPlant(9), 9), 70.0, 100.0, 0.5, watchdog_thread=False
+        )
+        assert [r.levelno for r in caplog.records] == [logging.INFO]
+        bank.vent("fault: test")
+        assert caplog.records[-1].levelno == logging.WARNING
+        bank.close()

@@ -1,0 +1,100 @@
+"""The README cannot drift from the code: every ```python block runs as pasted, every
+`softarm ...` line of a ```sh block parses with the real command-line parser, every
+`make X` names a Makefile target, and every optional extra of pyproject.toml is
+documented."""
+
+from __future__ import annotations
+
+import re
+import shlex
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from softarm import cli
+
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.DOTALL | re.MULTILINE)
+
+
+def blocks(language: str) -> list[str]:
+    return [body for lang, body in BLOCK.findall(README) if lang == language]
+
+
+def commands(program: str) -> list[str]:
+    """Lines of the sh blocks that run ``program``, without their comments."""
+    found = []
+    for body in blocks("sh"):
+        for line in body.splitlines():
+            words = shlex.split(line, comments=True)
+            if words[:1] == [program]:
+                found.append(words)
+    return found
+
+
+def test_there_is_something_to_check() -> None:
+    assert blocks("python") and commands("softarm") and commands("make")
+
+
+@pytest.mark.parametrize("index", range(len(blocks("python"))))
+def test_python_block_runs(index: int, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)  # whatever a block writes stays out of the repository
+    code = blocks("python")[index]
+    exec(compile(code, f"README.md python block {index}", "exec"), {"__name__": "__readme__"})
+
+
+@pytest.mark.parametrize("words", commands("softarm"), ids=" ".join)
+def test_softarm_line_parses(
+    words: list[str],
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.chdir(tmp_path)  # relative output paths resolve in a scratch folder
+    parser = cli.build_parser()
+    args = words[1:]
+    if any(a in ("--help", "-h", "--version") for a in args):
+        with pytest.raises(SystemExit) as exit_:
+            parser.parse_args(args)
+        assert exit_.value.code == 0
+        return
+    try:
+        parsed = parser.parse_args(args)
+    except SystemExit:
+        err = capsys.readouterr().err
+        # The only acceptable failure is a config file that the example expects the
+        # reader to have written first (`softarm config init hw.toml`).
+        assert "hw.toml" in err and "does not exist" in err, err
+        return
+    assert callable(parsed.run)
+
+
+def test_make_targets_exist() -> None:
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    targets = set(re.findall(r"(?m)^([\w-]+):", makefile))
+    for words in commands("make"):
+        assert words[1] in targets, f"make {words[1]}: no such target"
+
+
+def test_every_extra_is_documented() -> None:
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"][
+        "optional-dependencies"
+    ]
+    for name in extras:
+        assert f"| `{name}` |" in README, f"extra {name!r} is not in the README's table"
+
+
+def test_license_and_citation() -> None:
+    assert (ROOT / "LICENSE").read_text(encoding="utf-8").startswith("MIT License")
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert meta["license"] == {"text": "MIT"}
+    yaml = pytest.importorskip("yaml")
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))
+    assert cff["cff-version"] == "1.2.0" and cff["license"] == "MIT"
+    assert cff["version"] == meta["version"]
+    titles = [r["title"] for r in cff["references"]]
+    assert any("Redundancy Resolution" in t for t in titles)
+    assert any("Path Planning of Soft Robotic Arms" in t for t in titles)
+    assert all(r["authors"] and r["year"] for r in cff["references"])
