@@ -96,3 +96,24 @@ def test_limits_reject_non_numbers(bad: object) -> None:
         assert not limit.contains(bad)
         with pytest.raises(ParameterError, match=limit.name):
             limit.check(bad)
+
+
+def test_the_config_loader_imports_the_limits_without_the_drivers() -> None:
+    """softarm.hardware is lazy: the config loader gets the table without pyserial."""
+    import subprocess
+    import sys
+
+    code = "import sys, softarm.config; print('serial' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_the_lazy_package_exports_every_name() -> None:
+    import softarm.hardware as hw
+
+    assert set(hw.__all__) == set(hw._WHERE)
+    for name in hw.__all__:
+        value = getattr(hw, name)
+        assert name.isupper() or value.__module__ == f"softarm.hardware.{hw._WHERE[name]}"
+    with pytest.raises(AttributeError, match="no attribute 'Nope'"):
+        _ = hw.Nope

@@ -101,3 +101,11 @@ def test_behind_the_safety_layer(fake_nidaqmx) -> None:
     writes = np.array(fake_nidaqmx.tasks[0].writes)
     assert writes.max() == pytest.approx(5.0 * 70.0 / VoltageMap().full_scale_psi)
     assert writes.min() == 0.0 and not writes[-1].any()
+
+
+@pytest.mark.parametrize("reading", [np.zeros(8), np.r_[np.zeros(8), np.nan], ["x"] * 9])
+def test_a_bad_monitor_reading_is_a_hardware_error(fake_nidaqmx, reading: object) -> None:
+    bank = NidaqPressureBank(CHANNELS, monitor=lambda: reading)  # type: ignore[arg-type,return-value]
+    with pytest.raises(HardwareError, match="pressure monitor"):
+        bank.read_pressures()
+    bank.close()

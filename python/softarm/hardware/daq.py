@@ -110,10 +110,22 @@ class NidaqPressureBank:
         self.set_pressures(np.zeros(self.channels))
 
     def read_pressures(self) -> FloatArray:
-        """Measured pressures if a monitor was given, else the last command (psi)."""
-        if self._monitor is not None:
-            return np.asarray(self._monitor(), dtype=np.float64)
-        return self._last.copy()
+        """Measured pressures if a monitor was given, else the last command (psi).
+
+        Raises:
+            HardwareError: the monitor's reading is not ``channels`` finite numbers.
+        """
+        if self._monitor is None:
+            return self._last.copy()
+        try:
+            p = np.asarray(self._monitor(), dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise HardwareError(f"pressure monitor returned a non-numeric reading: {exc}") from exc
+        if p.shape != (self.channels,) or not np.all(np.isfinite(p)):
+            raise HardwareError(
+                f"pressure monitor must return {self.channels} finite values (psi), got {p!r}"
+            )
+        return p
 
     def close(self) -> None:
         """Vent, then close the task. Calling it twice is harmless."""
