@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
+from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._signals import Interrupted, raise_on_signals
 
 #: What the demo writes into --out.
@@ -23,6 +24,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--out", type=output_dir, default="out", help="output folder")
     p.add_argument("--berries", type=int_range(1, 1000), default=5, help="berries to harvest")
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the bush and arm")
+    add_plant_options(p, sim_only_flag=False)
     add_quiet(p)
     p.set_defaults(run=run)
 
@@ -31,6 +33,7 @@ def run(args: argparse.Namespace) -> int:
     """Harvest, print a line per berry and the summary, save the figures."""
     from softarm.commands.harvest import configure_logging, run_sim
 
+    options = plant_options(args)  # a bad --plant/--identified fails before any output
     configure_logging(args.quiet)
     args.out.mkdir(parents=True, exist_ok=True)
     log = args.out / "harvest_log.jsonl"
@@ -38,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     report, plot = args.out / "harvest_report.json", args.out / "harvest.png"
     with raise_on_signals():
         try:
-            run_sim(args.berries, args.seed, log, report, plot, args.quiet)
+            run_sim(args.berries, args.seed, log, report, plot, args.quiet, **options)
         except Interrupted as exc:
             print(f"softarm demo: {exc}: arm vented; log {log}", file=sys.stderr)
             return exc.exit_status

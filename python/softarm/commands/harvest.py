@@ -22,6 +22,7 @@ from softarm.commands._args import (
     non_negative_int,
     output_file,
 )
+from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
 from softarm.commands._signals import Interrupted, raise_on_signals
 from softarm.errors import ConfigError, HardwareUnavailableError
@@ -59,6 +60,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--report", type=output_file, help="write the JSON report here")
     p.add_argument("--log", type=output_file, help="write the JSON-lines step log here")
     p.add_argument("--plot", type=image_file, help="save a plot of the run (--sim only)")
+    add_plant_options(p)
     add_quiet(p)
     p.set_defaults(run=run)
 
@@ -72,10 +74,12 @@ def run(args: argparse.Namespace) -> int:
     configure_logging(args.quiet)
     with raise_on_signals():
         try:
+            options = plant_options(args)
             if args.sim:
                 return run_sim(
-                    args.berries, args.seed, args.log, args.report, args.plot, args.quiet
-                )
+                    args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
+                    **options,
+                )  # fmt: skip
             return _run_hardware(args)
         except Interrupted as exc:
             where = f"; log {args.log}" if args.log else ""
@@ -113,13 +117,15 @@ def run_sim(
     report_path: Path | None,
     plot_path: Path | None,
     quiet: bool = False,
+    **options: Any,
 ) -> int:
-    """The simulated harvest shared by ``harvest --sim`` and ``demo``."""
+    """The simulated harvest shared by ``harvest --sim`` and ``demo``; ``options`` are
+    more ``SimRigOptions`` (``plant``, ``identified``: see ``commands/_plant.py``)."""
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
     if not quiet:
         print(f"simulated harvest: {berries} berries, seed {seed}", flush=True)
-    rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, log_path=log_path))
+    rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, log_path=log_path, **options))
     try:
         report = _harvest(rig, berries, quiet)
     except Interrupted as exc:

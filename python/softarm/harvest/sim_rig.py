@@ -32,6 +32,7 @@ from softarm.harvest.sim_plant import ArmPlant
 from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
 from softarm.harvest.vision_loop import CameraVision
+from softarm.identification.result import IdentifiedPlant
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.pressure import MAX_PSI
@@ -61,6 +62,8 @@ class SimRigOptions:
     joint_limit_gain: float | None = None
     #: The simulated plant's parameters (``--plant FILE``, :mod:`softarm.sim.plant_file`).
     plant: PlantConfig = field(default_factory=PlantConfig)
+    #: The plant `softarm identify` measured (``--identified id.json``), for lag-aware control.
+    identified: IdentifiedPlant | None = None
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:

@@ -1,0 +1,51 @@
+"""``--plant FILE`` and ``--identified id.json``, shared by every command that builds the
+simulated rig (``harvest --sim``, ``demo``): the simulated plant's ``[plant]`` table
+(:mod:`softarm.sim.plant_file`) and the plant ``softarm identify`` measured
+(:mod:`softarm.identification.result`). Both files are read and checked before the run
+starts; a bad one is a one-line error naming the key (exit status 2)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from softarm.commands._args import config_file
+from softarm.errors import ParameterError
+
+__all__ = ["add_plant_options", "plant_options"]
+
+
+def add_plant_options(p: argparse.ArgumentParser, *, sim_only_flag: bool = True) -> None:
+    """Add ``--plant`` and ``--identified`` to ``p``."""
+    p.add_argument(
+        "--plant",
+        type=config_file,
+        help="simulated plant parameters: a TOML [plant] table (docs/identification.md)"
+        + (" (--sim only)" if sim_only_flag else ""),
+    )
+    p.add_argument(
+        "--identified",
+        type=config_file,
+        help="the plant `softarm identify` measured (id.json), checked and passed to the rig "
+        "as SimRigOptions.identified (per-channel lag tau_s, control period)",
+    )
+
+
+def plant_options(args: argparse.Namespace) -> dict[str, Any]:
+    """``SimRigOptions`` keywords from the parsed options (files read and validated).
+
+    Raises:
+        ParameterError: ``--plant`` without ``--sim``.
+        ConfigError: a file is unreadable or holds a bad key or value.
+    """
+    from softarm.identification.result import load_identified
+    from softarm.sim.plant_file import load_plant_file
+
+    out: dict[str, Any] = {}
+    if getattr(args, "plant", None) is not None:
+        if not getattr(args, "sim", True):
+            raise ParameterError("--plant: works with --sim only (the hardware is its own plant)")
+        out["plant"] = load_plant_file(args.plant)
+    if getattr(args, "identified", None) is not None:
+        out["identified"] = load_identified(args.identified)
+    return out
