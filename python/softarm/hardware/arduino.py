@@ -49,11 +49,12 @@ except ImportError:  # Windows
 class ArduinoLink:
     """A request/reply session with the Arduino over a serial port.
 
-    A request ends within ``timeout_s × (1 + retries)`` (plus one write) whatever the
-    line does: bytes are read in bounded chunks against a deadline, never with
-    ``readline`` (which waits for a newline as long as bytes keep coming), and a line
-    longer than :data:`~softarm.hardware.serial_protocol.MAX_FRAME_BYTES` is dropped up
-    to its newline, so a babbling device can neither hold a request nor grow a buffer.
+    A request ends within ``timeout_s × (1 + retries)`` whatever the line does: bytes are
+    read in bounded chunks against each attempt's deadline, never with ``readline``
+    (which waits for a newline as long as bytes keep coming), and a line longer than
+    :data:`~softarm.hardware.serial_protocol.MAX_FRAME_BYTES` is dropped up to its
+    newline, so a babbling device can neither hold a request nor grow a buffer. (A write
+    that blocks is cut off by pyserial's ``write_timeout``, also ``timeout_s``.)
 
     Within an attempt, lines that are not frames of this request are skipped: debug
     text (not starting with ``$``) and well-formed replies to other sequence numbers.
@@ -130,9 +131,10 @@ class ArduinoLink:
                 seq = self._next_seq()
                 seqs.add(seq)
                 frame = encode_frame(seq, command, *args)  # a bad argument is not retried
+                deadline = self._clock() + self._timeout  # the write counts against it too
                 try:
                     self._serial.write(frame)
-                    reply = self._await(seqs, command, self._clock() + self._timeout)
+                    reply = self._await(seqs, command, deadline)
                 except (SerialTimeoutError, FrameError) as exc:
                     _log.warning("%s on %s, attempt %d: %s", command, self.port, attempt + 1, exc)
                     last = exc
