@@ -15,7 +15,7 @@ Framing (NMEA-like, one frame per line, printable ASCII, ``\\n``-terminated)::
   2-bit errors); a CRC-16 detects every 1-, 2- and 3-bit error in a frame this short.
 * Only the canonical form is accepted: one ``$``, fields of printable ASCII (0x20–0x7E)
   without ``$``, ``*`` or ``,``, the upper-case CRC, ``\\n`` or ``\\r\\n``, at most
-  :data:`MAX_FRAME_BYTES` bytes. Lower-case or short hex, spaces, leading zeros: rejected
+  :data:`MAX_FRAME_BYTES` bytes. Lower-case, short or padded hex, leading zeros: rejected
   (each alternative spelling would let a bit flip turn one valid frame into another).
 * A line that does not start with ``$`` is not a frame (firmware debug output): the host
   skips it. A line that starts with ``$`` but fails these checks is a corrupted frame.
