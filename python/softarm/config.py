@@ -38,6 +38,7 @@ __all__ = [
     "ChannelsConfig",
     "Config",
     "GainsConfig",
+    "PlantModelConfig",
     "SectionConfig",
     "SerialConfig",
     "default_config",
@@ -123,6 +124,20 @@ class SerialConfig:
 
 
 @dataclass(frozen=True)
+class PlantModelConfig:
+    """The plant ``softarm identify`` measured (``[plant_model]``): either ``file``, an
+    ``id.json`` path relative to the config file, or the per-channel lists inline (the
+    keys of ``id.json``; see :mod:`softarm.identification.result`)."""
+
+    file: str | None = None
+    tau_s: tuple[float, ...] | None = None
+    metres_per_psi: tuple[float, ...] | None = None
+    hysteresis_psi: tuple[float, ...] | None = None
+    dead_time_s: tuple[float, ...] | None = None
+    control_period_s: float | None = None
+
+
+@dataclass(frozen=True)
 class Config:
     """A whole installation."""
 
@@ -131,6 +146,7 @@ class Config:
     calibration: CalibrationConfig = field(default_factory=CalibrationConfig)
     channels: ChannelsConfig = field(default_factory=ChannelsConfig)
     serial: SerialConfig = field(default_factory=SerialConfig)
+    plant_model: PlantModelConfig | None = None
 
 
 def load_config(path: str | Path) -> Config:
@@ -389,8 +405,36 @@ def _build(root: _Table) -> Config:
         ),
     )
     se.done()
+    plant_model = _plant_model(root.table("plant_model"), len(channels.names))
     root.done()
-    return Config(arm, gains, calibration, channels, serial)
+    return Config(arm, gains, calibration, channels, serial, plant_model)
+
+
+def _plant_model(t: _Table, n_channels: int) -> PlantModelConfig | None:
+    """``[plant_model]``: a file name, or the identified lists checked as ``id.json``."""
+    if not t.data:
+        return None
+    t.used.update(t.data)
+    file = t.data.get("file")
+    if file is not None:
+        if not isinstance(file, str) or not file:
+            raise t.error("file", "must be a path string (an id.json from softarm identify)")
+        if len(t.data) > 1:
+            others = sorted(set(t.data) - {"file"})
+            raise ConfigError(f"{t.source}: {t.key(others[0])}: give either file or the lists")
+        return PlantModelConfig(file=file)
+    from softarm.identification.result import IdentifiedPlant
+
+    plant = IdentifiedPlant.from_mapping(t.data, where=f"{t.source}: {t.path}")
+    if plant.n_channels != n_channels:
+        raise ConfigError(
+            f"{t.source}: {t.key('tau_s')} has {plant.n_channels} values, "
+            f"channels.names has {n_channels}"
+        )
+    return PlantModelConfig(
+        None, plant.tau_s, plant.metres_per_psi, plant.hysteresis_psi, plant.dead_time_s,
+        plant.control_period_s if "control_period_s" in t.data else None,
+    )  # fmt: skip
 
 
 # --- writing ----------------------------------------------------------------------------
@@ -428,4 +472,6 @@ def dump_config(config: Config) -> str:
         out += [f"[calibration.{name}]", *_lines(asdict(cam)), ""]
     out += ["[channels]", *_lines(asdict(config.channels)), ""]
     out += ["[serial]", *_lines(asdict(config.serial))]
+    if config.plant_model is not None:
+        out += ["", "[plant_model]", *_lines(asdict(config.plant_model))]
     return "\n".join(out) + "\n"

@@ -10,7 +10,7 @@ hysteresis, per channel (``softarm identify``; docs/identification.md).
 from softarm.identification.estimate import estimate
 from softarm.identification.protocol import Design, Segment
 from softarm.identification.record import Recording, run_experiment
-from softarm.identification.result import IdentifiedPlant, load_identified
+from softarm.identification.result import IdentifiedPlant, identified_from_config, load_identified
 from softarm.identification.rig import IdentificationRig, SimIdentificationRig, sim_plant_seed
 from softarm.identification.run import identify
 
@@ -22,6 +22,7 @@ __all__ = [
     "Segment",
     "SimIdentificationRig",
     "estimate",
+    "identified_from_config",
     "identify",
     "load_identified",
     "run_experiment",

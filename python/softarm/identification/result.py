@@ -13,11 +13,14 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softarm.errors import ConfigError
 
-__all__ = ["PER_CHANNEL_KEYS", "IdentifiedPlant", "load_identified"]
+if TYPE_CHECKING:
+    from softarm.config import Config
+
+__all__ = ["PER_CHANNEL_KEYS", "IdentifiedPlant", "identified_from_config", "load_identified"]
 
 #: The per-channel lists of ``id.json`` and the smallest value each may take.
 PER_CHANNEL_KEYS: dict[str, tuple[float, str]] = {
@@ -147,3 +150,17 @@ def load_identified(path: str | Path) -> IdentifiedPlant:
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{path}: not valid JSON: {exc}") from exc
     return IdentifiedPlant.from_mapping(data, where=str(path))
+
+
+def identified_from_config(config: Config, config_path: str | Path) -> IdentifiedPlant | None:
+    """The ``[plant_model]`` of a hardware config: its ``file`` (relative to the config
+    file) read with :func:`load_identified`, or its inline lists; None without one."""
+    pm = config.plant_model
+    if pm is None:
+        return None
+    if pm.file is not None:
+        return load_identified(Path(config_path).parent / pm.file)
+    data: dict[str, Any] = {k: list(getattr(pm, k) or ()) for k in PER_CHANNEL_KEYS}
+    if pm.control_period_s is not None:
+        data["control_period_s"] = pm.control_period_s
+    return IdentifiedPlant.from_mapping(data, where=f"{config_path}: plant_model")
