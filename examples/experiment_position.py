@@ -1,25 +1,35 @@
 """IV-B: position control at 35 set-points along +Y, proposed (eq. 13) against
 conventional resolved rate (eq. 7), on the simulated arm.
 
-Writes CSV, JSON and PNG files into the folder given as the first argument (default
-`experiments-out`) and prints the summary. Add `--quick` for a short run.
+Writes CSV, JSON and PNG files into --out and prints the summary (floats rounded).
 
-    python examples/experiment_position.py out/ [--quick]
+    python examples/experiment_position.py --out out/experiments --quick
 """
+
+from __future__ import annotations
 
 import json
 import sys
-from pathlib import Path
 
-from softarm.experiments import position
+from softarm.commands._args import Parser, non_negative_int, output_dir
+from softarm.commands._format import rounded
 
 
-def main() -> None:
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    out = Path(args[0]) if args else Path("experiments-out")
-    summary = position.run(out, seed=0, quick="--quick" in sys.argv)
-    print(json.dumps(summary, indent=2, default=str))
+def main(argv: list[str] | None = None) -> int:
+    parser = Parser(prog="experiment_position.py", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=output_dir, default="out/experiments", help="output folder")
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="seed of the simulated arm"
+    )
+    parser.add_argument("--quick", action="store_true", help="fewer targets, shorter runs")
+    args = parser.parse_args(argv)
+
+    from softarm.experiments import position
+
+    summary = position.run(args.out, seed=args.seed, quick=args.quick)
+    print(json.dumps(rounded(summary), indent=2, default=str))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -15,12 +15,11 @@ Exit status: 0 when every device is either working or absent (the reason is prin
 
 from __future__ import annotations
 
-import argparse
 import sys
 from collections.abc import Callable
 from dataclasses import replace
-from pathlib import Path
 
+from softarm.commands._args import Parser, config_file
 from softarm.config import Config, default_config, load_config
 from softarm.errors import ConfigError, HardwareError, HardwareUnavailableError
 from softarm.hardware.arduino import ArduinoLink
@@ -66,8 +65,10 @@ def camera_step(source: int | str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the bring-up; returns the exit status."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--config", type=Path, help="TOML config (default: shipped blackberry)")
+    parser = Parser(prog="hardware_bringup.py", description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--config", type=config_file, help="TOML config (default: shipped blackberry)"
+    )
     parser.add_argument("--port", help="override serial.port")
     parser.add_argument("--dry-run", action="store_true", help="open nothing, print the plan")
     args = parser.parse_args(argv)

@@ -6,22 +6,24 @@ eye-in-hand images → ArUco vision → two-camera fusion (eq. 21–22) → hybr
 (eq. 20) → safety layer → simulated pneumatic arm.
 
     python examples/harvest_sim.py --seeds 100 101 102 103 104 --berries 8 --out out/eval
+
+A progress bar with the ETA runs on stderr and a line per bush as each one finishes;
+the reports and logs go to --out.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
-from concurrent.futures import ProcessPoolExecutor
+import sys
 from pathlib import Path
 
-import numpy as np
-
-from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+from softarm.commands._args import Parser, int_range, non_negative_int, output_dir
 
 
 def one_seed(seed: int, berries: int, out: Path, avoid: bool, gain: float | None) -> dict:
     """Run one bush and save its report; returns the report as a dict."""
+    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+
     opts = SimRigOptions(
         n_berries=berries,
         seed=seed,
@@ -34,24 +36,44 @@ def one_seed(seed: int, berries: int, out: Path, avoid: bool, gain: float | None
     return report
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, nargs="+", default=[100, 101, 102, 103, 104])
-    ap.add_argument("--berries", type=int, default=8)
-    ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--out", type=Path, default=Path("out/eval"))
+def main(argv: list[str] | None = None) -> int:
+    ap = Parser(prog="harvest_sim.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument(
+        "--seeds", type=non_negative_int, nargs="+", default=[100, 101, 102, 103, 104],
+        help="one simulated bush and arm per seed",
+    )  # fmt: skip
+    ap.add_argument("--berries", type=int_range(1, 1000), default=8, help="berries per bush")
+    ap.add_argument("--jobs", type=int_range(1, 256), default=2, help="parallel processes")
+    ap.add_argument("--out", type=output_dir, default="out/eval", help="output folder")
     ap.add_argument("--no-avoid", action="store_true", help="no cane repulsion in closed loop")
     ap.add_argument("--joint-limit-gain", type=float, help="closed-loop resolver γ (eq. 20)")
-    args = ap.parse_args()
+    ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    args = ap.parse_args(argv)
+
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    import numpy as np
+
+    from softarm.commands._progress import Progress
+
     args.out.mkdir(parents=True, exist_ok=True)
-    with ProcessPoolExecutor(args.jobs) as pool:
-        futures = [
+    by_seed: dict[int, dict] = {}
+    with (
+        ProcessPoolExecutor(args.jobs) as pool,
+        Progress(len(args.seeds), "bushes", "bush", args.quiet) as bar,
+    ):
+        futures = {
             pool.submit(
                 one_seed, s, args.berries, args.out, not args.no_avoid, args.joint_limit_gain
-            )
+            ): s
             for s in args.seeds
-        ]
-        reports = [f.result() for f in futures]
+        }
+        for future in as_completed(futures):
+            seed, report = futures[future], future.result()
+            by_seed[seed] = report
+            bar.line(f"seed {seed}: {report['harvested']}/{report['attempted']} harvested")
+            bar.advance()
+    reports = [by_seed[s] for s in args.seeds]
     rows = [b for r in reports for b in r["berries"]]
     errors = [b["true_position_error_mm"] for b in rows if b["harvested"]]
     print("| seed | harvested | mean error (mm) | max error (mm) | min cane gap (mm) | contacts |")
@@ -74,7 +96,8 @@ def main() -> None:
         f"contact steps {sum(r['branch_contact_steps'] for r in reports)}, min gap "
         f"{1e3 * min(r['min_branch_gap_m'] for r in reports):.1f} mm"
     )
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -7,27 +7,29 @@ gripper is placed in front of the berry, then the eye-in-hand camera takes over 
 falls and saves the last eye-in-hand image with the tag's axes and the image centre, like
 the paper's fig. 10.
 
-    python examples/servo_aruco.py --seed 3 --out out/servo.png
+    python examples/servo_aruco.py --seed 3 --out out/examples
 """
 
 from __future__ import annotations
 
-import argparse
-from pathlib import Path
+import sys
 
-import cv2
-import numpy as np
-
-from softarm.harvest import BerryTarget
-from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
-from softarm.vision.detector import square_marker_poses
+from softarm.commands._args import Parser, non_negative_int, output_dir
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seed", type=int, default=3)
-    ap.add_argument("--out", type=Path, default=Path("out/servo.png"))
-    args = ap.parse_args()
+def main(argv: list[str] | None = None) -> int:
+    ap = Parser(prog="servo_aruco.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seed", type=non_negative_int, default=3, help="seed of the bush and arm")
+    ap.add_argument("--out", type=output_dir, default="out/examples", help="output folder")
+    args = ap.parse_args(argv)
+
+    import cv2
+    import numpy as np
+
+    from softarm.harvest import BerryTarget
+    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.vision.detector import square_marker_poses
+
     rig = build_sim_rig(SimRigOptions(n_berries=1, seed=args.seed))
     berry = rig.bush.berries[0]
     result = rig.machine.run_berry(BerryTarget(berry.tag_id), grasp=False)
@@ -54,10 +56,12 @@ def main() -> None:
             pose = square_marker_poses(det.corners, model, vision.berry_tag)[0].T_camera_marker
             rvec, _ = cv2.Rodrigues(pose[:3, :3])
             cv2.drawFrameAxes(img, model.matrix, model.distortion, rvec, pose[:3, 3], 0.015)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    cv2.imwrite(str(args.out), img)
-    print(f"saved {args.out}")
+    args.out.mkdir(parents=True, exist_ok=True)
+    out = args.out / "servo_aruco.png"
+    cv2.imwrite(str(out), img)
+    print(f"saved {out}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -123,7 +123,9 @@ def test_every_help_shows_the_defaults() -> None:
     for prog, parser in subs.items():
         text = " ".join(parser.format_help().split())
         for action in parser._actions:
-            if not action.option_strings or action.default in (None, False, argparse.SUPPRESS):
+            if not action.option_strings or any(
+                action.default is nothing for nothing in (None, False, argparse.SUPPRESS)
+            ):
                 continue
             shown = f"(default: {action.default})"
             assert shown in text, f"{prog} {action.option_strings[0]}: {shown} not in help"

@@ -44,13 +44,18 @@ _COMPLETE_FILE = {"bash": "_shtab_compgen_files", "zsh": "_files", "tcsh": "f"}
 _COMPLETE_DIR = {"bash": "_shtab_compgen_dirs", "zsh": "_files -/", "tcsh": "d"}
 
 
+def _says_nothing(default: object) -> bool:
+    # Identity, not ==: a default of 0 (a seed) is worth showing, though 0 == False.
+    return default is None or default is False or default is argparse.SUPPRESS
+
+
 class DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """Shows ``(default: X)`` after every option's help, except where the default says
     nothing (None, False: a flag that is off, an option that is absent)."""
 
     def _get_help_string(self, action: argparse.Action) -> str | None:
         help_ = action.help or ""
-        if action.default in (None, False, argparse.SUPPRESS) or "%(default)" in help_:
+        if _says_nothing(action.default) or "%(default)" in help_:
             return help_
         if not action.option_strings and action.nargs not in ("?", "*"):
             return help_
@@ -68,16 +73,7 @@ class Parser(argparse.ArgumentParser):
 
     def _add_action(self, action: argparse.Action) -> argparse.Action:
         # An option with a default but no help text would hide its default from --help.
-        if (
-            action.help is None
-            and action.option_strings
-            and action.default
-            not in (
-                None,
-                False,
-                argparse.SUPPRESS,
-            )
-        ):
+        if action.help is None and action.option_strings and not _says_nothing(action.default):
             action.help = ""
         # Path options complete file or folder names in `softarm completion` scripts
         # (shtab reads ``action.complete``; the values are shtab.FILE and DIRECTORY).
