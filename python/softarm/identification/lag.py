@@ -72,14 +72,12 @@ def fit_lag(sent: F64, pressure: F64, dt: float, p0: float, c0: float) -> LagFit
 
     lo = [math.log(TAU_BOUNDS[0]), DEAD_BOUNDS[0]]
     hi = [math.log(TAU_BOUNDS[1]), DEAD_BOUNDS[1]]
-    best = None
     # The residual is not smooth in D at multiples of dt (a new command enters the
-    # window): start from several dead times and keep the best.
-    for tau0 in (0.05, 0.5):
-        for dead0 in (0.25 * dt, 1.5 * dt, 4.5 * dt):
-            sol = least_squares(residual, [math.log(tau0), dead0], bounds=(lo, hi))
-            if best is None or sol.cost < best.cost:
-                best = sol
-    assert best is not None
+    # window) and has flat stretches in tau: start the local solver from the best point
+    # of a coarse grid.
+    grid = [(t, d * dt) for t in (0.02, 0.08, 0.3, 1.0, 3.0) for d in (0.25, 1.5, 4.5)]
+    costs = [float(np.sum(residual(np.array([math.log(t), d])) ** 2)) for t, d in grid]
+    tau0, dead0 = grid[int(np.argmin(costs))]
+    best = least_squares(residual, [math.log(tau0), dead0], bounds=(lo, hi))
     rms = math.sqrt(2.0 * best.cost / max(1, int(ok.sum())))
     return LagFit(math.exp(best.x[0]), float(best.x[1]), rms)
