@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -266,3 +267,24 @@ def test_a_normal_start_logs_no_warning(caplog: pytest.LogCaptureFixture) -> Non
         bank.vent("fault: test")
         assert caplog.records[-1].levelno == logging.WARNING
         bank.close()
+
+
+def test_sim_harvest_lines_reports_and_quiet(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One berry: the per-berry line gives that berry's own simulated and wall time (not
+    a running total); the report and log are written; --quiet keeps the summary only."""
+    files = [str(tmp_path / n) for n in ("r.json", "l.jsonl", "p.png")]
+    argv = ["harvest", "--sim", "--berries", "1", "--seed", "0"]
+    argv += ["--report", files[0], "--log", files[1], "--plot", files[2]]
+    status, out, err = run_cli(argv, capsys)
+    assert status in (0, 1), err
+    (berry_line,) = [line for line in out.splitlines() if line.startswith("berry 1/1")]
+    assert re.search(r"took \d+\.\d s simulated, \d+\.\d s wall$", berry_line)
+    assert "WARNING" not in err and "startup" not in err  # a normal start is not a warning
+    report = json.loads(Path(files[0]).read_text())
+    assert report["attempted"] == 1
+    assert all(len(repr(v)) < 12 for v in report["berries"][0].values() if isinstance(v, float))
+    assert Path(files[2]).stat().st_size > 0
+    status, out, _ = run_cli([*argv[:6], "--quiet"], capsys)
+    assert out.strip().startswith("harvested ")  # the summary line, nothing before it

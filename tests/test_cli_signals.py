@@ -65,3 +65,50 @@ def test_signal_vents_logs_and_exits(sig: signal.Signals, status: int, tmp_path:
     assert last["exit_status"] == status
     vents = [r for r in records if r["kind"] == "vent"]
     assert vents and sig.name in vents[-1]["reason"]
+
+
+class _FakeMachine:
+    def __init__(self) -> None:
+        self.vents: list[str] = []
+        self.actuator = self
+
+    def vent(self, reason: str) -> None:
+        self.vents.append(reason)
+
+    def run(self, berries: object) -> object:
+        from softarm.commands._signals import Interrupted
+
+        raise Interrupted(signal.SIGTERM)  # as the handler does, mid-run
+
+
+class _FakeRig:
+    def __init__(self) -> None:
+        self.machine = _FakeMachine()
+        self.closed = False
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def test_hardware_run_stopped_by_sigterm_vents_closes_and_logs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """On hardware the devices are released (the `finally` runs) and the log says why."""
+    import re
+
+    from softarm import cli
+    from softarm.commands.config import template
+    from softarm.harvest import hw_rig
+
+    config = tmp_path / "hw.toml"
+    config.write_text(re.sub(r"(?m)^# ((T_C1_base|T_C2_EE|matrix) = )", r"\1", template()))
+    rig = _FakeRig()
+    monkeypatch.setattr(hw_rig, "build_hardware_rig", lambda config, log: rig)
+    log = tmp_path / "run.jsonl"
+    status = cli.main(["harvest", "--config", str(config), "--log", str(log)])
+    assert status == 143
+    assert rig.closed and rig.machine.vents == ["stopped by SIGTERM"]
+    last = _records(log)[-1]
+    assert last["kind"] == "interrupted" and last["signal"] == "SIGTERM"
+    err = capsys.readouterr().err
+    assert "SIGTERM" in err and "Traceback" not in err
