@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
         again = f"softarm sweep {args.spec} --out {args.out} --resume"
         print(f"interrupted: finished trials are in the table; complete it with `{again}`",
               file=sys.stderr)  # fmt: skip
-        return 130
+        return 128 + int(outcome.signal or 2)  # 130 for SIGINT, 143 for SIGTERM
     if any(r["error"] is not None for r in rows):
         print("some trials failed (see the error column); --resume runs them again",
               file=sys.stderr)  # fmt: skip

@@ -47,6 +47,7 @@ class SweepOutcome:
     berries: int  # berry rows written now
     wall_s: float  # from the first task submitted to the last one finished
     interrupted: bool = False
+    signal: int | None = None  # the signal that interrupted it (SIGINT, SIGTERM)
     cpus: float = math.nan  # CPUs of the Ray cluster used
     extra: dict[str, Any] = field(default_factory=dict)
 
@@ -78,13 +79,21 @@ def init_ray(address: str | None = None, cpus: int | None = None) -> bool:
     return True
 
 
+class _Stopped(KeyboardInterrupt):
+    """SIGTERM, taking the Ctrl-C path."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(f"stopped by {signal.Signals(signum).name}")
+        self.signum = signum
+
+
 @contextmanager
 def _sigterm_as_interrupt() -> Iterator[None]:
     """SIGTERM (a batch system stopping the job) takes the Ctrl-C path. ray.init installs
     its own SIGTERM handler, so this is entered after it."""
 
     def handler(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt(f"signal {signum}")
+        raise _Stopped(signum)
 
     try:
         previous = signal.signal(signal.SIGTERM, handler)
@@ -150,8 +159,9 @@ def run_sweep(
             outcome.cpus = float(ray.cluster_resources().get("CPU", math.nan))
             with _sigterm_as_interrupt():
                 _drive(ray, todo, table, outcome, progress, trial_fn, max_retries, on_trial)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         outcome.interrupted = True
+        outcome.signal = getattr(exc, "signum", signal.SIGINT)
     finally:
         table.flush()
         if started:

@@ -18,6 +18,7 @@ will not report: the project keeps 500-599 held out.
 from __future__ import annotations
 
 import math
+import os
 import shutil
 import sys
 import tempfile
@@ -108,7 +109,6 @@ def run_tune(
     ray = require("ray")
     tune = require("ray.tune")
     optuna_search = require("ray.tune.search.optuna")
-    require("optuna")
     from ray.tune.search import ConcurrencyLimiter
 
     space = spec.tune.space or DEFAULT_SPACE
@@ -129,6 +129,9 @@ def run_tune(
             rows += work(t)
         tune.report(score_rows(rows, expected))
 
+    # Tune's own console tables and Optuna's per-trial log lines: the bar says enough.
+    os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
+    require("optuna").logging.set_verbosity(require("optuna").logging.WARNING)
     started = init_ray(address, cpus)
     storage = Path(tempfile.mkdtemp(prefix="softarm-tune-"))
     try:
