@@ -102,7 +102,7 @@ def _attach_python_side() -> None:
     from softarm._stubdocs import apply_stub_docstrings
 
     apply_stub_docstrings(_core)
-    SoftArm.from_config = classmethod(from_config)  # type: ignore[attr-defined]
+    setattr(SoftArm, "from_config", classmethod(from_config))  # noqa: B010  (native class)
 
 
 _attach_python_side()

@@ -16,7 +16,7 @@ import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TypeVar
 
 __all__ = [
     "DefaultsFormatter",
@@ -39,6 +39,8 @@ MAX_COUNT = 1_000_000
 #: them within 63 bits so they also fit every C ``int64`` they may be passed to.
 MAX_SEED = 2**63 - 1
 
+
+_A = TypeVar("_A", bound=argparse.Action)
 
 _COMPLETE_FILE = {"bash": "_shtab_compgen_files", "zsh": "_files", "tcsh": "f"}
 _COMPLETE_DIR = {"bash": "_shtab_compgen_dirs", "zsh": "_files -/", "tcsh": "d"}
@@ -71,7 +73,7 @@ class Parser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", DefaultsFormatter)
         super().__init__(*args, **kwargs)
 
-    def _add_action(self, action: argparse.Action) -> argparse.Action:
+    def _add_action(self, action: _A) -> _A:  # type: ignore[override]
         # An option with a default but no help text would hide its default from --help.
         if action.help is None and action.option_strings and not _says_nothing(action.default):
             action.help = ""
