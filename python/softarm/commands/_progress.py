@@ -2,12 +2,15 @@
 and result lines on stdout written through the bar so the two never tear each other.
 
 The bar is drawn only when stderr is a terminal (tqdm's ``disable=None``), so logs and
-pipes get the result lines alone; ``quiet`` silences both.
+pipes get the result lines alone; ``quiet`` silences both. tqdm redraws only when an item
+completes, and one berry takes seconds: a daemon thread redraws the bar every second so
+that the elapsed time keeps moving.
 """
 
 from __future__ import annotations
 
 import sys
+import threading
 from types import TracebackType
 
 from tqdm import tqdm
@@ -21,6 +24,8 @@ class Progress:
     def __init__(self, total: int | None, desc: str, unit: str = "it", quiet: bool = False):
         self.quiet = quiet
         self._bar: tqdm | None = None
+        self._stop = threading.Event()
+        self._ticker: threading.Thread | None = None
         if not quiet:
             self._bar = tqdm(
                 total=total,
@@ -33,6 +38,15 @@ class Progress:
                 bar_format="{desc}: {n_fmt}/{total_fmt}{unit} |{bar}| "
                 "{elapsed} elapsed, ETA {remaining}",
             )
+            if not self._bar.disable:
+                self._ticker = threading.Thread(target=self._tick, daemon=True)
+                self._ticker.start()
+
+    def _tick(self) -> None:
+        while not self._stop.wait(1.0):
+            bar = self._bar
+            if bar is not None:
+                bar.refresh()
 
     def line(self, text: str) -> None:
         """Print a result line above the bar (nothing when quiet)."""
@@ -52,6 +66,10 @@ class Progress:
 
     def close(self) -> None:
         """Remove the bar."""
+        self._stop.set()
+        if self._ticker is not None:
+            self._ticker.join()
+            self._ticker = None
         if self._bar is not None:
             self._bar.close()
             self._bar = None
