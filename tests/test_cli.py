@@ -80,6 +80,16 @@ def test_config_encoding_errors_name_the_option(
     assert err.count("\n") == 1 and "argument --config" in err and why in err
 
 
+def test_plot_needs_the_simulator(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from softarm.commands.config import template
+
+    config = tmp_path / "hw.toml"
+    config.write_text(template())
+    argv = ["harvest", "--config", str(config), "--plot", str(tmp_path / "p.png")]
+    status, _, err = run_cli(argv, capsys)
+    assert status == 2 and err.count("\n") == 1 and "argument --plot" in err
+
+
 def test_output_checks_create_nothing(tmp_path: Path) -> None:
     assert output_file(str(tmp_path / "r.json")) == tmp_path / "r.json"
     assert output_dir(str(tmp_path / "a" / "b")) == tmp_path / "a" / "b"

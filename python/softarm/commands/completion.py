@@ -1,4 +1,4 @@
-"""``softarm completion SHELL``: print a tab-completion script for the shell, generated
+"""softarm completion SHELL: print a tab-completion script for the shell, generated
 from the parser itself by shtab (optional extra ``completion``), so it never lags behind
 the commands and options.
 

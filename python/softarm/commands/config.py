@@ -1,4 +1,4 @@
-"""``softarm config``: write a commented hardware configuration, or check one.
+"""softarm config: write a commented hardware configuration, or check one.
 
 softarm config init hw.toml      # the template: fill in the calibration, then
 softarm config check hw.toml     # says what is still missing before a harvest
