@@ -21,6 +21,7 @@ from typing import Any, NoReturn, TypeVar
 __all__ = [
     "DefaultsFormatter",
     "Parser",
+    "RawDefaultsFormatter",
     "add_quiet",
     "config_file",
     "float_range",
@@ -62,6 +63,11 @@ class DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
         if not action.option_strings and action.nargs not in ("?", "*"):
             return help_
         return f"{help_} (default: %(default)s)" if help_ else "(default: %(default)s)"
+
+
+class RawDefaultsFormatter(DefaultsFormatter, argparse.RawDescriptionHelpFormatter):
+    """:class:`DefaultsFormatter` that keeps the description's line breaks (for a
+    description with example command lines)."""
 
 
 class Parser(argparse.ArgumentParser):

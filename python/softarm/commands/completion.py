@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 
+from softarm.commands._args import RawDefaultsFormatter
 from softarm.errors import SoftarmError
 
 SHELLS = ("bash", "zsh", "tcsh", "fish")
@@ -21,7 +22,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "completion",
         help="print a shell completion script (bash, zsh, tcsh, fish)",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=RawDefaultsFormatter,
     )
     p.add_argument("shell", choices=SHELLS, help="the shell to complete in")
     p.set_defaults(run=run)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from importlib import resources
 
-from softarm.commands._args import config_file, output_file
+from softarm.commands._args import RawDefaultsFormatter, config_file, output_file
 from softarm.errors import ConfigError
 
 #: Replaces the shipped file's [calibration] tables: every entry the hardware harvest
@@ -65,7 +65,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "config",
         help="write a commented hardware configuration (init) or check one (check)",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=RawDefaultsFormatter,
     )
     actions = p.add_subparsers(dest="action", required=True, metavar="ACTION")
     init = actions.add_parser("init", help="write the commented template")
