@@ -298,3 +298,19 @@ def test_sim_harvest_lines_reports_and_quiet(
     assert Path(files[2]).stat().st_size > 0
     status, out, _ = run_cli([*argv[:6], "--quiet"], capsys)
     assert out.strip().startswith("harvested ")  # the summary line, nothing before it
+
+
+@pytest.mark.parametrize(
+    ("content", "why"),
+    [(b"\xef\xbb\xbf[arm]\n", "byte-order mark"), (b"[arm]\nname = '\xff'\n", "not UTF-8")],
+)
+def test_load_config_encoding_errors_are_config_errors(
+    content: bytes, why: str, tmp_path: Path
+) -> None:
+    """The Python API too: a ConfigError naming the file, not a UnicodeDecodeError."""
+    from softarm.config import load_config
+
+    path = tmp_path / "hw.toml"
+    path.write_bytes(content)
+    with pytest.raises(softarm.ConfigError, match=why):
+        load_config(path)

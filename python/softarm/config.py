@@ -158,9 +158,16 @@ def load_config(path: str | Path) -> Config:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except OSError as exc:
         raise ConfigError(f"cannot read config file {str(path)!r}: {exc}") from exc
+    # TOML is UTF-8, and a byte-order mark is not TOML: say so rather than fail to parse.
+    if data.startswith(b"\xef\xbb\xbf"):
+        raise ConfigError(f"{str(path)!r} starts with a UTF-8 byte-order mark; save it without")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{str(path)!r} is not UTF-8 (byte offset {exc.start})") from exc
     return parse_config(text, source=str(path))
 
 
