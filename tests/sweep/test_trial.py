@@ -3,6 +3,8 @@ closed-loop resolver of the rig."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 import softarm
@@ -14,11 +16,12 @@ from softarm.sweep.trial import BERRY_COLUMNS, run_trial_rows
 
 
 def test_a_trial_that_raises_is_one_error_row() -> None:
-    # The rig refuses the Cosserat plant model: the trial fails before harvesting.
-    trial = TrialSpec(seed=0, plant={"model": "cosserat"}, berries=1, rig={}, gains={})
+    # A plant the spec parser would refuse, sent anyway: the trial fails before harvesting.
+    trial = TrialSpec(seed=0, plant={"pressure_tau": -1.0}, berries=1, rig={}, gains={})
     (row,) = run_trial_rows(trial)
-    assert row["error"] is not None and "cosserat" in row["error"]
-    assert row["trial_id"] == trial.trial_id and row["model"] == "cosserat"
+    assert row["error"] is not None and "ParameterError" in row["error"], row["error"]
+    assert "pressure_tau" in row["error"]
+    assert row["trial_id"] == trial.trial_id and row["pressure_tau"] == -1.0
     assert row["harvested"] is None
     assert set(BERRY_COLUMNS) <= set(row)
 
@@ -32,3 +35,15 @@ def test_gains_replace_the_closed_loop_resolver_only() -> None:
     assert controller.resolver.arm.n_dofs == softarm.SoftArm.blackberry().n_dofs
     with pytest.raises(ConfigError, match="alpha: unknown gain"):
         apply_gains(rig, {"alpha": 0.1})
+
+
+def test_harvest_gains_option_checks_the_file_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from softarm.cli import main
+
+    bad = tmp_path / "gains.toml"
+    bad.write_text("[gains]\nhybrid_alpha = 9.0\n")
+    assert main(["harvest", "--sim", "--berries", "1", "--gains", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "[gains] hybrid_alpha" in err and err.count("\n") == 1

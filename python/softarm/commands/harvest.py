@@ -61,6 +61,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--log", type=output_file, help="write the JSON-lines step log here")
     p.add_argument("--plot", type=image_file, help="save a plot of the run (--sim only)")
     add_plant_options(p)
+    p.add_argument(
+        "--gains",
+        type=config_file,
+        help="resolver gains: a TOML [gains] table of softarm.Gains keywords (`softarm tune` "
+        "writes one); over the defaults with --sim, over the config's [gains] on hardware",
+    )
     add_quiet(p)
     p.set_defaults(run=run)
 
@@ -75,10 +81,11 @@ def run(args: argparse.Namespace) -> int:
     with raise_on_signals():
         try:
             options = plant_options(args)
+            gains = _gains(args)
             if args.sim:
                 return run_sim(
                     args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
-                    **options,
+                    gains=gains, **options,
                 )  # fmt: skip
             return _run_hardware(args)
         except Interrupted as exc:
@@ -117,6 +124,7 @@ def run_sim(
     report_path: Path | None,
     plot_path: Path | None,
     quiet: bool = False,
+    gains: dict[str, Any] | None = None,
     **options: Any,
 ) -> int:
     """The simulated harvest shared by ``harvest --sim`` and ``demo``; ``options`` are
@@ -126,6 +134,10 @@ def run_sim(
     if not quiet:
         print(f"simulated harvest: {berries} berries, seed {seed}", flush=True)
     rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, log_path=log_path, **options))
+    if gains:
+        from softarm.sweep.gains_file import apply_gains
+
+        apply_gains(rig, gains)  # the closed-loop resolver's (--gains)
     try:
         report = _harvest(rig, berries, quiet)
     except Interrupted as exc:
@@ -181,6 +193,15 @@ def missing_calibration(config: Config) -> list[str]:
     return [f"calibration.{m}" for m in missing]
 
 
+def _gains(args: argparse.Namespace) -> dict[str, Any] | None:
+    """The ``[gains]`` of ``--gains FILE``, checked before the run (one-line errors)."""
+    if getattr(args, "gains", None) is None:
+        return None
+    from softarm.sweep.gains_file import load_gains
+
+    return load_gains(args.gains)
+
+
 def _run_hardware(args: argparse.Namespace) -> int:
     from softarm.config import load_config
     from softarm.harvest.hw_rig import build_hardware_rig
@@ -188,6 +209,13 @@ def _run_hardware(args: argparse.Namespace) -> int:
     from softarm.harvest.log import HarvestLog
 
     config = load_config(args.config)
+    if args.gains is not None:
+        import dataclasses
+
+        from softarm.config import GainsConfig
+
+        merged = {**config.gains.values, **_gains(args)}
+        config = dataclasses.replace(config, gains=GainsConfig(merged))
     missing = missing_calibration(config)
     if missing:
         raise ConfigError(

@@ -37,6 +37,7 @@ _BERRY_TYPES = {
     "stopped": "string",
     "error": "string",
     "wall_s": "float64",
+    "cpu_s": "float64",
     "node": "string",
 }
 

@@ -33,6 +33,7 @@ BERRY_COLUMNS: tuple[str, ...] = (
     "stopped",
     "error",
     "wall_s",
+    "cpu_s",
     "node",
 )
 
@@ -78,7 +79,7 @@ def error_row(trial: TrialSpec, error: str, wall_s: float = math.nan) -> dict[st
 def run_trial_rows(trial: TrialSpec) -> list[dict[str, Any]]:
     """One row per berry of ``trial`` (see :data:`BERRY_COLUMNS`), or one error row."""
     _single_threaded()
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     try:
         report = run_trial(trial).to_dict()
     except Exception as exc:  # recorded in the table; the sweep goes on
@@ -88,6 +89,7 @@ def run_trial_rows(trial: TrialSpec) -> list[dict[str, Any]]:
             error_row(trial, f"{type(exc).__name__}: {exc}{where}", time.perf_counter() - start)
         ]
     wall = time.perf_counter() - start
+    cpu = time.process_time() - cpu_start  # this process's CPU time: throughput on a busy host
     rows = []
     for i, b in enumerate(report["berries"]):
         rows.append(
@@ -108,6 +110,7 @@ def run_trial_rows(trial: TrialSpec) -> list[dict[str, Any]]:
                 "stopped": report.get("stopped"),
                 "error": None,
                 "wall_s": wall,
+                "cpu_s": cpu,
                 "node": socket.gethostname(),
             }
         )
