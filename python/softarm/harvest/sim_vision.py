@@ -45,6 +45,9 @@ class SimCameras:
     """Geometry of the simulated cameras and markers (true values).
 
     ``scale`` multiplies both image sizes and focal lengths (0.5 = a quarter of the pixels).
+    ``crop`` (default) renders and searches only the window of each frame that holds the
+    markers (:meth:`~softarm.sim.SyntheticCamera.render_crop`: the same pixels there, the
+    same detections, a fraction of the time); False renders whole frames.
     """
 
     T_base_c1: FloatArray
@@ -60,6 +63,7 @@ class SimCameras:
     base_tag: float = 0.08
     berry_tag: float = 0.03
     scale: float = 1.0
+    crop: bool = True
 
     def size(self, which: int) -> tuple[int, int]:
         """Image (width, height) of C1 (``which`` = 1) or C2 (2) after ``scale``."""
@@ -89,6 +93,8 @@ def sim_vision(
     (w1, h1), (w2, h2) = cams.size(1), cams.size(2)
     c1 = SyntheticCamera(m1, w1, h1, noise_std=cams.noise_std, supersample=2, seed=seed)
     c2 = SyntheticCamera(m2, w2, h2, noise_std=cams.noise_std, supersample=2, seed=seed + 1)
+    render1 = c1.render_crop if cams.crop else c1.render
+    render2 = c2.render_crop if cams.crop else c2.render
     cube = MarkerCube.standard(cams.cube_marker)
     T_c1_base = invert(cams.T_base_c1)
 
@@ -106,10 +112,10 @@ def sim_vision(
         items += cube_scene_markers(cube.markers, cube.marker_length, DICT, T_c1_cube)
         if with_berries and not hide(t):
             items += tags(T_c1_base)
-        return c1.render(items)
+        return render1(items)
 
     def frame2(t: float) -> np.ndarray:
-        return c2.render([] if hide(t) else tags(invert(true_pose() @ cams.T_ee_c2)))
+        return render2([] if hide(t) else tags(invert(true_pose() @ cams.T_ee_c2)))
 
     T_base_c1 = register_c1(
         lambda t: frame1(t, False), m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag

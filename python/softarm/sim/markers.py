@@ -88,8 +88,10 @@ def marker_texture(
     """Reflectance texture (0 black, 1 white) of a marker with ``pad`` white texels around."""
     cells = get_dictionary(dictionary).markerSize + 2
     bits = cv2.aruco.generateImageMarker(get_dictionary(dictionary), int(marker_id), cells)
-    big = np.kron(
-        bits.astype(np.float32) / 255.0, np.ones((texels_per_cell, texels_per_cell), np.float32)
+    # Each cell repeated texels_per_cell times along both axes (a Kronecker product with a
+    # block of ones, without multiplying), then the white quiet zone.
+    big = np.repeat(
+        np.repeat(bits.astype(np.float32) / 255.0, texels_per_cell, 0), texels_per_cell, 1
     )
     out = np.pad(big, pad, constant_values=1.0)
     out.setflags(write=False)

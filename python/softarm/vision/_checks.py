@@ -65,10 +65,21 @@ def as_pose(value: Any, name: str, tol: float = 1e-6) -> FloatArray:
         arr = as_array(value, (4, 4), name)
     except (ShapeError, NonFiniteError) as exc:
         raise PoseError(str(exc)) from exc
-    if not np.allclose(arr[3], [0.0, 0.0, 0.0, 1.0], atol=tol):
-        raise PoseError(f"{name} last row must be [0, 0, 0, 1], got {arr[3].tolist()}")
-    rot = arr[:3, :3]
-    if not np.allclose(rot.T @ rot, np.eye(3), atol=tol) or np.linalg.det(rot) < 0.0:
+    # The tests of np.allclose(a, b, atol=tol) (|a - b| <= tol + 1e-5 |b|) on plain floats:
+    # poses are checked wherever one is built, and numpy's general path costs ~100 µs here.
+    m = arr.tolist()
+    last = zip(m[3], (0.0, 0.0, 0.0, 1.0), strict=True)
+    if not all(abs(v - e) <= tol + 1e-5 * e for v, e in last):
+        raise PoseError(f"{name} last row must be [0, 0, 0, 1], got {m[3]}")
+    cols = [(m[0][j], m[1][j], m[2][j]) for j in range(3)]
+    for i in range(3):
+        for j in range(i, 3):
+            dot = sum(a * b for a, b in zip(cols[i], cols[j], strict=True))
+            expect = 1.0 if i == j else 0.0
+            if not abs(dot - expect) <= tol + 1e-5 * expect:
+                raise PoseError(f"{name} rotation block is not orthonormal with determinant +1")
+    (a, b, c), (d, e, f), (g, h, k) = m[0][:3], m[1][:3], m[2][:3]
+    if a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g) < 0.0:
         raise PoseError(f"{name} rotation block is not orthonormal with determinant +1")
     return np.ascontiguousarray(arr)
 

@@ -11,18 +11,22 @@ top-right (L/2, L/2, 0), bottom-right (L/2, -L/2, 0), bottom-left (-L/2, -L/2, 0
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
+from softarm.errors import VisionError
 from softarm.vision._checks import FloatArray, as_gray, positive
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.crop import ImageCrop
 from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.poses import pose_from_rvec_tvec
-from softarm.vision.refine import refine_marker_corners
+from softarm.vision.refine import READ_MARGIN, refine_marker_corners
 
 # A best IPPE solution worse than this (px RMS) triggers the SQPNP fallback.
 FALLBACK_RMS_PX = 1.0
@@ -34,12 +38,48 @@ def marker_object_points(marker_length: float) -> FloatArray:
     return np.array([[-h, h, 0.0], [h, h, 0.0], [h, -h, 0.0], [-h, -h, 0.0]])
 
 
-@dataclass(frozen=True)
 class Detection:
-    """One detected marker: its ``marker_id`` and (4, 2) pixel ``corners`` in detection order."""
+    """One detected marker: its ``marker_id`` and (4, 2) pixel ``corners`` in detection order.
 
-    marker_id: int
-    corners: FloatArray
+    ``refine``, when given, is called once on the first read of :attr:`corners` and its
+    result replaces them: :meth:`MarkerDetector.detect` defers its edge refinement this way,
+    so a marker no caller looks at (the base tag and the other berries in a tracking frame)
+    costs nothing. Read-only; equal when the ids and corners are.
+    """
+
+    __slots__ = ("_corners", "_marker_id", "_refine")
+
+    def __init__(
+        self,
+        marker_id: int,
+        corners: npt.ArrayLike,
+        refine: Callable[[], FloatArray] | None = None,
+    ) -> None:
+        self._marker_id = int(marker_id)
+        self._corners = np.asarray(corners, dtype=np.float64)
+        self._refine = refine
+
+    @property
+    def marker_id(self) -> int:
+        """The marker's id in its dictionary."""
+        return self._marker_id
+
+    @property
+    def corners(self) -> FloatArray:
+        """(4, 2) pixel corners, refined on first read when the detector deferred it."""
+        if self._refine is not None:
+            self._corners, self._refine = self._refine(), None
+        return self._corners
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Detection):
+            return NotImplemented
+        return self.marker_id == other.marker_id and np.array_equal(self.corners, other.corners)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"Detection(marker_id={self.marker_id}, corners={self.corners.tolist()})"
 
 
 @dataclass(frozen=True)
@@ -71,6 +111,11 @@ class MarkerDetector:
     ``parameters`` defaults to :func:`default_parameters` (sub-pixel refinement). With
     ``refine_edges`` (default), corners are further refined from the marker's four sides
     (:mod:`softarm.vision.refine`) when :meth:`detect` is given the camera model.
+
+    An :class:`~softarm.vision.crop.ImageCrop` (a window of a larger frame) is searched
+    as if it were that frame: corners come back in full-frame pixels, and the marker
+    perimeter limits, which OpenCV sets as a fraction of the image's larger side, are
+    rescaled to the full frame's side so that a crop finds what the frame would.
     """
 
     def __init__(
@@ -82,10 +127,9 @@ class MarkerDetector:
         self.dictionary = dictionary
         self.refine_edges = bool(refine_edges)
         self._cells = int(get_dictionary(dictionary).markerSize) + 2
-        self._detector = cv2.aruco.ArucoDetector(
-            get_dictionary(dictionary),
-            default_parameters() if parameters is None else parameters,
-        )
+        self._parameters = default_parameters() if parameters is None else parameters
+        self._detector = cv2.aruco.ArucoDetector(get_dictionary(dictionary), self._parameters)
+        self._crop_detectors: dict[tuple[int, int], Any] = {}
 
     def detect(
         self, image: npt.NDArray[Any] | None, camera: CameraModel | None = None
@@ -96,20 +140,67 @@ class MarkerDetector:
         the sides). Raises :class:`~softarm.errors.VisionError` for None, empty or
         malformed frames.
         """
+        origin = (0, 0)
+        detector = self._detector
+        if isinstance(image, ImageCrop):
+            if image.origin is None or image.full_size is None:
+                raise VisionError("image is a slice of an ImageCrop: its origin is unknown")
+            origin = image.origin
+            detector = self._crop_detector(image.full_size, image.shape[:2])
         gray = as_gray(image)
-        corners, ids, _ = self._detector.detectMarkers(gray)
+        corners, ids, _ = detector.detectMarkers(gray)
         if ids is None or len(ids) == 0:
             return []
         out = [
-            Detection(int(i), np.asarray(c, dtype=np.float64).reshape(4, 2))
+            Detection(int(i), np.asarray(c, dtype=np.float64).reshape(4, 2) + origin)
             for c, i in zip(corners, np.ravel(ids), strict=True)
         ]
         if self.refine_edges and camera is not None:
             out = [
-                Detection(d.marker_id, refine_marker_corners(gray, d.corners, camera, self._cells))
+                Detection(d.marker_id, d.corners, self._deferred(gray, d.corners, camera, origin))
                 for d in out
             ]
         return out
+
+    def _deferred(
+        self,
+        gray: npt.NDArray[np.uint8],
+        corners: FloatArray,
+        camera: CameraModel,
+        origin: tuple[int, int],
+    ) -> Callable[[], FloatArray]:
+        """The edge refinement of one marker, to run later on a copy of the pixels it reads
+        (the caller may reuse the frame's buffer for the next frame)."""
+        h, w = gray.shape
+        lo = np.floor(corners.min(axis=0)).astype(int) - READ_MARGIN - origin
+        hi = np.ceil(corners.max(axis=0)).astype(int) + READ_MARGIN + 1 - origin
+        x0, y0 = max(int(lo[0]), 0), max(int(lo[1]), 0)
+        patch = gray[y0 : min(int(hi[1]), h), x0 : min(int(hi[0]), w)].copy()
+        at = (origin[0] + x0, origin[1] + y0)
+        return partial(refine_marker_corners, patch, corners, camera, self._cells, at)
+
+    def _crop_detector(self, full_size: tuple[int, int], shape: tuple[int, ...]) -> Any:
+        """A detector for crops of shape ``shape`` from a ``full_size`` frame: OpenCV's
+        perimeter limits in pixels are ``int(rate * max(cols, rows))`` (aruco_detector.cpp),
+        so the rates are rescaled to give the full frame's integer limits."""
+        side, crop_side = max(full_size), max(shape[:2])
+        key = (side, crop_side)
+        hit = self._crop_detectors.get(key)
+        if hit is not None:
+            return hit
+        base = self._parameters
+        params = cv2.aruco.DetectorParameters()
+        for name in dir(base):
+            if not name.startswith("_") and not callable(getattr(base, name)):
+                setattr(params, name, getattr(base, name))
+        # +0.5 keeps int() on the full frame's integer after the float round trip.
+        params.minMarkerPerimeterRate = (int(base.minMarkerPerimeterRate * side) + 0.5) / crop_side
+        params.maxMarkerPerimeterRate = (int(base.maxMarkerPerimeterRate * side) + 0.5) / crop_side
+        if len(self._crop_detectors) > 64:
+            self._crop_detectors.clear()
+        hit = cv2.aruco.ArucoDetector(get_dictionary(self.dictionary), params)
+        self._crop_detectors[key] = hit
+        return hit
 
 
 def square_marker_poses(

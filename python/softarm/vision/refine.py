@@ -21,43 +21,55 @@ from softarm.vision._checks import FloatArray
 from softarm.vision.camera_model import CameraModel
 
 _STEP = 0.25  # px between profile samples across an edge
+_MAX_REACH = 4.0  # px: the widest half-profile across an edge
 _MAX_SHIFT = 2.0  # px: a refined corner further than this from the detection is refused
+#: Pixels beyond the corners' bounding box that the refinement reads (the half-profile,
+#: one for the bilinear neighbour, one for rounding): a copy of this neighbourhood is
+#: enough to refine the marker later.
+READ_MARGIN = int(_MAX_REACH) + 2
 
 
 def refine_marker_corners(
-    gray: npt.NDArray[np.uint8], corners: FloatArray, camera: CameraModel, cells: int
+    gray: npt.NDArray[np.uint8],
+    corners: FloatArray,
+    camera: CameraModel,
+    cells: int,
+    origin: tuple[int, int] = (0, 0),
 ) -> FloatArray:
     """Refined (4, 2) pixel corners of one marker in the 2-D ``gray`` image (``cells`` =
-    bits + 2 border cells); returns ``corners`` unchanged if the edges cannot be measured."""
+    bits + 2 border cells); returns ``corners`` unchanged if the edges cannot be measured.
+
+    ``gray`` may be a window of the frame whose top-left pixel is frame pixel ``origin``
+    = (x0, y0); ``corners`` and the result are in frame pixels either way."""
     quad = np.asarray(corners, dtype=np.float64).reshape(4, 2)
     h, w = gray.shape
-    samples, normals, counts = [], [], []
-    # Half-width of the profile: well inside the black border cell, whatever the view.
-    widths = [np.linalg.norm(quad[k] - quad[(k + 1) % 4]) for k in range(4)]
-    reach = float(np.clip(0.4 * min(widths) / cells, 1.0, 4.0))
-    reach = _STEP * round(reach / _STEP)  # so that the offsets are symmetric about 0
-    offsets = _STEP * np.arange(-round(reach / _STEP), round(reach / _STEP) + 1)
-    for k in range(4):
-        a, b = quad[k], quad[(k + 1) % 4]
-        length = float(np.linalg.norm(b - a))
-        if length < 8:
-            return quad
-        tangent = (b - a) / length
-        normal = np.array([tangent[1], -tangent[0]])
-        margin = max(3.0, 0.08 * length) / length
-        fractions = np.linspace(margin, 1 - margin, max(int(length), 8))
-        base = a + fractions[:, None] * (b - a)  # (n, 2)
-        samples.append(base[:, None, :] + offsets[None, :, None] * normal)  # (n, m, 2)
-        normals.append(normal)
-        counts.append(len(fractions))
-    pts64 = np.concatenate(samples)  # (N, m, 2) pixel positions of the profile samples
+    ox, oy = int(origin[0]), int(origin[1])
+    sides = np.roll(quad, -1, axis=0) - quad  # side k runs from corner k to corner k + 1
+    lengths = np.sqrt(np.einsum("ij,ij->i", sides, sides))
+    if lengths.min() < 8:
+        return quad
+    # Half-width of the profile: well inside the black border cell, whatever the view;
+    # a whole number of steps, so that the offsets are symmetric about 0.
+    half = round(float(np.clip(0.4 * lengths.min() / cells, 1.0, _MAX_REACH)) / _STEP)
+    reach = _STEP * half
+    offsets = _STEP * np.arange(-half, half + 1)
+    normals = np.column_stack([sides[:, 1], -sides[:, 0]]) / lengths[:, None]
+    # Profiles at evenly spaced points of each side, clear of the corners.
+    counts = np.maximum(lengths.astype(int), 8)
+    side = np.repeat(np.arange(4), counts)
+    index = np.arange(side.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    margin = (np.maximum(3.0, 0.08 * lengths) / lengths)[side]
+    fraction = margin + (1.0 - 2.0 * margin) * index / (counts[side] - 1)
+    centre_px = quad[side] + fraction[:, None] * sides[side]  # (N, 2) points on the sides
+    normal = normals[side]
+    pts64 = centre_px[:, None, :] + offsets[None, :, None] * normal[:, None, :]  # (N, m, 2)
     # Every sample lies within ``reach`` of the quad's sides.
     lo = np.floor(quad.min(axis=0) - reach - 1).astype(int)
     hi = np.ceil(quad.max(axis=0) + reach + 1).astype(int)
-    if lo.min() < 0 or hi[0] > w - 1 or hi[1] > h - 1:
+    if lo[0] < ox or lo[1] < oy or hi[0] > ox + w - 1 or hi[1] > oy + h - 1:
         return quad
     # Work on a float copy of the marker's neighbourhood only (a full-frame copy costs ~1 ms).
-    crop = gray[lo[1] : hi[1] + 1, lo[0] : hi[0] + 1].astype(np.float32)
+    crop = gray[lo[1] - oy : hi[1] + 1 - oy, lo[0] - ox : hi[0] + 1 - ox].astype(np.float32)
     pts = (pts64 - lo).astype(np.float32)
     prof = cv2.remap(crop, pts[..., 0], pts[..., 1], cv2.INTER_LINEAR)  # (N, m)
     # Signed gradient: for a box-filtered step sampled bilinearly its centroid is exactly the
@@ -70,29 +82,38 @@ def refine_marker_corners(
     ok_edge = contrast > 0.25 * np.median(contrast)
     shift = (grad @ mid) / np.where(ok_edge, wsum, 1.0)  # edge offset along the normal
     good = ok_edge & (np.abs(shift) < reach)
-    side = np.repeat(np.arange(4), counts)
-    centre_px = pts64[:, len(offsets) // 2]  # offsets is symmetric: its middle is 0
-    edge = centre_px + shift[:, None] * np.stack(normals)[side]
     if np.any(np.bincount(side[good], minlength=4) < 4):
         return quad
-    norm_pts = camera.normalize(edge[good])  # one call for all four sides
+    edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
-    lines = []
-    for k in range(4):
-        pts_k = norm_pts[side == k]
-        centre = pts_k.mean(axis=0)
-        _, _, vt = np.linalg.svd(pts_k - centre, full_matrices=False)
-        lines.append((centre, vt[0]))  # point and direction of side k
-    out = np.empty((4, 2))
-    for k in range(4):
-        # Corner k joins side k-1 (ending at k) and side k (starting at k).
-        (p1, d1), (p2, d2) = lines[k - 1], lines[k]
-        mat = np.column_stack([d1, -d2])
-        if abs(np.linalg.det(mat)) < 1e-9:
-            return quad
-        s = np.linalg.solve(mat, p2 - p1)
-        out[k] = p1 + s[0] * d1
-    pix = camera.project(np.column_stack([out, np.ones(4)]))
+    lines = _fit_lines(camera.normalize(edge), side)  # one call for all four sides
+    if lines is None:
+        return quad
+    pix = camera.project(np.column_stack([lines, np.ones(4)]))
     if np.max(np.linalg.norm(pix - quad, axis=1)) > _MAX_SHIFT:
         return quad
     return pix
+
+
+def _fit_lines(points: FloatArray, side: npt.NDArray[np.intp]) -> FloatArray | None:
+    """Corners (4, 2) where the total-least-squares lines through the ``points`` of each
+    side (``side`` = 0..3) meet, corner k joining side k - 1 and side k; None when two
+    adjacent lines are parallel."""
+    n = np.bincount(side, minlength=4).astype(np.float64)
+    centre = np.column_stack(
+        [np.bincount(side, points[:, 0], 4) / n, np.bincount(side, points[:, 1], 4) / n]
+    )
+    d = points - centre[side]
+    sxx = np.bincount(side, d[:, 0] * d[:, 0], 4)
+    sxy = np.bincount(side, d[:, 0] * d[:, 1], 4)
+    syy = np.bincount(side, d[:, 1] * d[:, 1], 4)
+    # The line's direction is the principal axis of the scatter matrix [[sxx, sxy], [sxy, syy]].
+    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
+    direction = np.column_stack([np.cos(angle), np.sin(angle)])
+    p1, d1 = np.roll(centre, 1, axis=0), np.roll(direction, 1, axis=0)  # side k - 1
+    cross = d1[:, 0] * direction[:, 1] - d1[:, 1] * direction[:, 0]
+    if np.min(np.abs(cross)) < 1e-9:
+        return None
+    gap = centre - p1
+    s = (gap[:, 0] * direction[:, 1] - gap[:, 1] * direction[:, 0]) / cross
+    return p1 + s[:, None] * d1
