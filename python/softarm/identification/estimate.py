@@ -5,6 +5,7 @@ hysteresis from the tracked poses with the geometry fitted alongside
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -13,7 +14,7 @@ import numpy as np
 from softarm._core import SoftArm
 from softarm.errors import HardwareError
 from softarm.identification.kinematic import fit_kinematics
-from softarm.identification.lag import fit_lag
+from softarm.identification.lag import fit_lag, simulate_lag
 from softarm.identification.record import Recording
 from softarm.identification.result import IdentifiedPlant
 
@@ -49,7 +50,17 @@ def estimate(
             f"the tracker saw the arm at the end of only {len(seen)} holds "
             f"(at least {MIN_HOLDS} are needed): check the cameras and the marker cube"
         )
-    kin = fit_kinematics(rec, nominal)
+    # The kinematic fit is driven by the fitted lag model's pressures, not the readings:
+    # the same at the end of a hold, but free of the monitor's noise (noise in the
+    # regressor would bias the gains towards zero).
+    modelled = np.column_stack(
+        [
+            simulate_lag(rec.sent[:, i], rec.period, f.tau_s, f.dead_time_s,
+                         float(rec.pressure_before[i]), float(rec.sent_before[i]))
+            for i, f in enumerate(lags)
+        ]
+    )  # fmt: skip
+    kin = fit_kinematics(dataclasses.replace(rec, pressure=modelled), nominal)
     meta: dict[str, Any] = {
         "arm_time_s": round(rec.duration, 3),
         "holds": len(rec.holds),

@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
+from softarm.errors import ParameterError
 from softarm.hardware.safety import SafePressureBank
 from softarm.hardware.simulated import SimulatedPressureBank
 from softarm.sim.arm import PlantConfig, SimulatedArm
@@ -67,16 +68,21 @@ class _SimPressures:
     """The :class:`~softarm.hardware.simulated.PressurePlant` face of a SimulatedArm that
     also keeps the tracker's last measurement."""
 
-    def __init__(self, arm: SimulatedArm) -> None:
+    def __init__(self, arm: SimulatedArm, noise_psi: float = 0.0, seed: int = 0) -> None:
         self.arm = arm
         self.command = np.zeros(arm.n)
         self.measured = arm.reset(self.command)
+        self.noise_psi = noise_psi
+        self.rng = np.random.default_rng(seed)
 
     def command_pressures(self, psi: F64) -> None:
         self.command = np.asarray(psi, dtype=np.float64).copy()
 
     def pressures(self) -> F64:
-        return self.arm.pressure
+        p = self.arm.pressure
+        if self.noise_psi > 0.0:  # a pressure monitor's reading noise
+            p = p + self.rng.normal(0.0, self.noise_psi, p.shape)
+        return p
 
     def advance(self, dt: float) -> None:
         # The regulators receive psi; the plant converts through the nominal map and
@@ -92,6 +98,8 @@ class SimIdentificationRig:
         seed: the harvest seed; the plant is drawn from :func:`sim_plant_seed`.
         model: the nominal arm (default ``SoftArm.blackberry()``).
         period: control period (s).
+        reading_noise_psi: standard deviation of the pressure readings' noise (psi); the
+            plant's regulators are exact, a real pressure monitor is not.
     """
 
     def __init__(
@@ -100,11 +108,14 @@ class SimIdentificationRig:
         seed: int = 0,
         model: SoftArm | None = None,
         period: float = 0.05,
+        reading_noise_psi: float = 0.0,
     ) -> None:
         self.model = model if model is not None else SoftArm.blackberry()
         self.plant = plant if plant is not None else PlantConfig()
         self.arm = SimulatedArm(self.model, self.plant, seed=sim_plant_seed(seed))
-        self._sim = _SimPressures(self.arm)
+        if not (np.isfinite(reading_noise_psi) and reading_noise_psi >= 0.0):
+            raise ParameterError(f"reading_noise_psi = {reading_noise_psi}: must be >= 0")
+        self._sim = _SimPressures(self.arm, reading_noise_psi, sim_plant_seed(seed) + 1)
         self.period = period
         self.pose_cutoff: float | None = self.plant.cutoff
         self.metres_per_psi = METRES_PER_PSI
