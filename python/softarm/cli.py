@@ -33,6 +33,7 @@ COMMANDS: dict[str, str] = {
     "tune": "softarm.commands.tune",
     "calibrate": "softarm.commands.calibrate",
     "identify": "softarm.commands.identify",
+    "replay": "softarm.commands.replay",
 }
 
 

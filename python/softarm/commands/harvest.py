@@ -60,6 +60,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--report", type=output_file, help="write the JSON report here")
     p.add_argument("--log", type=output_file, help="write the JSON-lines step log here")
     p.add_argument("--plot", type=image_file, help="save a plot of the run (--sim only)")
+    p.add_argument(
+        "--view",
+        action="store_true",
+        help="stream the run to the rerun viewer (--sim only; viz extra)",
+    )
+    p.add_argument(
+        "--record", type=output_file, metavar="RUN.rrd",
+        help="save a rerun recording of the run (--sim only; viz extra)",
+    )  # fmt: skip
     add_plant_options(p)
     p.add_argument(
         "--gains",
@@ -77,6 +86,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None and not args.sim:
         print("softarm harvest: error: argument --plot: works with --sim only", file=sys.stderr)
         return 2
+    if (args.view or args.record is not None) and not args.sim:
+        print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
+        return 2
     configure_logging(args.quiet)
     with raise_on_signals():
         try:
@@ -85,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
             if args.sim:
                 return run_sim(
                     args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
-                    gains=gains, **options,
+                    gains=gains, view=args.view, record=args.record, **options,
                 )  # fmt: skip
             return _run_hardware(args)
         except Interrupted as exc:
@@ -125,6 +137,8 @@ def run_sim(
     plot_path: Path | None,
     quiet: bool = False,
     gains: dict[str, Any] | None = None,
+    view: bool = False,
+    record: Path | None = None,
     **options: Any,
 ) -> int:
     """The simulated harvest shared by ``harvest --sim`` and ``demo``; ``options`` are
@@ -138,11 +152,15 @@ def run_sim(
         from softarm.sweep.gains_file import apply_gains
 
         apply_gains(rig, gains)  # the closed-loop resolver's (--gains)
+    viewer = _viewer(rig, view, record)
     try:
         report = _harvest(rig, berries, quiet)
     except Interrupted as exc:
         stop(rig.machine.log, rig.machine.actuator.vent, exc)
         raise
+    finally:
+        if viewer is not None:
+            viewer.close()  # the recording complete, even after a stop
     print(summary(report.to_dict()))
     if report_path is not None:
         report.save(report_path)
@@ -152,6 +170,8 @@ def run_sim(
         print(f"plot: {plot_path}")
     if log_path is not None:
         print(f"log: {log_path}")
+    if record is not None:
+        print(f"recording: {record}")
     return 0 if all(b.final_state.value == "done" for b in report.berries) else 1
 
 
@@ -171,6 +191,15 @@ def _harvest(rig: SimRig, n: int, quiet: bool) -> HarvestReport:
                 bar.advance()
 
         return rig.run(on_berry)
+
+
+def _viewer(rig: SimRig, view: bool, record: Path | None) -> Any:
+    """The rerun view of ``rig`` (softarm.viz.sim_view) for --view/--record, else None."""
+    if not view and record is None:
+        return None
+    from softarm.viz.sim_view import attach
+
+    return attach(rig, record=record, spawn=view)
 
 
 def _plot(rig: SimRig, report: HarvestReport, path: Path) -> None:

@@ -4,6 +4,9 @@ asked for, with a one-line error that says how to install it."""
 from __future__ import annotations
 
 import importlib
+import os
+import shutil
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -12,6 +15,7 @@ from softarm.errors import SoftarmError
 __all__ = [
     "INSTALL",
     "MissingDependencyError",
+    "ViewerUnavailableError",
     "close_recording",
     "open_recording",
     "require_rerun",
@@ -28,6 +32,10 @@ TIMELINE = "sim_time"
 
 class MissingDependencyError(SoftarmError, ImportError):
     """An optional dependency is not installed."""
+
+
+class ViewerUnavailableError(SoftarmError):
+    """The rerun viewer cannot be started here (no display, no viewer executable)."""
 
 
 def require_rerun() -> Any:
@@ -54,8 +62,8 @@ def open_recording(name: str, record: str | Path | None = None, spawn: bool = Fa
     rr = require_rerun()
     stream = rr.RecordingStream(APPLICATION, recording_id=name)
     if spawn:
-        # Start the viewer without connecting, then send to it and to the file at once.
-        stream.spawn(connect=False)
+        _spawn_viewer(rr, stream)
+        # The viewer started without a connection: send to it and to the file at once.
         sinks = [rr.GrpcSink()]
         if record is not None:
             sinks.append(rr.FileSink(str(record)))
@@ -71,3 +79,30 @@ def close_recording(stream: Any) -> None:
     readers use) and is complete."""
     stream.flush()
     stream.disconnect()
+
+
+def _spawn_viewer(rr: Any, stream: Any) -> None:
+    """Start the rerun viewer (the executable the rerun-sdk wheel installs beside this
+    Python, when it is not on PATH), or a one-line :class:`ViewerUnavailableError`.
+
+    Without a display the viewer starts and dies at once and the run would lose its
+    data, so that case is refused before the run starts.
+    """
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        raise ViewerUnavailableError(
+            "no display for the rerun viewer (DISPLAY and WAYLAND_DISPLAY are unset): "
+            "record to a file with --record run.rrd and open it with `rerun run.rrd`"
+        )
+    beside = Path(sys.executable).with_name("rerun")
+    exe = shutil.which("rerun") or (str(beside) if beside.exists() else None)
+    if exe is None:
+        raise ViewerUnavailableError(
+            f"the rerun viewer executable is not on PATH: {INSTALL}, or use --record run.rrd"
+        )
+    try:
+        rr.spawn(connect=False, executable_path=exe, recording=stream)
+    except (RuntimeError, OSError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc)
+        raise ViewerUnavailableError(f"cannot start the rerun viewer: {first}") from None
