@@ -39,6 +39,7 @@ class Section:
     def offset(self) -> float: ...
     @property
     def twist(self) -> float: ...
+    def __reduce__(self) -> tuple[type[Section], tuple[float, float, float, float, float, float]]: ...
     def __eq__(self, value: object, /) -> bool: ...
     def __ne__(self, value: object, /) -> bool: ...
     __hash__: None  # type: ignore[assignment]
@@ -86,6 +87,7 @@ class SoftArm(_Kinematics):
     def sections(self) -> list[Section]: ...
     def configuration(self, q: _ArrayLike) -> _F64:
         """Eq. (1) per section: (arc length, bending angle, bending direction)."""
+    def __reduce__(self) -> tuple[type[SoftArm], tuple[list[Section]]]: ...
 
 @final
 class ArcChain(_Kinematics):
@@ -100,6 +102,7 @@ class ArcChain(_Kinematics):
     @property
     def lengths(self) -> _F64: ...
     def straight(self) -> _F64: ...
+    def __reduce__(self) -> tuple[type[ArcChain], tuple[_F64, _F64, _F64]]: ...
 
 @final
 class Gains:
@@ -285,6 +288,9 @@ class PolynomialCurve:
         """Point (3,) at a scalar u, or points (N, 3) at an array of u."""
     def sample(self, n: int) -> _F64:
         """n points evenly spaced in u, (n, 3)."""
+    def __reduce__(
+        self,
+    ) -> tuple[type[PolynomialCurve], tuple[_F64, tuple[float, float]]]: ...
 
 @final
 class Segment:
@@ -295,6 +301,7 @@ class Segment:
     def a(self) -> _F64: ...
     @property
     def b(self) -> _F64: ...
+    def __reduce__(self) -> tuple[type[Segment], tuple[_F64, _F64]]: ...
 
 @final
 class PointCloud:
@@ -304,6 +311,7 @@ class PointCloud:
     @property
     def points(self) -> _F64: ...
     def __len__(self) -> int: ...
+    def __reduce__(self) -> tuple[type[PointCloud], tuple[_F64]]: ...
 
 @final
 class TriangleMesh:
@@ -314,6 +322,15 @@ class TriangleMesh:
     ) -> TriangleMesh: ...
     @property
     def tolerance(self) -> float: ...
+    @property
+    def vertices(self) -> _F64:
+        """(N, 3) vertices."""
+    @property
+    def triangles(self) -> npt.NDArray[np.int64]:
+        """(M, 3) vertex indices of the triangles."""
+    def __reduce__(
+        self,
+    ) -> tuple[type[TriangleMesh], tuple[_F64, npt.NDArray[np.int64], float]]: ...
 
 _Obstacle = PolynomialCurve | Segment | PointCloud | TriangleMesh | _ArrayLike
 
@@ -333,6 +350,17 @@ class Closest:
     def arm_point(self) -> _F64: ...
     @property
     def obstacle_point(self) -> _F64: ...
+    def __reduce__(self) -> tuple[object, tuple[float, int, float, float, _F64, _F64]]: ...
+
+def _rebuild_closest(
+    distance: float,
+    section: int,
+    s: float,
+    u: float,
+    arm_point: _ArrayLike,
+    obstacle_point: _ArrayLike,
+) -> Closest:
+    """Unpickler of ``Closest``."""
 
 def closest(arm: SoftArm | ArcChain, q: _ArrayLike, obstacle: _Obstacle) -> Closest:
     """Closest pair between the arm at q and the obstacle (eq. 12-18, global)."""
@@ -356,7 +384,13 @@ class Plan:
         """Smallest exact distance of the whole backbone to any obstacle (m)."""
     @property
     def termination(self) -> str:
-        """ "reached", "stalled" or "iteration_limit"."""
+        """ "reached", "stalled", "iteration_limit" or "non_finite_step"."""
+    def __reduce__(self) -> tuple[object, tuple[_F64, _F64, int, float, str]]: ...
+
+def _rebuild_plan(
+    path: _ArrayLike, tip_path: _ArrayLike, iterations: int, min_clearance: float, termination: str
+) -> Plan:
+    """Unpickler of ``Plan``."""
 
 @final
 class PotentialFieldPlanner:
@@ -384,6 +418,7 @@ class PotentialFieldPlanner:
         self, q0: _ArrayLike, goal: _ArrayLike, obstacles: Sequence[_Obstacle] | None = None
     ) -> Plan:
         """Plan from q0 to the tip position goal; releases the GIL."""
+    def __reduce__(self) -> tuple[object, tuple[SoftArm | ArcChain]]: ...
 
 def path_clearance(
     arm: SoftArm | ArcChain,

@@ -2,7 +2,7 @@
 
 use crate::arc::ArcParams;
 use crate::chain::{SectionModel, SectionState};
-use crate::error::{check_finite, check_len, Error, Result};
+use crate::error::{check_bounded, check_len, check_parameter, Error, Result, MAX_COORDINATE};
 use crate::kinematics::Kinematics;
 use crate::math::{Mat3, Vec3};
 
@@ -21,24 +21,29 @@ pub struct ArcChain {
 }
 
 impl ArcChain {
+    /// Smallest static segment length (m).
+    pub const MIN_LENGTH: f64 = 1e-6;
+    /// Largest static segment length (m); the default length limits (1.5 L) then stay well
+    /// inside [`crate::error::MAX_COORDINATE`].
+    pub const MAX_LENGTH: f64 = 1e4;
+
     /// A chain with static segment lengths `lengths` and default limits: length in
     /// [0.5, 1.5]·L0, Θ in [−π, π], φ in [−2π, 2π].
     ///
     /// # Errors
-    /// [`Error::Shape`] for no segment, [`Error::Parameter`] for a length that is not
-    /// positive and finite.
+    /// [`Error::Shape`] for no segment, [`Error::Parameter`] for a length outside
+    /// [[`ArcChain::MIN_LENGTH`], [`ArcChain::MAX_LENGTH`]].
     pub fn new(lengths: &[f64]) -> Result<Self> {
         if lengths.is_empty() {
             return Err(Error::shape("lengths", "at least one segment", "none"));
         }
         for (i, &l) in lengths.iter().enumerate() {
-            if !(l.is_finite() && l > 0.0) {
-                return Err(Error::parameter(
-                    &format!("lengths[{i}]"),
-                    l,
-                    "must be positive and finite",
-                ));
-            }
+            check_parameter(
+                &format!("lengths[{i}]"),
+                l,
+                Self::MIN_LENGTH,
+                Self::MAX_LENGTH,
+            )?;
         }
         let pi = std::f64::consts::PI;
         let lower = lengths
@@ -59,14 +64,15 @@ impl ArcChain {
     /// The same chain with explicit limits (3 per segment).
     ///
     /// # Errors
-    /// [`Error::Shape`], [`Error::NonFinite`], or [`Error::Parameter`] when a lower limit
+    /// [`Error::Shape`], [`Error::NonFinite`], [`Error::OutOfRange`] for a limit beyond
+    /// [`crate::error::MAX_COORDINATE`], or [`Error::Parameter`] when a lower limit
     /// is not below its upper limit or a length limit is not positive.
     pub fn with_limits(mut self, lower: &[f64], upper: &[f64]) -> Result<Self> {
         let n = 3 * self.lengths.len();
         check_len("lower", lower, n)?;
         check_len("upper", upper, n)?;
-        check_finite("lower", lower)?;
-        check_finite("upper", upper)?;
+        check_bounded("lower", lower, MAX_COORDINATE)?;
+        check_bounded("upper", upper, MAX_COORDINATE)?;
         for i in 0..n {
             if lower[i] >= upper[i] {
                 return Err(Error::parameter(

@@ -9,7 +9,9 @@
 use nalgebra::{DMatrix, Matrix3xX};
 
 use crate::arc::ArcParams;
-use crate::error::{check_finite, check_len, check_range, Error, Result};
+use crate::error::{
+    check_bounded, check_count, check_len, check_range, Error, Result, MAX_COORDINATE, MAX_SAMPLES,
+};
 use crate::math::{Frame, Mat3, Mat4, Vec3};
 
 /// What one section contributes, at one configuration.
@@ -62,10 +64,29 @@ pub trait SectionModel {
     }
 }
 
-/// Checks a configuration vector: length and finiteness.
+/// Checks a configuration vector: length, finiteness, and magnitude at most
+/// [`MAX_COORDINATE`] (beyond it products in the kinematics could overflow).
 pub fn check_q<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<()> {
     check_len("q", q, model.n_dofs())?;
-    check_finite("q", q)
+    check_bounded("q", q, MAX_COORDINATE)
+}
+
+/// [`check_q`], and that every section is a real arc: a positive arc length. Distance
+/// queries need it (the closed forms of [`crate::distance`] take `L > 0`; a negative length
+/// mirrors the arc and its distances stop being the backbone's).
+pub fn check_q_arcs<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<()> {
+    check_q(model, q)?;
+    for i in 0..model.n_sections() {
+        let length = state(model, q, i).arc.length;
+        if !(length > 0.0) {
+            return Err(Error::parameter(
+                &format!("q[{}..{}]", 3 * i, 3 * i + 3),
+                length,
+                format!("gives section {i} a non-positive arc length"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks a (section, s) pair for backbone-point queries.
@@ -280,13 +301,6 @@ pub fn backbone<M: SectionModel + ?Sized>(
     samples: usize,
 ) -> Result<Vec<Vec3>> {
     check_q(model, q)?;
-    if samples < 2 {
-        return Err(Error::OutOfRange {
-            arg: "samples".into(),
-            value: samples as f64,
-            min: 2.0,
-            max: f64::INFINITY,
-        });
-    }
+    check_count("samples", samples, 2, MAX_SAMPLES)?;
     Ok(backbone_unchecked(model, q, samples))
 }

@@ -119,3 +119,66 @@ pub fn check_range(arg: &str, value: f64, min: f64, max: f64) -> Result<()> {
         })
     }
 }
+
+/// Largest magnitude of a configuration coordinate (m or rad). Far beyond any arm, and
+/// small enough that every product the kinematics forms (lengths times bending angles,
+/// squared distances) stays finite.
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// Largest magnitude of an obstacle coordinate or a goal position (m). Squared distances
+/// and the curve search's products of positions and speeds stay below 1e300.
+pub const MAX_POSITION: f64 = 1e100;
+
+/// Most samples of one curve, section or path that a call may ask for: enough for any
+/// plot or baseline, small enough that the output (3 f64 per sample) always fits in memory.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
+/// Most iterations of an iterative call (planner steps, stall windows): the path stores one
+/// configuration per iteration.
+pub const MAX_ITERATIONS: usize = 100_000;
+
+/// Fails with [`Error::OutOfRange`] unless `min <= value <= max`, for a count.
+pub fn check_count(arg: &str, value: usize, min: usize, max: usize) -> Result<()> {
+    if value >= min && value <= max {
+        Ok(())
+    } else {
+        Err(Error::OutOfRange {
+            arg: arg.to_owned(),
+            value: value as f64,
+            min: min as f64,
+            max: max as f64,
+        })
+    }
+}
+
+/// Fails unless every value is finite and at most `bound` in magnitude: a
+/// [`Error::NonFinite`] for NaN or infinity, an [`Error::OutOfRange`] naming `arg[index]`
+/// for a finite value beyond the bound.
+pub fn check_bounded(arg: &str, values: &[f64], bound: f64) -> Result<()> {
+    check_finite(arg, values)?;
+    match values.iter().position(|v| v.abs() > bound) {
+        None => Ok(()),
+        Some(i) => Err(Error::OutOfRange {
+            arg: format!("{arg}[{i}]"),
+            value: values[i],
+            min: -bound,
+            max: bound,
+        }),
+    }
+}
+
+/// Fails with [`Error::Parameter`] unless `value` is finite and `min <= value <= max`.
+pub fn check_parameter(arg: &str, value: f64, min: f64, max: f64) -> Result<()> {
+    if !value.is_finite() {
+        return Err(Error::parameter(arg, value, "must be finite"));
+    }
+    if value >= min && value <= max {
+        Ok(())
+    } else {
+        Err(Error::parameter(
+            arg,
+            value,
+            format!("must lie in [{min}, {max}]"),
+        ))
+    }
+}

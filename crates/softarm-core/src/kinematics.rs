@@ -51,7 +51,8 @@ pub trait Kinematics: SectionModel {
     /// `samples` points per section along the backbone (both ends included).
     ///
     /// # Errors
-    /// As [`Kinematics::forward`], plus [`Error::OutOfRange`] for `samples < 2`.
+    /// As [`Kinematics::forward`], plus [`Error::OutOfRange`] for `samples` outside
+    /// [2, [`crate::error::MAX_SAMPLES`]].
     fn backbone(&self, q: &[f64], samples: usize) -> Result<Vec<Vec3>> {
         chain::backbone(self, q, samples)
     }

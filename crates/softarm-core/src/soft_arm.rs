@@ -2,7 +2,7 @@
 
 use crate::arc::ArcParams;
 use crate::chain::{self, SectionModel, SectionState};
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, check_parameter, Error, Result};
 use crate::kinematics::Kinematics;
 use crate::math::{Mat3, Vec3};
 use crate::pneumatic::{arc_params, arc_params_jacobian, polar_config, PolarConfig};
@@ -25,12 +25,23 @@ pub struct Section {
 }
 
 impl Section {
+    /// Smallest actuator radius (m). Bending angles scale as elongation / radius: a
+    /// radius far below a millimetre would bend a section thousands of turns (and a
+    /// subnormal one overflows the kinematics to NaN).
+    pub const MIN_RADIUS: f64 = 1e-4;
+    /// Largest actuator radius, rest length, offset and |elongation limit| (m).
+    pub const MAX_SIZE: f64 = 100.0;
+    /// Smallest rest length (m).
+    pub const MIN_REST_LENGTH: f64 = 1e-4;
+
     /// A validated section.
     ///
     /// # Errors
-    /// [`Error::Parameter`] for a non-finite value, a radius or rest length that is not
-    /// positive, `lower >= upper`, a lower limit that would give a non-positive arc
-    /// length, or a negative offset.
+    /// [`Error::Parameter`] for a non-finite value, a radius outside
+    /// [[`Section::MIN_RADIUS`], [`Section::MAX_SIZE`]], a rest length outside
+    /// [[`Section::MIN_REST_LENGTH`], [`Section::MAX_SIZE`]], limits or an offset beyond
+    /// [`Section::MAX_SIZE`], `lower >= upper`, a lower limit that would give a
+    /// non-positive arc length, a negative offset, or a twist beyond one turn.
     pub fn new(
         radius: f64,
         rest_length: f64,
@@ -39,28 +50,18 @@ impl Section {
         offset: f64,
         twist: f64,
     ) -> Result<Self> {
-        for (name, v) in [
-            ("radius", radius),
-            ("rest_length", rest_length),
-            ("lower", lower),
-            ("upper", upper),
-            ("offset", offset),
-            ("twist", twist),
-        ] {
-            if !v.is_finite() {
-                return Err(Error::parameter(name, v, "must be finite"));
-            }
-        }
-        if radius <= 0.0 {
-            return Err(Error::parameter("radius", radius, "must be positive"));
-        }
-        if rest_length <= 0.0 {
-            return Err(Error::parameter(
-                "rest_length",
-                rest_length,
-                "must be positive",
-            ));
-        }
+        let tau = std::f64::consts::TAU;
+        check_parameter("radius", radius, Self::MIN_RADIUS, Self::MAX_SIZE)?;
+        check_parameter(
+            "rest_length",
+            rest_length,
+            Self::MIN_REST_LENGTH,
+            Self::MAX_SIZE,
+        )?;
+        check_parameter("lower", lower, -Self::MAX_SIZE, Self::MAX_SIZE)?;
+        check_parameter("upper", upper, -Self::MAX_SIZE, Self::MAX_SIZE)?;
+        check_parameter("offset", offset, 0.0, Self::MAX_SIZE)?;
+        check_parameter("twist", twist, -tau, tau)?;
         if lower >= upper {
             return Err(Error::parameter(
                 "lower",
@@ -74,9 +75,6 @@ impl Section {
                 lower,
                 format!("must exceed -rest_length = {}", -rest_length),
             ));
-        }
-        if offset < 0.0 {
-            return Err(Error::parameter("offset", offset, "must not be negative"));
         }
         Ok(Section {
             radius,

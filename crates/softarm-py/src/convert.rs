@@ -4,18 +4,44 @@
 use nalgebra::{DMatrix, Matrix3xX};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyOverflowError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt};
 use softarm_core::{Frame, Mat4, Vec3};
 
-use crate::errors::{InputError, ShapeError};
+use crate::errors::{InputError, OutOfRangeError, ShapeError};
 
 static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+static CONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+
+/// Array kinds accepted as real numbers: signed and unsigned integers and floats. Complex
+/// (whose imaginary part a float conversion would drop), strings (which numpy would parse),
+/// booleans, objects and dates are refused by name.
+const REAL_KINDS: &str = "iuf";
+
+/// `numpy.asarray(obj)` (shape kept, no dtype forced), refused unless its dtype is real.
+fn real_asarray<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    let asarray = ASARRAY.get_or_try_init(py, || -> PyResult<Py<PyAny>> {
+        Ok(py.import("numpy")?.getattr("asarray")?.unbind())
+    })?;
+    let a = asarray.bind(py).call1((obj,)).map_err(|e| {
+        InputError::new_err(format!("{arg}: cannot be read as a float array ({e})"))
+    })?;
+    let dtype = a.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    if !REAL_KINDS.contains(kind.as_str()) {
+        return Err(InputError::new_err(format!(
+            "{arg}: expected real numbers, got dtype {}",
+            dtype.str()?
+        )));
+    }
+    Ok(a)
+}
 
 /// A float64, C-contiguous array view of `obj` (converted with `numpy.asarray` when it
-/// is not one already), kept alive by the returned handle.
+/// is not one already), kept alive by the returned handle. Only real dtypes are converted.
 pub fn as_array<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
         if a.is_c_contiguous() {
@@ -23,17 +49,78 @@ pub fn as_array<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, 
         }
     }
     let py = obj.py();
-    let asarray = ASARRAY.get_or_try_init(py, || -> PyResult<Py<PyAny>> {
+    let real = real_asarray(obj, arg)?;
+    let contiguous = CONTIGUOUS.get_or_try_init(py, || -> PyResult<Py<PyAny>> {
         Ok(py.import("numpy")?.getattr("ascontiguousarray")?.unbind())
     })?;
     let kwargs = PyDict::new(py);
     kwargs.set_item("dtype", "float64")?;
-    let converted = asarray.bind(py).call((obj,), Some(&kwargs)).map_err(|e| {
-        InputError::new_err(format!("{arg}: cannot be read as a float array ({e})"))
-    })?;
+    let converted = contiguous
+        .bind(py)
+        .call((real,), Some(&kwargs))
+        .map_err(|e| {
+            InputError::new_err(format!("{arg}: cannot be read as a float array ({e})"))
+        })?;
     converted
         .cast_into::<PyArrayDyn<f64>>()
         .map_err(|_| InputError::new_err(format!("{arg}: cannot be read as a float array")))
+}
+
+/// A real scalar argument: a Python float or int, or a numpy real scalar or 0-d array.
+/// Booleans, complex numbers, strings and arrays are refused by name, never coerced.
+pub fn real(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<f64> {
+    if let Ok(f) = obj.cast::<PyFloat>() {
+        return Ok(f.value());
+    }
+    if obj.is_instance_of::<PyInt>() && !obj.is_instance_of::<PyBool>() {
+        return obj.extract::<f64>().map_err(|_| {
+            let shown = obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string());
+            OutOfRangeError::new_err(format!("{arg} = {shown} is beyond the float range"))
+        });
+    }
+    let not_real = || -> PyResult<PyErr> {
+        Ok(InputError::new_err(format!(
+            "{arg}: expected a real number, got {}",
+            obj.get_type().name()?
+        )))
+    };
+    if obj.is_instance_of::<PyBool>() {
+        return Err(not_real()?);
+    }
+    let Ok(a) = real_asarray(obj, arg) else {
+        return Err(not_real()?);
+    };
+    if a.getattr("ndim")?.extract::<usize>()? != 0 {
+        return Err(not_real()?);
+    }
+    a.call_method0("item")?.extract::<f64>()
+}
+
+/// A count argument: a Python or numpy integer in `[min, max]`. A float, a bool or another
+/// type is an [`InputError`]; an integer out of range (however large, or negative) is an
+/// [`OutOfRangeError`] that shows the value given.
+pub fn count(obj: &Bound<'_, PyAny>, arg: &str, min: usize, max: usize) -> PyResult<usize> {
+    let out_of_range = || {
+        let shown = obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string());
+        OutOfRangeError::new_err(format!("{arg} = {shown} is out of range [{min}, {max}]"))
+    };
+    if obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyFloat>() {
+        return Err(InputError::new_err(format!(
+            "{arg}: expected an integer, got {}",
+            obj.get_type().name()?
+        )));
+    }
+    match obj.extract::<i64>() {
+        Ok(v) => usize::try_from(v)
+            .ok()
+            .filter(|&v| v >= min && v <= max)
+            .ok_or_else(out_of_range),
+        Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => Err(out_of_range()),
+        Err(_) => Err(InputError::new_err(format!(
+            "{arg}: expected an integer, got {}",
+            obj.get_type().name()?
+        ))),
+    }
 }
 
 /// Shape of an array as a readable string, e.g. `(3, 4)`.

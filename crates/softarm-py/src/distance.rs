@@ -4,11 +4,12 @@
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyType;
 use softarm_core::chain::SectionModel;
 use softarm_core::distance::{self as dist, Obstacle};
 use softarm_core::{self as core, Vec3};
 
-use crate::convert::{array, points_out, reshape, vec3_out, vector};
+use crate::convert::{array, count, points_out, real, reshape, vec3_out, vector};
 use crate::errors::{InputError, IntoPyResult};
 use crate::kinematics::{ArcChain, SoftArm};
 
@@ -82,9 +83,10 @@ impl PolynomialCurve {
 impl PolynomialCurve {
     /// `coeffs` (3, d + 1): ascending powers of u, row 0 is x(u); `u_range` (u_min, u_max).
     #[new]
-    fn new(coeffs: &Bound<'_, PyAny>, u_range: (f64, f64)) -> PyResult<Self> {
+    fn new(coeffs: &Bound<'_, PyAny>, u_range: &Bound<'_, PyAny>) -> PyResult<Self> {
         let (flat, _) = array(coeffs, "coeffs", &[Some(3), None])?;
-        let c = dist::PolynomialCurve::from_rows(&flat, u_range).py()?;
+        let r = vector(u_range, "u_range", 2)?;
+        let c = dist::PolynomialCurve::from_rows(&flat, (r[0], r[1])).py()?;
         Ok(PolynomialCurve {
             obstacle: Obstacle::Curve(c.clone()),
             curve: c,
@@ -119,7 +121,7 @@ impl PolynomialCurve {
 
     /// Points at the parameters `u` (scalar → (3,), array (N,) → (N, 3)).
     fn __call__<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        if let Ok(v) = u.extract::<f64>() {
+        if let Ok(v) = real(u, "u") {
             return Ok(vec3_out(py, &self.curve().eval(v)).into_any());
         }
         let (us, _) = array(u, "u", &[None])?;
@@ -128,8 +130,22 @@ impl PolynomialCurve {
     }
 
     /// `n` points evenly spaced in u (the paper's point model of the curve), (n, 3).
-    fn sample<'py>(&self, py: Python<'py>, n: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        points_out(py, &self.curve().sample(n))
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        n: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = count(n, "n", 0, core::error::MAX_SAMPLES)?;
+        points_out(py, &self.curve().sample(n).py()?)
+    }
+
+    /// Pickling and `copy.deepcopy`: rebuilt from its coefficients and range.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyType>, (Bound<'py, PyArray2<f64>>, (f64, f64)))> {
+        let me = slf.get();
+        Ok((slf.get_type(), (me.coeffs(slf.py())?, me.u_range())))
     }
 
     fn __repr__(&self) -> String {
@@ -174,6 +190,18 @@ impl Segment {
         vec3_out(py, &self.b)
     }
 
+    /// Pickling and `copy.deepcopy`: rebuilt from its end points.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (
+        Bound<'py, PyType>,
+        (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>),
+    ) {
+        let (py, me) = (slf.py(), slf.get());
+        (slf.get_type(), (me.a(py), me.b(py)))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Segment(a={:?}, b={:?})",
@@ -215,6 +243,13 @@ impl PointCloud {
         }
     }
 
+    /// Pickling and `copy.deepcopy`: rebuilt from its points (the hierarchy is rebuilt).
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyType>, (Bound<'py, PyArray2<f64>>,))> {
+        Ok((slf.get_type(), (slf.get().points(slf.py())?,)))
+    }
+
     fn __repr__(&self) -> String {
         format!("PointCloud(n={})", self.__len__())
     }
@@ -230,12 +265,16 @@ pub struct TriangleMesh {
 #[pymethods]
 impl TriangleMesh {
     #[new]
-    #[pyo3(signature = (vertices, triangles, tolerance = 1e-4))]
+    #[pyo3(
+        signature = (vertices, triangles, tolerance = None),
+        text_signature = "(vertices, triangles, tolerance=0.0001)"
+    )]
     fn new(
         vertices: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,
-        tolerance: f64,
+        tolerance: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let tolerance = tolerance.map_or(Ok(1e-4), |t| real(t, "tolerance"))?;
         let verts = points_arg(vertices, "vertices")?;
         let (flat, _) = array(triangles, "triangles", &[None, Some(3)])?;
         let mut tris = Vec::with_capacity(flat.len() / 3);
@@ -260,9 +299,55 @@ impl TriangleMesh {
     /// Chord tolerance (m).
     #[getter]
     fn tolerance(&self) -> f64 {
+        self.mesh().tolerance()
+    }
+
+    /// The vertices, (N, 3).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v: Vec<Vec3> = self
+            .mesh()
+            .mesh()
+            .vertices()
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, p.z))
+            .collect();
+        points_out(py, &v)
+    }
+
+    /// The triangles' vertex indices, (M, 3) int64.
+    #[getter]
+    fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let t = self.mesh().mesh().indices();
+        let flat: Vec<i64> = t.iter().flatten().map(|&i| i64::from(i)).collect();
+        let arr = numpy::ndarray::Array2::from_shape_vec([t.len(), 3], flat).map_err(|e| {
+            pyo3::exceptions::PyValueError::new_err(format!("internal shape mismatch: {e}"))
+        })?;
+        Ok(numpy::IntoPyArray::into_pyarray(arr, py))
+    }
+
+    /// Pickling and `copy.deepcopy`: rebuilt from its vertices, triangles and tolerance.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyType>,
+        (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, f64),
+    )> {
+        let (py, me) = (slf.py(), slf.get());
+        Ok((
+            slf.get_type(),
+            (me.vertices(py)?, me.triangles(py)?, me.tolerance()),
+        ))
+    }
+}
+
+impl TriangleMesh {
+    fn mesh(&self) -> &dist::TriangleMesh {
         match &self.obstacle {
-            Obstacle::Mesh(m) => m.tolerance(),
-            _ => 0.0,
+            Obstacle::Mesh(m) => m,
+            // The constructor only ever stores a mesh.
+            _ => unreachable!("a TriangleMesh holds a mesh"),
         }
     }
 }
@@ -281,6 +366,8 @@ pub fn obstacle_from(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Obstacle> {
     if let Ok(m) = obj.cast::<TriangleMesh>() {
         return Ok(m.get().obstacle.clone());
     }
+    // The point is validated by the core query (`Obstacle::validate`, the one check of
+    // every obstacle form), like every obstacle the core receives.
     match vector(obj, arg, 3) {
         Ok(v) => Ok(Obstacle::Point(Vec3::new(v[0], v[1], v[2]))),
         Err(_) => Err(InputError::new_err(format!(
@@ -346,6 +433,37 @@ impl Closest {
     fn obstacle_point<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vec3_out(py, &self.inner.obstacle_point)
     }
+    /// Pickling and `copy.deepcopy`, through `_core._rebuild_closest`.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            f64,
+            usize,
+            f64,
+            f64,
+            Bound<'py, PyArray1<f64>>,
+            Bound<'py, PyArray1<f64>>,
+        ),
+    )> {
+        let c = &self.inner;
+        let f = py.import("softarm._core")?.getattr("_rebuild_closest")?;
+        Ok((
+            f,
+            (
+                c.distance,
+                c.section,
+                c.s,
+                c.u,
+                self.arm_point(py),
+                self.obstacle_point(py),
+            ),
+        ))
+    }
+
     fn __repr__(&self) -> String {
         let c = &self.inner;
         format!(
@@ -373,6 +491,30 @@ fn closest(
     Ok(Closest { inner })
 }
 
+/// Rebuilds a `Closest` from its fields (the unpickler of `Closest.__reduce__`).
+#[pyfunction]
+fn _rebuild_closest(
+    distance: f64,
+    section: usize,
+    s: f64,
+    u: f64,
+    arm_point: &Bound<'_, PyAny>,
+    obstacle_point: &Bound<'_, PyAny>,
+) -> PyResult<Closest> {
+    let a = vector(arm_point, "arm_point", 3)?;
+    let o = vector(obstacle_point, "obstacle_point", 3)?;
+    Ok(Closest {
+        inner: dist::Closest {
+            distance,
+            section,
+            s,
+            u,
+            arm_point: Vec3::new(a[0], a[1], a[2]),
+            obstacle_point: Vec3::new(o[0], o[1], o[2]),
+        },
+    })
+}
+
 /// Registers the distance classes and `closest`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PolynomialCurve>()?;
@@ -381,5 +523,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<TriangleMesh>()?;
     m.add_class::<Closest>()?;
     m.add_function(wrap_pyfunction!(closest, m)?)?;
+    m.add_function(wrap_pyfunction!(_rebuild_closest, m)?)?;
     Ok(())
 }

@@ -1,38 +1,32 @@
 //! `SoftArm`, `Section` and `ArcChain` for Python. Both arm classes get the same
 //! kinematic methods from one macro, so the two can never drift apart.
 
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayDyn, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
+use pyo3::types::PyType;
 use softarm_core::chain::{forward_jacobian_into, forward_unchecked, SectionModel};
 use softarm_core::{self as core, Kinematics};
 
 use crate::convert::{
-    array, array_view, dmatrix_out, mat4_out, matrix3x_out, points_out, vec3_out, vector,
+    array, count, dmatrix_out, mat4_out, matrix3x_out, points_out, real, vec3_out, vector,
     write_dmatrix, write_frame, write_mat4,
 };
-use crate::errors::{IntoPyResult, OutOfRangeError};
+use crate::errors::IntoPyResult;
 
 /// Converts a Python section index, rejecting negative and too large values by name.
-fn section_index<M: SectionModel>(model: &M, section: i64) -> PyResult<usize> {
-    let n = model.n_sections();
-    usize::try_from(section)
-        .ok()
-        .filter(|&s| s < n)
-        .ok_or_else(|| {
-            OutOfRangeError::new_err(format!(
-                "section = {section} is out of range [0, {}]",
-                n.saturating_sub(1)
-            ))
-        })
+fn section_index<M: SectionModel>(model: &M, section: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count(section, "section", 0, model.n_sections().saturating_sub(1))
 }
 
-/// An (N, n) batch of configurations as a C-contiguous float64 array (no copy when it
-/// already is one).
-fn batch_input<'py, M: SectionModel>(
-    model: &M,
-    qs: &Bound<'py, PyAny>,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    array_view(qs, "qs", &[None, Some(model.n_dofs())])
+/// An (N, n) batch of configurations, checked and copied. The copy is taken while the GIL
+/// is held, so that another thread writing the caller's array after validation (while
+/// the batch runs without the GIL) can neither put NaN into the output nor race with the
+/// read: the batch only ever reads memory it owns. One memcpy per call, small beside the
+/// kinematics of each row.
+fn batch_input<M: SectionModel>(model: &M, qs: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let (flat, _) = array(qs, "qs", &[None, Some(model.n_dofs())])?;
+    core::error::check_bounded("qs", &flat, core::error::MAX_COORDINATE).py()?;
+    Ok(flat)
 }
 
 macro_rules! kinematic_methods {
@@ -96,11 +90,12 @@ macro_rules! kinematic_methods {
                 &self,
                 py: Python<'py>,
                 q: &Bound<'py, PyAny>,
-                section: i64,
-                s: f64,
+                section: &Bound<'py, PyAny>,
+                s: &Bound<'py, PyAny>,
             ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
                 let q = vector(q, "q", self.inner.n_dofs())?;
                 let section = section_index(&self.inner, section)?;
+                let s = real(s, "s")?;
                 let (p, j) = self.inner.point(&q, section, s).py()?;
                 Ok((vec3_out(py, &p), matrix3x_out(py, &j)?))
             }
@@ -122,20 +117,20 @@ macro_rules! kinematic_methods {
 
             /// `samples` points per section along the backbone, ends included:
             /// (n_sections * samples, 3).
-            #[pyo3(signature = (q, samples = 20))]
-            fn backbone<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, samples: i64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+            #[pyo3(signature = (q, samples = None), text_signature = "(self, q, samples=20)")]
+            fn backbone<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, samples: Option<&Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArray2<f64>>> {
                 let q = vector(q, "q", self.inner.n_dofs())?;
-                let samples = usize::try_from(samples).unwrap_or(0);
+                let samples = match samples {
+                    Some(v) => count(v, "samples", 2, core::error::MAX_SAMPLES)?,
+                    None => 20,
+                };
                 let pts = self.inner.backbone(&q, samples).py()?;
                 points_out(py, &pts)
             }
 
             /// Poses of a batch of configurations: (N, n) → (N, 4, 4). Releases the GIL.
             fn forward_batch<'py>(&self, py: Python<'py>, qs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-                let input = batch_input(&self.inner, qs)?;
-                let ro = input.readonly();
-                let flat = ro.as_slice()?;
-                core::error::check_finite("qs", flat).py()?;
+                let flat = batch_input(&self.inner, qs)?;
                 let n = self.inner.n_dofs();
                 let rows = flat.len() / n;
                 let out = PyArray3::<f64>::zeros(py, [rows, 4, 4], false);
@@ -154,10 +149,7 @@ macro_rules! kinematic_methods {
 
             /// Jacobians of a batch of configurations: (N, n) → (N, 6, n). Releases the GIL.
             fn jacobian_batch<'py>(&self, py: Python<'py>, qs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-                let input = batch_input(&self.inner, qs)?;
-                let ro = input.readonly();
-                let flat = ro.as_slice()?;
-                core::error::check_finite("qs", flat).py()?;
+                let flat = batch_input(&self.inner, qs)?;
                 let n = self.inner.n_dofs();
                 let rows = flat.len() / n;
                 let out = PyArray3::<f64>::zeros(py, [rows, 6, n], false);
@@ -189,17 +181,40 @@ pub struct Section {
 #[pymethods]
 impl Section {
     #[new]
-    #[pyo3(signature = (radius, rest_length, lower, upper, offset = 0.0, twist = 0.0))]
+    #[pyo3(
+        signature = (radius, rest_length, lower, upper, offset = None, twist = None),
+        text_signature = "(radius, rest_length, lower, upper, offset=0.0, twist=0.0)"
+    )]
     fn new(
-        radius: f64,
-        rest_length: f64,
-        lower: f64,
-        upper: f64,
-        offset: f64,
-        twist: f64,
+        radius: &Bound<'_, PyAny>,
+        rest_length: &Bound<'_, PyAny>,
+        lower: &Bound<'_, PyAny>,
+        upper: &Bound<'_, PyAny>,
+        offset: Option<&Bound<'_, PyAny>>,
+        twist: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let inner = core::Section::new(radius, rest_length, lower, upper, offset, twist).py()?;
+        let opt = |v: Option<&Bound<'_, PyAny>>, arg: &str| v.map_or(Ok(0.0), |v| real(v, arg));
+        let inner = core::Section::new(
+            real(radius, "radius")?,
+            real(rest_length, "rest_length")?,
+            real(lower, "lower")?,
+            real(upper, "upper")?,
+            opt(offset, "offset")?,
+            opt(twist, "twist")?,
+        )
+        .py()?;
         Ok(Section { inner })
+    }
+
+    /// Pickling and `copy.deepcopy`: rebuilt through the validating constructor.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (Bound<'py, PyType>, (f64, f64, f64, f64, f64, f64)) {
+        let s = &slf.get().inner;
+        (
+            slf.get_type(),
+            (s.radius, s.rest_length, s.lower, s.upper, s.offset, s.twist),
+        )
     }
 
     /// Actuator distance from the centre line (m).
@@ -297,6 +312,18 @@ kinematic_methods!(SoftArm, {
         crate::convert::reshape(py, flat, [cfg.len(), 3])
     }
 
+    /// Pickling and `copy.deepcopy`: rebuilt from its sections.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, PyType>, (Vec<Section>,)) {
+        let sections = slf
+            .get()
+            .inner
+            .sections()
+            .iter()
+            .map(|&inner| Section { inner })
+            .collect();
+        (slf.get_type(), (sections,))
+    }
+
     fn __repr__(&self) -> String {
         format!("SoftArm(n_sections={})", self.inner.n_sections())
     }
@@ -342,6 +369,30 @@ kinematic_methods!(ArcChain, {
     /// The straight configuration at the static lengths, shape (n,).
     fn straight<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, self.inner.straight())
+    }
+
+    /// Pickling and `copy.deepcopy`: rebuilt from its lengths and limits.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (
+        Bound<'py, PyType>,
+        (
+            Bound<'py, PyArray1<f64>>,
+            Bound<'py, PyArray1<f64>>,
+            Bound<'py, PyArray1<f64>>,
+        ),
+    ) {
+        let py = slf.py();
+        let c = &slf.get().inner;
+        (
+            slf.get_type(),
+            (
+                PyArray1::from_slice(py, c.lengths()),
+                PyArray1::from_slice(py, c.lower()),
+                PyArray1::from_slice(py, c.upper()),
+            ),
+        )
     }
 
     fn __repr__(&self) -> String {

@@ -44,23 +44,13 @@ impl PointCloud {
     /// A cloud of `points`.
     ///
     /// # Errors
-    /// [`Error::Shape`] for an empty cloud, [`Error::NonFinite`] for a NaN or infinite
-    /// coordinate (index into the flattened (N, 3) array).
+    /// [`Error::Shape`] for an empty cloud, otherwise as
+    /// [`super::obstacle::check_points`].
     pub fn new(points: Vec<Vec3>) -> Result<Self> {
         if points.is_empty() {
             return Err(Error::shape("points", "at least one point", "none"));
         }
-        for (i, p) in points.iter().enumerate() {
-            for (j, v) in p.iter().enumerate() {
-                if !v.is_finite() {
-                    return Err(Error::NonFinite {
-                        arg: "points".into(),
-                        index: 3 * i + j,
-                        value: *v,
-                    });
-                }
-            }
-        }
+        super::obstacle::check_points("points", &points)?;
         let leaves: Vec<Aabb> = points
             .iter()
             .map(|p| {

@@ -13,8 +13,20 @@ use parry3d_f64::shape::{FeatureId, Segment as PSegment, TriMesh};
 
 use super::arc_cloud::{from_parry, to_parry};
 use super::arc_point::PlacedArc;
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_parameter, Error, Result};
 use crate::math::Vec3;
+
+/// Smallest chord tolerance (m). Meeting a tolerance `e` on an arc of length `L` bent by
+/// `Θ` takes about `√(L Θ / 8e)` chords: 630 for a 1 m arc bent by π at 1 µm, but 20,000
+/// at 1 nm. Below a micron the chord count, not the geometry, would set the cost.
+pub const MIN_TOLERANCE: f64 = 1e-6;
+/// Largest chord tolerance (m).
+pub const MAX_TOLERANCE: f64 = 1.0;
+/// Most chords per arc. With the smallest tolerance this meets it for every arc with
+/// `L Θ ≤ 8 · 1e-6 · 65536² ≈ 3.4e4 m·rad` (any arm); a longer or more bent arc gets the
+/// sagitta of this many chords, still a conservative distance, reported in
+/// [`MeshHit::error`].
+pub const MAX_CHORDS: usize = 1 << 16;
 
 /// A triangle mesh obstacle.
 #[derive(Clone)]
@@ -45,28 +57,24 @@ pub struct MeshHit {
     pub arc_point: Vec3,
     /// Closest mesh point.
     pub mesh_point: Vec3,
+    /// The chord error bound `e` used (m): the tolerance or less, unless the arc needs more
+    /// than [`MAX_CHORDS`] chords.
+    pub error: f64,
 }
 
 impl TriangleMesh {
     /// A mesh from vertices and triangles; `tolerance` (m) bounds the chord error.
     ///
     /// # Errors
-    /// [`Error::Shape`] for no triangle or an index out of range, [`Error::NonFinite`]
-    /// for a bad vertex, [`Error::Parameter`] for a tolerance that is not positive.
+    /// [`Error::Shape`] for no triangle or an index out of range, as
+    /// [`super::obstacle::check_points`] for a bad vertex, [`Error::Parameter`] for a
+    /// tolerance outside [[`MIN_TOLERANCE`], [`MAX_TOLERANCE`]].
     pub fn new(vertices: &[Vec3], triangles: &[[u32; 3]], tolerance: f64) -> Result<Self> {
         if triangles.is_empty() {
             return Err(Error::shape("triangles", "at least one triangle", "none"));
         }
-        if !(tolerance.is_finite() && tolerance > 0.0) {
-            return Err(Error::parameter(
-                "tolerance",
-                tolerance,
-                "must be positive and finite",
-            ));
-        }
-        for v in vertices {
-            check_finite("vertices", v.as_slice())?;
-        }
+        check_parameter("tolerance", tolerance, MIN_TOLERANCE, MAX_TOLERANCE)?;
+        super::obstacle::check_points("vertices", vertices)?;
         let n = vertices.len();
         if let Some(t) = triangles.iter().flatten().find(|&&i| i as usize >= n) {
             return Err(Error::shape(
@@ -100,7 +108,7 @@ impl TriangleMesh {
     /// Distance between the chords of `arc` and the mesh (see the module docs).
     pub fn closest_to_arc(&self, arc: &PlacedArc) -> MeshHit {
         let mut k = 1usize;
-        while arc.arc.chord_error(k) > self.tolerance && k < 4096 {
+        while arc.arc.chord_error(k) > self.tolerance && k < MAX_CHORDS {
             k *= 2;
         }
         let e = arc.arc.chord_error(k);
@@ -110,6 +118,7 @@ impl TriangleMesh {
             triangle: 0,
             arc_point: arc.point(0.0),
             mesh_point: arc.point(0.0),
+            error: e,
         };
         let mut d_best = f64::INFINITY;
         let id = Pose::IDENTITY;
@@ -153,6 +162,7 @@ impl TriangleMesh {
                     triangle: tri as usize,
                     arc_point: arc.point(s),
                     mesh_point: pb,
+                    error: e,
                 };
             }
         }

@@ -16,7 +16,7 @@ pub use arc_curve::{closest_arc_curve, closest_arc_curve_within, ArcCurveHit};
 pub use arc_mesh::TriangleMesh;
 pub use arc_point::{LocalArc, PlacedArc};
 pub use obstacle::{
-    closest, closest_to_arc, closest_to_arcs, closest_to_arcs_within, placed_arcs, Closest,
-    Obstacle,
+    check_obstacles, check_points, closest, closest_to_arc, closest_to_arcs,
+    closest_to_arcs_within, placed_arcs, Closest, Obstacle,
 };
 pub use polynomial::{PolynomialCurve, Segment};

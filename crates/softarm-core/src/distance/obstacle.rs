@@ -5,8 +5,8 @@ use super::arc_curve::{closest_arc_curve, closest_arc_curve_within};
 use super::arc_mesh::TriangleMesh;
 use super::arc_point::PlacedArc;
 use super::polynomial::{PolynomialCurve, Segment};
-use crate::chain::{check_q, section_arc_unchecked};
-use crate::error::Result;
+use crate::chain::{check_q_arcs, section_arc_unchecked};
+use crate::error::{Error, Result, MAX_POSITION};
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
 
@@ -23,6 +23,72 @@ pub enum Obstacle {
     Cloud(PointCloud),
     /// A triangle mesh (parry TriMesh, chord approximation of the arc).
     Mesh(TriangleMesh),
+}
+
+/// The one check of obstacle geometry, used by every obstacle form (points, clouds,
+/// segments, mesh vertices; curves check their bounding sphere the same way): every
+/// coordinate finite and within [`MAX_POSITION`] of the origin. Errors index the flattened
+/// (N, 3) array.
+///
+/// # Errors
+/// [`Error::NonFinite`] for NaN or infinity, [`Error::OutOfRange`] for a coordinate beyond
+/// [`MAX_POSITION`].
+pub fn check_points(arg: &str, points: &[Vec3]) -> Result<()> {
+    for (i, p) in points.iter().enumerate() {
+        for (j, &v) in p.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(Error::NonFinite {
+                    arg: arg.to_owned(),
+                    index: 3 * i + j,
+                    value: v,
+                });
+            }
+            if v.abs() > MAX_POSITION {
+                return Err(Error::OutOfRange {
+                    arg: format!("{arg}[{}]", 3 * i + j),
+                    value: v,
+                    min: -MAX_POSITION,
+                    max: MAX_POSITION,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+impl Obstacle {
+    /// A point obstacle, checked by [`check_points`].
+    ///
+    /// # Errors
+    /// As [`check_points`].
+    pub fn point(p: Vec3) -> Result<Self> {
+        check_points("point", &[p])?;
+        Ok(Obstacle::Point(p))
+    }
+
+    /// Checks the obstacle; every query entry point calls it. Curves, segments, clouds and
+    /// meshes are checked when built (their fields are private, so they stay valid); a
+    /// point is a public variant and is checked here, by the same [`check_points`].
+    ///
+    /// # Errors
+    /// As [`check_points`], naming `arg`.
+    pub fn validate(&self, arg: &str) -> Result<()> {
+        match self {
+            Obstacle::Point(p) => check_points(arg, &[*p]),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// [`Obstacle::validate`] on every obstacle, naming `obstacles[k]`.
+///
+/// # Errors
+/// As [`check_points`].
+pub fn check_obstacles(obstacles: &[Obstacle]) -> Result<()> {
+    for (k, ob) in obstacles.iter().enumerate() {
+        ob.validate(&format!("obstacles[{k}]"))?;
+    }
+    Ok(())
 }
 
 impl From<PolynomialCurve> for Obstacle {
@@ -227,7 +293,9 @@ pub fn closest_to_arcs_within(
 /// every section (planning paper eq. 12–18: the global minimum over sections, `s` and `u`).
 ///
 /// # Errors
-/// [`crate::Error::Shape`] / [`crate::Error::NonFinite`] for a bad `q`.
+/// [`crate::Error::Shape`] / [`crate::Error::NonFinite`] / [`crate::Error::OutOfRange`] for a
+/// bad `q`, [`crate::Error::Parameter`] for a `q` that gives a section a non-positive arc
+/// length, and as [`Obstacle::validate`] for a bad obstacle.
 ///
 /// # Example
 /// ```
@@ -243,6 +311,7 @@ pub fn closest<K: Kinematics + ?Sized>(
     q: &[f64],
     obstacle: &Obstacle,
 ) -> Result<Closest> {
-    check_q(model, q)?;
+    check_q_arcs(model, q)?;
+    obstacle.validate("obstacle")?;
     Ok(closest_to_arcs(&placed_arcs(model, q), obstacle))
 }

@@ -1,7 +1,13 @@
 //! Parametric polynomial curves `F_o(u)` (planning paper eq. 10) and line segments.
 
-use crate::error::{Error, Result};
+use crate::error::{check_count, Error, Result, MAX_POSITION, MAX_SAMPLES};
 use crate::math::Vec3;
+
+/// Largest magnitude of a curve parameter `u`, and largest speed or acceleration bound
+/// (`|F_o'|`, `|F_o''|` over a grid interval). With positions below
+/// [`MAX_POSITION`] (1e100), every product the closest-point search forms (positions
+/// times speeds, speeds squared, parameters times slopes) stays below 1e300.
+pub const MAX_PARAMETER: f64 = 1e150;
 
 /// Most sample intervals a curve is bracketed with.
 pub(crate) const MAX_INTERVALS: usize = 64;
@@ -31,7 +37,11 @@ impl PolynomialCurve {
     ///
     /// # Errors
     /// [`Error::Shape`] for no coefficient, [`Error::NonFinite`] for a NaN or infinite
-    /// coefficient or bound, [`Error::Parameter`] for an empty range (`u_min >= u_max`).
+    /// coefficient or bound, [`Error::Parameter`] for an empty range (`u_min >= u_max`),
+    /// a bound beyond [`MAX_PARAMETER`], or a curve whose evaluation over its range is not
+    /// finite: one that leaves the ball of radius [`MAX_POSITION`] (1e100 m) or whose speed
+    /// or acceleration bound exceeds [`MAX_PARAMETER`]. The search's certificates are
+    /// products of these quantities; a curve beyond them would overflow to NaN and infinity.
     ///
     /// # Example
     /// ```
@@ -75,6 +85,15 @@ impl PolynomialCurve {
                 format!("u_min must be smaller than u_max = {u_max}"),
             ));
         }
+        for v in [u_min, u_max] {
+            if v.abs() > MAX_PARAMETER {
+                return Err(Error::parameter(
+                    "u_range",
+                    v,
+                    format!("must lie in [-{MAX_PARAMETER:e}, {MAX_PARAMETER:e}]"),
+                ));
+            }
+        }
         // Trailing zero coefficients do not raise the degree.
         let mut coeffs = coeffs.to_vec();
         while coeffs.len() > 1 && coeffs.last().is_some_and(|c| *c == Vec3::zeros()) {
@@ -103,19 +122,20 @@ impl PolynomialCurve {
             .skip(1)
             .map(|(k, c)| c * k as f64)
             .collect();
-        let speed = grid
+        let speed: Vec<f64> = grid
             .windows(2)
             .map(|w| speed_bound(&deriv, w[0], w[1]))
             .collect();
-        let accel = grid
+        let accel: Vec<f64> = grid
             .windows(2)
             .map(|w| speed_bound(&deriv2, w[0], w[1]))
             .collect();
-        let spheres = grid
+        let spheres: Vec<(Vec3, f64)> = grid
             .windows(2)
             .map(|w| bounding_sphere(&coeffs, w[0], w[1]))
             .collect();
         let sphere = bounding_sphere(&coeffs, u_min, u_max);
+        check_evaluation(&speed, &accel, &spheres, sphere)?;
         Ok(PolynomialCurve {
             coeffs,
             u_min,
@@ -219,8 +239,12 @@ impl PolynomialCurve {
 
     /// `n` points evenly spaced in `u` (both ends included): the point-set model of the
     /// curve that the paper compares against.
-    pub fn sample(&self, n: usize) -> Vec<Vec3> {
-        match n {
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for `n` above [`MAX_SAMPLES`].
+    pub fn sample(&self, n: usize) -> Result<Vec<Vec3>> {
+        check_count("n", n, 0, MAX_SAMPLES)?;
+        Ok(match n {
             0 => Vec::new(),
             1 => vec![self.eval(0.5 * (self.u_min + self.u_max))],
             _ => (0..n)
@@ -229,8 +253,50 @@ impl PolynomialCurve {
                     self.eval(self.u_min + t * (self.u_max - self.u_min))
                 })
                 .collect(),
-        }
+        })
     }
+}
+
+/// Rejects a curve whose bounds over its range are not finite or too large (see
+/// [`PolynomialCurve::new`]): the whole curve must lie within [`MAX_POSITION`] of the
+/// origin, as every other obstacle (see [`super::obstacle::check_points`]).
+fn check_evaluation(
+    speed: &[f64],
+    accel: &[f64],
+    spheres: &[(Vec3, f64)],
+    sphere: (Vec3, f64),
+) -> Result<()> {
+    let reach = |(c, r): (Vec3, f64)| c.norm() + r;
+    let far = std::iter::once(sphere)
+        .chain(spheres.iter().copied())
+        .map(reach)
+        .find(|v| !(*v <= MAX_POSITION));
+    if let Some(v) = far {
+        return Err(Error::parameter(
+            "coeffs",
+            v,
+            format!(
+                "the curve reaches this far (m) from the origin over u_range; it must stay \
+                 within {MAX_POSITION:e} m"
+            ),
+        ));
+    }
+    if let Some(v) = speed
+        .iter()
+        .chain(accel)
+        .copied()
+        .find(|v| !(*v <= MAX_PARAMETER))
+    {
+        return Err(Error::parameter(
+            "coeffs",
+            v,
+            format!(
+                "the curve's speed or acceleration bound over u_range exceeds \
+                 {MAX_PARAMETER:e}; rescale u"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Taylor coefficients of `P(m + h t)` in `t`, for `P` in ascending vector coefficients.
@@ -284,10 +350,10 @@ impl Segment {
     /// The segment from `a` to `b` (a point when `a == b`).
     ///
     /// # Errors
-    /// [`Error::NonFinite`] for a NaN or infinite coordinate.
+    /// As [`super::obstacle::check_points`] for either end.
     pub fn new(a: Vec3, b: Vec3) -> Result<Self> {
         for (name, v) in [("a", a), ("b", b)] {
-            crate::error::check_finite(name, v.as_slice())?;
+            super::obstacle::check_points(name, &[v])?;
         }
         let curve = PolynomialCurve::new(&[a, b - a], (0.0, 1.0))?;
         Ok(Segment { a, b, curve })

@@ -23,15 +23,19 @@
 mod options;
 pub mod scenarios;
 
-pub use options::{PlannerOptions, Termination};
+pub use options::{PlannerOptions, Termination, MAX_ARM_SAMPLES, MAX_OPTION};
 
 use nalgebra::{DMatrix, Matrix3, Matrix3xX};
 
-use crate::chain::{check_q, forward_jacobian_into, point_unchecked};
+use crate::chain::{check_q, check_q_arcs, forward_jacobian_into, point_unchecked};
 use crate::distance::{
-    closest_to_arcs, closest_to_arcs_within, placed_arcs, Closest, Obstacle, PlacedArc,
+    check_obstacles, closest_to_arcs, closest_to_arcs_within, placed_arcs, Closest, Obstacle,
+    PlacedArc,
 };
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_bounded, check_count, Error, Result, MAX_POSITION};
+
+/// Most configurations `path_clearance` interpolates between two path entries.
+pub const MAX_SUBSTEPS: usize = 10_000;
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
 
@@ -85,14 +89,16 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
     ///
     /// # Errors
     /// [`Error::Shape`] / [`Error::NonFinite`] for a bad `q0` or `goal`,
-    /// [`Error::OutOfRange`] for a `q0` outside the model's limits, [`Error::Parameter`]
+    /// [`Error::OutOfRange`] for a `q0` outside the model's limits or a goal beyond
+    /// [`MAX_POSITION`], as [`check_obstacles`] for a bad obstacle, [`Error::Parameter`]
     /// for a curve or mesh obstacle with `arm_samples` set (the sampled baseline supports
     /// points, clouds and segments).
     pub fn plan(&self, q0: &[f64], goal: &Vec3, obstacles: &[Obstacle]) -> Result<Plan> {
         let model = &self.model;
         let o = &self.options;
         check_q(model, q0)?;
-        check_finite("goal", goal.as_slice())?;
+        check_bounded("goal", goal.as_slice(), MAX_POSITION)?;
+        check_obstacles(obstacles)?;
         let (lo, hi) = (model.lower(), model.upper());
         for i in 0..q0.len() {
             crate::error::check_range(&format!("q0[{i}]"), q0[i], lo[i], hi[i])?;
@@ -197,6 +203,12 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
                 if !changed {
                     break;
                 }
+            }
+            if dq.iter().any(|v| !v.is_finite()) {
+                // A damping of 0 at a singular Jacobian: no step can be taken (eq. 8 has
+                // no finite solution); stop rather than write NaN into the path.
+                termination = Termination::NonFiniteStep;
+                break;
             }
             // Step limits, then the configuration limits.
             let mut scale: f64 = 1.0;
@@ -326,7 +338,8 @@ pub fn closest_sampled(arcs: &[PlacedArc], m: usize, obstacle: &Obstacle) -> Clo
 /// obstacle between two steps).
 ///
 /// # Errors
-/// As [`crate::distance::closest`] for a bad configuration in `path`.
+/// As [`crate::distance::closest`] for a bad configuration in `path` or a bad obstacle,
+/// [`Error::OutOfRange`] for `substeps` outside [1, [`MAX_SUBSTEPS`]].
 pub fn path_clearance<K: Kinematics + ?Sized>(
     model: &K,
     path: &[Vec<f64>],
@@ -334,8 +347,13 @@ pub fn path_clearance<K: Kinematics + ?Sized>(
     substeps: usize,
 ) -> Result<f64> {
     let mut min = f64::INFINITY;
+    check_count("substeps", substeps, 1, MAX_SUBSTEPS)?;
+    check_obstacles(obstacles)?;
+    // Interpolated configurations are convex combinations of checked ones: their
+    // coordinates stay finite and bounded, and each section's arc length (affine in q for
+    // both models) stays positive.
     for q in path {
-        check_q(model, q)?;
+        check_q_arcs(model, q)?;
     }
     for (k, q) in path.iter().enumerate() {
         min = min.min(clearance(&placed_arcs(model, q), obstacles));

@@ -1,6 +1,6 @@
 //! Planner options and termination reasons.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, MAX_ITERATIONS};
 
 /// Why [`super::PotentialFieldPlanner::plan`] stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -11,15 +11,18 @@ pub enum Termination {
     Stalled,
     /// `max_iterations` were taken.
     IterationLimit,
+    /// The step of eq. (9) was not finite (an undamped pseudo-inverse at a singularity).
+    NonFiniteStep,
 }
 
 impl Termination {
-    /// Lower-case name: "reached", "stalled", "iteration_limit".
+    /// Lower-case name: "reached", "stalled", "iteration_limit", "non_finite_step".
     pub fn name(&self) -> &'static str {
         match self {
             Termination::Reached => "reached",
             Termination::Stalled => "stalled",
             Termination::IterationLimit => "iteration_limit",
+            Termination::NonFiniteStep => "non_finite_step",
         }
     }
 }
@@ -71,45 +74,65 @@ impl Default for PlannerOptions {
     }
 }
 
+/// Largest gain, tolerance or distance option (in its own unit): far beyond any arm, and
+/// small enough that a step (gains times distances, divided by squared distances of at
+/// least 1 µm) stays finite.
+pub const MAX_OPTION: f64 = 1e3;
+
+/// Most arm points per section of the sampled baseline (brute force, per obstacle point
+/// and per iteration).
+pub const MAX_ARM_SAMPLES: usize = 10_000;
+
 impl PlannerOptions {
     /// Checks every option.
     ///
     /// # Errors
-    /// [`Error::Parameter`] naming the first option that is not finite and positive (the
-    /// damping may be 0; `arm_samples` must be at least 2 when set).
+    /// [`Error::Parameter`] naming the first option out of its range: the gains,
+    /// distances and tolerances finite, positive and at most [`MAX_OPTION`] (the repulsion
+    /// gain, the damping and the stall tolerance may be 0), `max_step_fraction` in (0, 1],
+    /// `max_iterations` and `stall_window` at most [`MAX_ITERATIONS`] (the window at least
+    /// 1), `arm_samples` in [2, [`MAX_ARM_SAMPLES`]] when set.
     pub fn validate(&self) -> Result<()> {
-        for (name, v, allow_zero) in [
-            ("attraction_gain", self.attraction_gain, false),
-            ("max_tip_step", self.max_tip_step, false),
-            ("repulsion_gain", self.repulsion_gain, true),
-            ("influence_distance", self.influence_distance, false),
-            ("max_step_fraction", self.max_step_fraction, false),
-            ("damping", self.damping, true),
-            ("goal_tolerance", self.goal_tolerance, false),
-            ("stall_tolerance", self.stall_tolerance, true),
+        for (name, v, allow_zero, max) in [
+            ("attraction_gain", self.attraction_gain, false, MAX_OPTION),
+            ("max_tip_step", self.max_tip_step, false, MAX_OPTION),
+            ("repulsion_gain", self.repulsion_gain, true, MAX_OPTION),
+            (
+                "influence_distance",
+                self.influence_distance,
+                false,
+                MAX_OPTION,
+            ),
+            ("max_step_fraction", self.max_step_fraction, false, 1.0),
+            ("damping", self.damping, true, MAX_OPTION),
+            ("goal_tolerance", self.goal_tolerance, false, MAX_OPTION),
+            ("stall_tolerance", self.stall_tolerance, true, MAX_OPTION),
         ] {
-            let ok = v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0));
+            let ok = v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) && v <= max;
             if !ok {
+                let low = if allow_zero { "[0" } else { "(0" };
                 return Err(Error::parameter(
                     name,
                     v,
-                    if allow_zero {
-                        "must be finite and not negative"
-                    } else {
-                        "must be finite and positive"
-                    },
+                    format!("must be finite and in {low}, {max}]"),
                 ));
             }
         }
-        if self.stall_window == 0 {
-            return Err(Error::parameter("stall_window", 0.0, "must be at least 1"));
-        }
-        if let Some(m) = self.arm_samples {
-            if m < 2 {
+        for (name, v, min, max) in [
+            ("max_iterations", self.max_iterations, 0, MAX_ITERATIONS),
+            ("stall_window", self.stall_window, 1, MAX_ITERATIONS),
+            (
+                "arm_samples",
+                self.arm_samples.unwrap_or(2),
+                2,
+                MAX_ARM_SAMPLES,
+            ),
+        ] {
+            if v < min || v > max {
                 return Err(Error::parameter(
-                    "arm_samples",
-                    m as f64,
-                    "must be at least 2",
+                    name,
+                    v as f64,
+                    format!("must be an integer in [{min}, {max}]"),
                 ));
             }
         }

@@ -104,7 +104,7 @@ impl Scenario {
     pub fn point_obstacles(&self, n: usize) -> Result<Vec<Obstacle>> {
         self.curves
             .iter()
-            .map(|c| PointCloud::new(c.sample(n)).map(Obstacle::Cloud))
+            .map(|c| c.sample(n).and_then(PointCloud::new).map(Obstacle::Cloud))
             .collect()
     }
 }
