@@ -31,8 +31,9 @@ import numpy.typing as npt
 from softarm._core import Section, SoftArm
 from softarm.calibration.metrics import PoseErrorStats
 from softarm.errors import ConfigError, NonFiniteError, ShapeError, SoftarmError
+from softarm.hardware.pressure_map import METRES_PER_PSI
 
-__all__ = ["Calibration", "load_calibration", "load_model"]
+__all__ = ["Calibration", "GainMap", "load_calibration", "load_model"]
 
 F64 = npt.NDArray[np.float64]
 
@@ -80,6 +81,12 @@ class Calibration:
         if e.shape[-1:] != (self.arm.n_actuators,) or not np.all(np.isfinite(e)):
             raise ShapeError(f"elongations: expected finite (..., {self.arm.n_actuators})")
         return e / self.actuator_gain
+
+    def pressure_map(self, max_psi: float = 70.0) -> GainMap:
+        """The elongation <-> psi map of the fitted actuators, for
+        ``softarm.harvest.actuator.SafeActuator(bank, pressure_map=...)``: the model's
+        (true) elongations become pressures through each actuator's own gain."""
+        return GainMap(max_psi, self.actuator_gain)
 
     def predict(self, commands: npt.ArrayLike) -> F64:
         """End-effector poses (N, 4, 4) the fitted model predicts for ``commands``."""
@@ -169,6 +176,31 @@ class Calibration:
             parameters={str(k): float(v) for k, v in data.get("parameters", {}).items()},
             converged=bool(data.get("converged", True)),
         )
+
+
+class GainMap:
+    """``ElongationMap`` with one gain per actuator: psi = l / (gain x 1/2100 m/psi)."""
+
+    def __init__(self, max_psi: float, gain: F64) -> None:
+        self.max_psi = float(max_psi)
+        self.metres_per_psi = METRES_PER_PSI * np.asarray(gain, dtype=np.float64)
+
+    @property
+    def max_elongation(self) -> F64:
+        return self.max_psi * self.metres_per_psi
+
+    def to_psi(self, elongation: npt.ArrayLike, *, clamp: bool = True) -> F64:
+        e = np.asarray(elongation, dtype=np.float64)
+        if not np.all(np.isfinite(e)):
+            raise NonFiniteError(f"elongation must be finite, got {e.tolist()!r}")
+        psi = e / self.metres_per_psi
+        return np.clip(psi, 0.0, self.max_psi) if clamp else psi
+
+    def to_elongation(self, psi: npt.ArrayLike, *, clamp: bool = True) -> F64:
+        p = np.asarray(psi, dtype=np.float64)
+        if not np.all(np.isfinite(p)):
+            raise NonFiniteError(f"psi must be finite, got {p.tolist()!r}")
+        return (np.clip(p, 0.0, self.max_psi) if clamp else p) * self.metres_per_psi
 
 
 def load_calibration(path: str | Path) -> Calibration:

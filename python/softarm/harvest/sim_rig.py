@@ -15,6 +15,7 @@ import numpy as np
 
 import softarm
 from softarm._core import Resolver
+from softarm.calibration.result import Calibration
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator
@@ -64,6 +65,9 @@ class SimRigOptions:
     plant: PlantConfig = field(default_factory=PlantConfig)
     #: The plant `softarm identify` measured (``--identified id.json``), for lag-aware control.
     identified: IdentifiedPlant | None = None
+    #: A fitted model (``softarm calibrate``, ``--model model.toml``): the controller's arm
+    #: and the actuators' gains; None: the nominal blackberry arm.
+    calibration: Calibration | None = None
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -146,13 +150,17 @@ def build_sim_rig(
     ``controller`` defaults to the hybrid ``softarm.Resolver`` on the nominal arm model."""
     o = options or SimRigOptions()
     cfg = o.config
-    model = softarm.SoftArm.blackberry()
-    if o.plant.model != "pcc":
-        raise ParameterError(
-            f"plant.model = {o.plant.model!r}: this rig builds only the 'pcc' plant"
-        )
-    # softarm identify --sim --seed S identifies this same plant (seed S + 1000).
-    plant = ArmPlant(SimulatedArm(model, o.plant, seed=o.seed + 1000))
+    nominal = softarm.SoftArm.blackberry()
+    model = nominal if o.calibration is None else o.calibration.arm
+    # softarm identify/calibrate --sim --seed S measure this same plant (seed S + 1000).
+    if o.plant.model == "cosserat":  # optional extra: pyelastica
+        from softarm.sim.cosserat import CosseratPlant
+
+        plant: ArmPlant = CosseratPlant(nominal, o.plant, seed=o.seed + 1000)
+    elif o.plant.model == "pcc":
+        plant = ArmPlant(SimulatedArm(nominal, o.plant, seed=o.seed + 1000))
+    else:
+        raise ParameterError(f"plant.model = {o.plant.model!r}: must be 'pcc' or 'cosserat'")
     cams = default_cameras(o.scale, o.noise_std)
     # The true actuators' range: 0-70 psi (or less if the regulators saturate lower)
     # through each one's true elongation per psi.
@@ -164,7 +172,12 @@ def build_sim_rig(
     )  # fmt: skip
     on_bush = list(bush.berries)
     canes = [b.curve() for b in bush.branches]
-    watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
+    if o.plant.model == "cosserat":  # the rod's centre line, not arcs
+        from softarm.sim.cosserat.clearance import RodClearance
+
+        watch = ArmWatch(plant, RodClearance(plant, canes, cfg.grasp_offset))  # type: ignore[arg-type]
+    else:
+        watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
     clock = SimClock([plant.advance, watch.sample])
     bank = SafePressureBank(
         SimulatedPressureBank(plant, plant.arm.n_actuators), 70.0, 100.0, 0.5, clock.now,
@@ -188,7 +201,7 @@ def build_sim_rig(
         vision,
         vision,
         controller,
-        SafeActuator(bank),
+        SafeActuator(bank, None if o.calibration is None else o.calibration.pressure_map()),
         gripper,
         gripper,
         n_actuators=model.n_actuators,

@@ -1,0 +1,45 @@
+"""A second physics for the simulated arm: a Cosserat rod with gravity (PyElastica).
+
+PyElastica is the optional extra ``cosserat`` (``pip install 'softarm[cosserat]'``); it
+is imported only when a rod is built, and :func:`require_elastica` says how to install it
+when it is absent. :class:`~softarm.sim.cosserat.plant.CosseratPlant` is the plant (the
+interface of ``softarm.harvest.sim_plant.ArmPlant``), :class:`~softarm.sim.cosserat.rod.RodArm`
+the rod, :mod:`~softarm.sim.cosserat.params` its masses and stiffness.
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+from typing import Any
+
+from softarm.errors import SoftarmError
+
+__all__ = ["CosseratPlant", "MissingDependencyError", "RodArm", "require_elastica"]
+
+
+class MissingDependencyError(SoftarmError, ImportError):
+    """An optional dependency is not installed."""
+
+
+def require_elastica() -> ModuleType:
+    """The ``elastica`` module (PyElastica), or a clear error saying how to get it."""
+    try:
+        return importlib.import_module("elastica")
+    except ImportError as exc:
+        raise MissingDependencyError(
+            "the Cosserat-rod plant needs PyElastica, the optional extra 'cosserat': "
+            "pip install 'softarm[cosserat]' (or pip install pyelastica)"
+        ) from exc
+
+
+def __getattr__(name: str) -> Any:
+    if name == "CosseratPlant":
+        from softarm.sim.cosserat.plant import CosseratPlant
+
+        return CosseratPlant
+    if name == "RodArm":
+        from softarm.sim.cosserat.rod import RodArm
+
+        return RodArm
+    raise AttributeError(f"module 'softarm.sim.cosserat' has no attribute {name!r}")

@@ -1,0 +1,68 @@
+"""Clearance between the Cosserat rod's body and the canes (ground truth of contact).
+
+The same surfaces as :class:`softarm.harvest.clearance.Clearance` (each section's ring
+radius + one muscle, the gripper as a 25 mm cylinder from the distal plate to the grasp
+point, 5 mm canes), measured on the rod's *current* centre line: exact point-to-segment
+distances from every centre-line segment to the canes sampled at 150 points each. The
+rod's shape depends on gravity and its history, not on q alone, so ``gap`` ignores q.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import PolynomialCurve
+from softarm.harvest.clearance import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
+
+__all__ = ["RodClearance"]
+
+F64 = npt.NDArray[np.float64]
+
+
+def _point_segment_distances(points: F64, a: F64, b: F64) -> F64:
+    """(S, P) distances from points (P, 3) to segments a -> b (S, 3)."""
+    ab = b - a
+    t = (
+        np.einsum("spk,sk->sp", points[None] - a[:, None], ab)
+        / np.maximum(np.einsum("sk,sk->s", ab, ab), 1e-18)[:, None]
+    )
+    closest = a[:, None] + np.clip(t, 0.0, 1.0)[..., None] * ab[:, None]
+    return np.linalg.norm(points[None] - closest, axis=2)
+
+
+class RodClearance:
+    """Smallest surface gap between a :class:`~softarm.sim.cosserat.plant.CosseratPlant`
+    as it is now and the canes; the interface of ``Clearance`` (``gap``, ``path_gap``)."""
+
+    def __init__(
+        self, plant: object, canes: Sequence[PolynomialCurve], grasp_offset: float
+    ) -> None:
+        self.plant, self.canes, self.offset = plant, list(canes), grasp_offset
+        sections = plant.arm.sections  # type: ignore[attr-defined]
+        self.radii = np.array([s.radius + ACTUATOR_RADIUS + CANE_RADIUS for s in sections])
+        self.plate = sections[-1].offset
+        self.points = (
+            np.concatenate([c(np.linspace(*c.u_range, 150)) for c in self.canes])
+            if self.canes
+            else np.zeros((0, 3))
+        )
+
+    def gap(self, q: F64 | None = None) -> float:
+        """Smallest surface gap (m) now; inf without canes; < 0 means contact."""
+        if not self.canes:
+            return float("inf")
+        line = self.plant.centreline()  # type: ignore[attr-defined]
+        sec = self.plant.centreline_sections()[1:]  # type: ignore[attr-defined]
+        d = _point_segment_distances(self.points, line[:-1], line[1:]).min(axis=1)
+        body = float((d - self.radii[sec]).min())
+        ee = self.plant.pose()  # type: ignore[attr-defined]
+        tip = ee[:3, 3] + np.outer(np.linspace(-self.plate, self.offset, 6), ee[:3, 2])
+        dg = np.linalg.norm(tip[:, None, :] - self.points[None], axis=2).min()
+        return min(body, float(dg) - GRIPPER_RADIUS - CANE_RADIUS)
+
+    def path_gap(self, q0: F64, q1: F64, steps: int = 12) -> float:
+        """The rod cannot be evaluated at other commands: the gap now."""
+        return self.gap()
