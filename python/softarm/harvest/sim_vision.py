@@ -98,24 +98,33 @@ def sim_vision(
     cube = MarkerCube.standard(cams.cube_marker)
     T_c1_base = invert(cams.T_base_c1)
 
-    def tags(T_cam_base: FloatArray) -> list[SceneMarker]:
+    base_tag = SceneMarker(BASE_TAG_ID, DICT, cams.base_tag, T_c1_base @ cams.T_base_tag)
+    # C1's berry tags stay put until picked: keep their (checked) scene markers.
+    still: dict[tuple[int, bytes], SceneMarker] = {}
+
+    def tags(T_cam_base: FloatArray, memo: dict[tuple[int, bytes], SceneMarker]) -> list:
         out = []
         for b in berries():
             pose = T_cam_base @ b.tag_pose()
             if pose[2, 3] > 0.01:  # in front of the camera
-                out.append(SceneMarker(b.tag_id, DICT, cams.berry_tag, pose))
+                key = (b.tag_id, pose.tobytes())
+                if key not in memo:
+                    if len(memo) > 64:
+                        memo.clear()
+                    memo[key] = SceneMarker(b.tag_id, DICT, cams.berry_tag, pose)
+                out.append(memo[key])
         return out
 
     def frame1(t: float, with_berries: bool = True) -> np.ndarray:
-        items = [SceneMarker(BASE_TAG_ID, DICT, cams.base_tag, T_c1_base @ cams.T_base_tag)]
+        items = [base_tag]
         T_c1_cube = T_c1_base @ true_pose() @ cams.T_ee_cube
         items += cube_scene_markers(cube.markers, cube.marker_length, DICT, T_c1_cube)
         if with_berries and not hide(t):
-            items += tags(T_c1_base)
+            items += tags(T_c1_base, still)
         return render1(items)
 
     def frame2(t: float) -> np.ndarray:
-        return render2([] if hide(t) else tags(invert(true_pose() @ cams.T_ee_c2)))
+        return render2([] if hide(t) else tags(invert(true_pose() @ cams.T_ee_c2), {}))
 
     T_base_c1 = register_c1(
         lambda t: frame1(t, False), m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag

@@ -27,6 +27,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any, overload
 
 import cv2
 import numpy as np
@@ -124,7 +125,8 @@ class SyntheticCamera:
         s = self.supersample
         self._offsets = ((np.arange(s) + 0.5) / s).astype(np.float32)  # sub-sample centres
         self._ray_table: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]] | None = None
-        self._patches: OrderedDict[tuple[object, ...], tuple] = OrderedDict()
+        self._patches: OrderedDict[tuple[object, ...], Any] = OrderedDict()
+        self._planes: dict[tuple[object, ...], tuple[TexturedPlane, Box | None]] = {}
         self._vignette_cache: tuple[float, npt.NDArray[np.float32]] | None = None
 
     def render(
@@ -177,32 +179,52 @@ class SyntheticCamera:
             if float(normal @ t) >= 0.0:  # back face: the camera is behind the plane
                 continue
             if isinstance(item, SceneMarker):
-                cells = item.marker_length / (_marker_cells(item) or 1)
-                z_near = max(float(t[2]) - item.marker_length, 1e-3)
-                px_per_cell = self.model.focal * cells / z_near
-                plane = item.to_plane(int(np.ceil(self.supersample * px_per_cell)))
+                plane, box = self._marker_plane(item)
             else:
-                plane = item
-            box = self._bbox(plane)
+                plane, box = item, self._bbox(item)
             if box is not None:
                 out.append(_Layer(item, plane, box, normal))
+        return out
+
+    def _marker_plane(self, item: SceneMarker) -> tuple[TexturedPlane, Box | None]:
+        """The marker's textured plane (one texel per sub-sample where it is nearest) and
+        pixel box; kept for the next frame, where a marker that does not move reuses it."""
+        key = (item.marker_id, item.dictionary, item.marker_length, item.border)
+        key += (item.T_camera_marker.tobytes(),)
+        hit = self._planes.get(key)
+        if hit is not None:
+            return hit
+        cells = item.marker_length / (_marker_cells(item) or 1)
+        z_near = max(float(item.T_camera_marker[2, 3]) - item.marker_length, 1e-3)
+        px_per_cell = self.model.focal * cells / z_near
+        plane = item.to_plane(int(np.ceil(self.supersample * px_per_cell)))
+        out = (plane, self._bbox(plane))
+        self._planes[key] = out
+        if len(self._planes) > _PATCH_CACHE_SIZE:
+            self._planes.pop(next(iter(self._planes)))
         return out
 
     def _image(self, background: float, layers: list[_Layer], box: Box) -> npt.NDArray[np.uint8]:
         """The uint8 pixels of window ``box``: planes, vignetting, blur, noise."""
         x0, y0, x1, y1 = box
         img = np.full((y1 - y0, x1 - x0), background, np.float32)
+        drawn: list[Box] = []
         for layer in layers:
             bx0, by0, bx1, by1 = layer.box
             if bx0 >= x1 or by0 >= y1 or bx1 <= x0 or by1 <= y0:
                 continue
-            alpha, color = self._coverage(layer)
             # Clip to the window (render_crop's window holds every box whole).
             cx0, cy0, cx1, cy1 = max(bx0, x0), max(by0, y0), min(bx1, x1), min(by1, y1)
             sub = (slice(cy0 - by0, cy1 - by0), slice(cx0 - bx0, cx1 - bx0))
             region = img[cy0 - y0 : cy1 - y0, cx0 - x0 : cx1 - x0]
-            region *= 1.0 - alpha[sub]
-            region += color[sub]
+            if not any(_overlap(layer.box, b) for b in drawn):
+                # Over the plain background the blend is linear in the texture: one channel.
+                region += self._coverage(layer, background)[sub]
+            else:
+                alpha, color = self._coverage(layer)
+                region *= 1.0 - alpha[sub]
+                region += color[sub]
+            drawn.append(layer.box)
         light = self.lighting
         if light.vignetting > 0:
             img *= self._vignette(light.vignetting)[y0:y1, x0:x1]
@@ -216,29 +238,40 @@ class SyntheticCamera:
         # Rounds to nearest and saturates at 255 (values are >= 0 here, so abs is a no-op).
         return np.asarray(cv2.convertScaleAbs(img), dtype=np.uint8)
 
-    def _coverage(self, layer: _Layer) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-        """(alpha, premultiplied colour) of one plane over its box: the plane is composited
-        as ``pixel = pixel * (1 - alpha) + colour``. Markers are looked up first: the same
-        marker at the same pose and lighting draws the same pixels."""
+    @overload
+    def _coverage(
+        self, layer: _Layer
+    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+
+    @overload
+    def _coverage(self, layer: _Layer, background: float) -> npt.NDArray[np.float32]: ...
+
+    def _coverage(self, layer: _Layer, background: float | None = None) -> Any:
+        """How one plane changes the pixels of its box. Without ``background``: (alpha,
+        premultiplied colour), composited as ``pixel = pixel * (1 - alpha) + colour``. With
+        it, over that plain gray: the change ``pixel - background``, which is linear in the
+        texture (one channel to sample instead of two). Markers are looked up first: the
+        same marker at the same pose and lighting draws the same pixels."""
         item = layer.item
         key = None
         if isinstance(item, SceneMarker):
             key = (
                 item.marker_id, item.dictionary, item.marker_length, item.border,
-                item.T_camera_marker.tobytes(), self.lighting,
+                item.T_camera_marker.tobytes(), self.lighting, background,
             )  # fmt: skip
             hit = self._patches.get(key)
             if hit is not None:
                 self._patches.move_to_end(key)
                 return hit
-        out = self._draw(layer)
+        out = self._draw(layer, background)
         if key is not None:
             self._patches[key] = out
             if len(self._patches) > _PATCH_CACHE_SIZE:
                 self._patches.popitem(last=False)
         return out
 
-    def _draw(self, layer: _Layer) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    def _draw(self, layer: _Layer, background: float | None) -> Any:
+        """:meth:`_coverage` without the cache."""
         item = layer.plane
         pose = item.T_camera_plane
         rot, t = pose[:3, :3], pose[:3, 3]
@@ -265,17 +298,27 @@ class SyntheticCamera:
         mx = (hom[0, 0] * x + hom[0, 1] * y + hom[0, 2]) * den
         my = (hom[1, 0] * x + hom[1, 1] * y + hom[1, 2]) * den
         mx[behind] = -10.0
-        rgba = _premultiplied(tex)
         # Fixed-point maps: the same 1/32-texel rounding that remap applies to float maps
         # block by block, done in one pass (a quarter less time, the same pixels).
         fixed, frac = cv2.convertMaps(mx, my, cv2.CV_16SC2)
-        sampled = cv2.remap(rgba, fixed, frac, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
-        small = cv2.resize(sampled, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA)
-        refl, alpha = small[..., 0], small[..., 1]
         shade = self._shade(layer.normal)
         light = self.lighting
         ink = shade * light.black
-        color = ink * alpha + shade * (light.white - light.black) * refl
+        paper = shade * (light.white - light.black)
+        if background is not None:
+            # Outside the texture remap gives 0, i.e. no change: sample ink - background +
+            # paper * reflectance, box-filter it, and it is exactly the blend below less
+            # the background, alpha (background - ink) + paper * premultiplied reflectance.
+            change = _affine(tex, ink - background, paper)
+            sampled = cv2.remap(
+                change, fixed, frac, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT
+            )
+            return cv2.resize(sampled, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA)
+        rgba = _premultiplied(tex)
+        sampled = cv2.remap(rgba, fixed, frac, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+        small = cv2.resize(sampled, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA)
+        refl, alpha = small[..., 0], small[..., 1]
+        color = ink * alpha + paper * refl
         return alpha, color
 
     def _rays(self, box: Box) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
@@ -393,6 +436,28 @@ def _marker_cells(item: SceneMarker) -> int:
     from softarm.vision.dictionaries import get_dictionary
 
     return int(get_dictionary(item.dictionary).markerSize + 2)
+
+
+def _overlap(a: Box, b: Box) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+_AFFINE_CACHE: dict[
+    tuple[int, float, float], tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]
+] = {}
+
+
+def _affine(tex: npt.NDArray[np.float32], offset: float, gain: float) -> npt.NDArray[np.float32]:
+    """``offset + gain * tex`` (float32), kept for the next frame of the same marker."""
+    key = (id(tex), offset, gain)
+    hit = _AFFINE_CACHE.get(key)
+    if hit is not None and hit[0] is tex:
+        return hit[1]
+    out = (np.float32(offset) + np.float32(gain) * tex).astype(np.float32)
+    if len(_AFFINE_CACHE) > 64:
+        _AFFINE_CACHE.clear()
+    _AFFINE_CACHE[key] = (tex, out)
+    return out
 
 
 _PREMULT_CACHE: dict[int, tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]] = {}

@@ -80,7 +80,9 @@ def refine_marker_corners(
     wsum = grad.sum(axis=1)
     contrast = np.abs(wsum)
     ok_edge = contrast > 0.25 * np.median(contrast)
-    shift = (grad @ mid) / np.where(ok_edge, wsum, 1.0)  # edge offset along the normal
+    # Edge offset along the normal (in float64: a float32 @ float64 product would take
+    # numpy's slow mixed-type loop instead of BLAS).
+    shift = (grad.astype(np.float64) @ mid) / np.where(ok_edge, wsum, 1.0)
     good = ok_edge & (np.abs(shift) < reach)
     if np.any(np.bincount(side[good], minlength=4) < 4):
         return quad
