@@ -100,7 +100,7 @@ def main() -> None:
         "--nominal-geometry", action="store_true", help="also fit gains with the nominal geometry"
     )
     args = ap.parse_args()
-    results = {}
+    results: dict[str, dict[str, Any]] = {}
     for name in args.plants:
         rows = []
         for seed in args.seeds:

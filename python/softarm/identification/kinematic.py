@@ -177,7 +177,7 @@ def fit_kinematics(
                 break
             z_prev = z
 
-            def sub(xa: F64, z: F64 = z, active: F64 = active) -> F64:
+            def sub(xa: F64, z: F64 = z, active: npt.NDArray[np.intp] = active) -> F64:
                 full = x.copy()
                 full[active] = xa
                 return residual(full, z)

@@ -105,8 +105,12 @@ class IdentifiedPlant:
         meta = data.get("metadata", {})
         if not isinstance(meta, Mapping):
             raise ConfigError(f"{where}.metadata: must be an object, got {meta!r}")
+        lists = {k: tuple(float(v) for v in data[k]) for k in PER_CHANNEL_KEYS}
         return cls(
-            *(tuple(float(v) for v in data[k]) for k in PER_CHANNEL_KEYS),
+            tau_s=lists["tau_s"],
+            metres_per_psi=lists["metres_per_psi"],
+            hysteresis_psi=lists["hysteresis_psi"],
+            dead_time_s=lists["dead_time_s"],
             control_period_s=float(data.get("control_period_s", 0.05)),
             metadata=dict(meta),
         )
