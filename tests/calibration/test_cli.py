@@ -35,3 +35,14 @@ def test_bad_options(tmp_path) -> None:
         _run("--sim", "--poses", "5")
     with pytest.raises(ParameterError, match="--plant"):
         _run("--config", "hw.toml", "--plant", "p.toml")
+
+
+def test_harvest_model_option(tmp_path) -> None:
+    from softarm.commands._plant import plant_options
+
+    out = tmp_path / "model.toml"
+    assert _run("--sim", "--seed", "1", "--poses", "25", "--out", str(out), "--quiet") == 0
+    opts = plant_options(argparse.Namespace(sim=True, model=out))
+    assert isinstance(opts["calibration"], Calibration)
+    with pytest.raises(ParameterError, match="--model"):
+        plant_options(argparse.Namespace(sim=False, model=out))

@@ -19,7 +19,7 @@ from softarm.sim.arm import PlantConfig
 from softarm.sim.pressure import METRES_PER_PSI
 from softarm.sim.tracker import PoseTracker
 
-__all__ = ["PlantDriver", "build_plant", "calibrate_plant"]
+__all__ = ["PlantDriver", "build_plant", "calibrate_plant", "true_poses"]
 
 F64 = npt.NDArray[np.float64]
 
@@ -68,6 +68,8 @@ def calibrate_plant(
     n_poses: int = 80,
     seed: int = 0,
     on_pose: Callable[[int, F64], None] | None = None,
+    settle: float = 1.0,
+    average: float = 0.5,
 ) -> tuple[Calibration, F64, F64]:
     """Drive ``plant`` through ``n_poses`` excitation poses measured by a tracker with
     ``config``'s noise, and fit; returns the calibration and the data (commands, poses)."""
@@ -76,11 +78,13 @@ def calibrate_plant(
     )
     drv = PlantDriver(plant, tracker)
     commands = excitation_set(nominal, n_poses, seed=seed)
-    c, p = collect(commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose)
+    c, p = collect(
+        commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose, settle=settle, average=average
+    )
     return calibrate(nominal, c, p), c, p
 
 
-def true_poses(plant: object, commands: F64) -> F64:
+def true_poses(plant: object, commands: F64, settle: float = 1.0) -> F64:
     """The plant's noise-free settled poses at ``commands`` (driven as in the fit)."""
     drv = PlantDriver(plant, None)
-    return collect(commands, drv.send, drv.sleep, drv.measure)[1]
+    return collect(commands, drv.send, drv.sleep, drv.measure, settle=settle, average=0.05)[1]

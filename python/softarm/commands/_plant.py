@@ -1,7 +1,8 @@
-"""``--plant FILE`` and ``--identified id.json``, shared by every command that builds the
-simulated rig (``harvest --sim``, ``demo``): the simulated plant's ``[plant]`` table
-(:mod:`softarm.sim.plant_file`) and the plant ``softarm identify`` measured
-(:mod:`softarm.identification.result`). Both files are read and checked before the run
+"""``--plant FILE``, ``--identified id.json`` and ``--model model.toml``, shared by every
+command that builds the simulated rig (``harvest --sim``, ``demo``): the simulated plant's
+``[plant]`` table (:mod:`softarm.sim.plant_file`), the plant ``softarm identify`` measured
+(:mod:`softarm.identification.result`) and the model ``softarm calibrate`` fitted
+(:mod:`softarm.calibration.result`). Both files are read and checked before the run
 starts; a bad one is a one-line error naming the key (exit status 2)."""
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ __all__ = ["add_plant_options", "plant_options"]
 
 
 def add_plant_options(p: argparse.ArgumentParser, *, sim_only_flag: bool = True) -> None:
-    """Add ``--plant`` and ``--identified`` to ``p``."""
+    """Add ``--plant``, ``--identified`` and ``--model`` to ``p``."""
     p.add_argument(
         "--plant",
         type=config_file,
@@ -28,6 +29,12 @@ def add_plant_options(p: argparse.ArgumentParser, *, sim_only_flag: bool = True)
         type=config_file,
         help="the plant `softarm identify` measured (id.json), checked and passed to the rig "
         "as SimRigOptions.identified (per-channel lag tau_s, control period)",
+    )
+    p.add_argument(
+        "--model",
+        type=config_file,
+        help="a fitted arm model (`softarm calibrate` writes model.toml): the controller's "
+        "arm and the actuators' gains (--sim only)",
     )
 
 
@@ -48,4 +55,11 @@ def plant_options(args: argparse.Namespace) -> dict[str, Any]:
         out["plant"] = load_plant_file(args.plant)
     if getattr(args, "identified", None) is not None:
         out["identified"] = load_identified(args.identified)
+    if getattr(args, "model", None) is not None:
+        if not getattr(args, "sim", True):
+            # On hardware: paste model.toml's [[arm.sections]] into the config for now.
+            raise ParameterError("--model: works with --sim only")
+        from softarm.calibration import load_calibration
+
+        out["calibration"] = load_calibration(args.model)
     return out
