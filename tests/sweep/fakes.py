@@ -4,7 +4,9 @@ that the failure, resume and cluster tests take seconds. Sent to the workers by 
 from __future__ import annotations
 
 import os
+import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
 from softarm.sweep.spec import TrialSpec
@@ -37,4 +39,17 @@ def crash_on_seed_1(trial: TrialSpec) -> list[dict[str, Any]]:
 
 def slow(trial: TrialSpec) -> list[dict[str, Any]]:
     time.sleep(2.0)
+    return rows(trial)
+
+
+def crash_marker(trial: TrialSpec) -> Path:
+    return Path(tempfile.gettempdir()) / f"softarm-sweep-test-crashed-{trial.trial_id}"
+
+
+def crash_once(trial: TrialSpec) -> list[dict[str, Any]]:
+    """The worker dies on the first attempt at each trial; Ray's retry then succeeds."""
+    marker = crash_marker(trial)
+    if not marker.exists():
+        marker.touch()
+        os._exit(1)
     return rows(trial)

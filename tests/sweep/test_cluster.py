@@ -105,6 +105,22 @@ def test_a_dying_worker_fails_its_trial_only(joined: str, tmp_path: Path) -> Non
     assert len(rows) == 4 * 2 and all(r["error"] is None for r in rows)
 
 
+def test_a_worker_killed_once_is_retried(joined: str, tmp_path: Path) -> None:
+    spec = _spec([7])
+    for t in spec.trials():
+        fakes.crash_marker(t).unlink(missing_ok=True)
+    try:
+        outcome = run_sweep(spec, tmp_path, address=joined, trial_fn=fakes.crash_once,
+                            progress=False, max_retries=1)  # fmt: skip
+        assert all(fakes.crash_marker(t).exists() for t in spec.trials())  # each one died
+    finally:
+        for t in spec.trials():
+            fakes.crash_marker(t).unlink(missing_ok=True)
+    assert (outcome.ran, outcome.failed) == (2, 0)
+    rows = pq.read_table(tmp_path / "results.parquet").to_pylist()
+    assert len(rows) == 2 * 2 and all(r["error"] is None for r in rows)
+
+
 def test_tune_writes_gains_that_harvest_and_gains_load(joined: str, tmp_path: Path) -> None:
     pytest.importorskip("optuna")
     from softarm.sweep.gains_file import load_gains

@@ -108,7 +108,7 @@ def _sigterm_as_interrupt() -> Iterator[None]:
 
 def _progress(total: int, enabled: bool) -> Any:
     tqdm = require("tqdm").tqdm
-    return tqdm(total=total, unit="berry", disable=not enabled, file=sys.stderr,
+    return tqdm(total=total, unit="berry", disable=None if enabled else True, file=sys.stderr,
                 dynamic_ncols=True, smoothing=0.05, desc="sweep")  # fmt: skip
 
 

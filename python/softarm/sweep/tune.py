@@ -204,8 +204,9 @@ def _bar_callback(tune: Any, total: int, enabled: bool) -> Any:
         """One tick per finished candidate, best score so far as the postfix."""
 
         def __init__(self) -> None:
-            self.bar = tqdm(total=total, unit="candidate", desc="tune", disable=not enabled,
-                            file=sys.stderr, dynamic_ncols=True)  # fmt: skip
+            # disable=None: drawn on a terminal only, never into a log file.
+            self.bar = tqdm(total=total, unit="candidate", desc="tune", file=sys.stderr,
+                            disable=None if enabled else True, dynamic_ncols=True)  # fmt: skip
             self.best = -math.inf
 
         def on_trial_complete(self, iteration: int, trials: Any, trial: Any, **info: Any) -> None:
