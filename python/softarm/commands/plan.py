@@ -68,7 +68,11 @@ def run(args: argparse.Namespace) -> int:
         from softarm.planning.plot import plot_plan
 
         out = plot_plan(
-            load(args.scenario), results[0].plan, args.plot, f"scenario {args.scenario}"
+            load(args.scenario),
+            results[0].plan,
+            args.plot,
+            f"scenario {args.scenario}",
+            baselines=results[1:],
         )
         if not args.json:
             print(f"wrote {out}")

@@ -108,7 +108,9 @@ def main(argv: list[str] | None = None) -> int:
     sections = []
     for name in SCENARIOS:
         results = compare(name, args.repeats)
-        fig = plot_plan(load(name), results[0].plan, img / f"plan_{name}.png", TITLES[name])
+        fig = plot_plan(
+            load(name), results[0].plan, img / f"plan_{name}.png", TITLES[name], results[1:]
+        )
         sections.append(
             f"## {TITLES[name]}\n\n{table(name, results)}\n\n{verdict(results)}.\n\n"
             f"![{name}](img/{fig.name})\n"
