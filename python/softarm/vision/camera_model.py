@@ -1,6 +1,7 @@
-"""Pinhole camera intrinsics with OpenCV lens distortion, saved as JSON.
+"""Pinhole camera intrinsics with OpenCV lens distortion, saved as JSON, OpenCV FileStorage
+or ROS camera_info (:mod:`softarm.vision.camera_files`).
 
-File format (JSON, UTF-8), version ``softarm.camera/1``::
+softarm's own file format (JSON, UTF-8), version ``softarm.camera/1``::
 
     {
       "format": "softarm.camera/1",
@@ -35,8 +36,9 @@ _DIST_LENGTHS = (0, 4, 5, 8, 12, 14)
 class CameraModel:
     """Intrinsics ``matrix`` (3x3, pixels) and OpenCV ``distortion`` coefficients.
 
-    ``image_size`` is ``(width, height)`` in pixels when known. Arrays are validated and
-    stored as read-only float64.
+    ``distortion`` None means no distortion, as in OpenCV (stored as five zeros, the
+    default). ``image_size`` is ``(width, height)`` in pixels when known. Arrays are
+    validated and stored as read-only float64.
     """
 
     matrix: FloatArray
@@ -52,7 +54,8 @@ class CameraModel:
             )
         if abs(mat[1, 0]) > 0:
             raise ParameterError(f"matrix[1, 0] must be 0, got {mat[1, 0]}")
-        dist = as_array(np.ravel(np.asarray(self.distortion, dtype=object)), (None,), "distortion")
+        raw = np.zeros(5) if self.distortion is None else self.distortion
+        dist = as_array(np.ravel(np.asarray(raw, dtype=object)), (None,), "distortion")
         if dist.size not in _DIST_LENGTHS:
             raise ShapeError(
                 f"distortion must have one of {_DIST_LENGTHS} coefficients, got {dist.size}"
@@ -127,18 +130,55 @@ class CameraModel:
         except (KeyError, TypeError, ValueError) as exc:
             raise ConfigError(f"camera file is malformed: {exc}") from exc
 
-    def save(self, path: str | Path) -> None:
-        """Write the model to ``path`` as JSON (see the module docstring for the format)."""
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2) + "\n", encoding="utf-8")
+    def save(
+        self, path: str | Path, format: str | None = None, *, camera_name: str = "camera"
+    ) -> None:
+        """Write the model to ``path``. ``format``: ``"json"`` (softarm's, see the module
+        docstring), ``"opencv"`` (``cv2.FileStorage``, as OpenCV's calibration sample
+        writes) or ``"ros"`` (a ROS camera_info YAML named ``camera_name``); None picks
+        by extension (``.json``; ``.yml``/``.xml`` OpenCV; ``.yaml`` ROS).
+
+        Raises:
+            ConfigError: unknown format or extension, a model the format cannot hold
+                (ROS needs the image size), or the file cannot be written.
+        """
+        from softarm.vision import camera_files
+
+        fmt = camera_files.format_for_path(path) if format is None else format
+        if fmt == "json":
+            try:
+                Path(path).write_text(json.dumps(self.to_dict(), indent=2) + "\n", "utf-8")
+            except OSError as exc:
+                raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
+        elif fmt == "opencv":
+            camera_files.write_opencv(self, path)
+        elif fmt == "ros":
+            camera_files.write_ros(self, path, camera_name)
+        else:
+            raise ConfigError(f"format must be one of {camera_files.FORMATS} or None, got {fmt!r}")
 
     @classmethod
     def load(cls, path: str | Path) -> CameraModel:
-        """Read a model written by :meth:`save`."""
+        """Read a camera file: softarm JSON, OpenCV FileStorage (YAML, XML or JSON) or ROS
+        camera_info YAML, told apart by their contents.
+
+        Raises:
+            ConfigError: the file cannot be read, is in none of these formats, or holds
+                an invalid model (the message names the file and the field).
+        """
+        from softarm.vision import camera_files
+
         try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, json.JSONDecodeError) as exc:
+            text = Path(path).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
             raise ConfigError(f"cannot read camera file {str(path)!r}: {exc}") from exc
-        return cls.from_dict(data)
+        fmt, fields = camera_files.read_camera_file(path, text)
+        if fmt == "json":
+            return cls.from_dict(fields)
+        try:
+            return cls(fields["matrix"], fields["distortion"], fields["image_size"])
+        except (ValueError, TypeError) as exc:
+            raise ConfigError(f"camera file {str(path)!r} ({fmt}): {exc}") from exc
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, CameraModel):

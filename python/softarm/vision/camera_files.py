@@ -1,0 +1,235 @@
+"""Camera calibration files in the formats other tools write: OpenCV ``FileStorage`` and
+ROS ``camera_info`` YAML (besides softarm's own JSON, :mod:`softarm.vision.camera_model`).
+
+**OpenCV** (``cv2.FileStorage``, YAML, XML or JSON), as OpenCV's calibration sample
+(``samples/cpp/calibration.cpp``) writes it: ``image_width``, ``image_height``,
+``camera_matrix`` (3x3 ``opencv-matrix``) and ``distortion_coefficients`` (N x 1); other
+keys (``calibration_time``, ``avg_reprojection_error``, per-view extrinsics) are ignored.
+``cameraMatrix`` / ``distCoeffs`` are accepted as the two matrices' names too.
+
+**ROS** ``sensor_msgs/CameraInfo`` YAML, as ``camera_calibration`` (``ost.yaml``) and
+``camera_calibration_parsers`` write it: ``image_width``, ``image_height``,
+``camera_name``, ``camera_matrix``, ``distortion_model``, ``distortion_coefficients``,
+``rectification_matrix`` and ``projection_matrix``, each matrix as ``{rows, cols, data}``.
+``plumb_bob`` (k1 k2 p1 p2 k3) and ``rational_polynomial`` (k1 k2 p1 p2 k3 k4 k5 k6) are
+OpenCV's own models and are read as they are; ``equidistant`` (fisheye) is a different
+lens model and is refused. A monocular camera has the identity rectification; the
+projection matrix is written as ``[K | 0]`` and ignored when read (it describes the
+rectified image, which softarm does not use).
+
+Both are parsed with ``cv2.FileStorage`` (OpenCV reads YAML with or without the
+``%YAML`` line), so no YAML library is needed.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import cv2
+import numpy as np
+
+from softarm.errors import ConfigError
+
+if TYPE_CHECKING:
+    from softarm.vision.camera_model import CameraModel
+
+__all__ = ["FORMATS", "format_for_path", "read_camera_file", "write_opencv", "write_ros"]
+
+#: ``CameraModel.save`` formats: softarm JSON, OpenCV FileStorage, ROS camera_info.
+FORMATS = ("json", "opencv", "ros")
+# The ROS names of OpenCV's distortion models, by number of coefficients.
+_ROS_MODELS = {5: "plumb_bob", 8: "rational_polynomial"}
+_ROS_LENGTHS = {"plumb_bob": (4, 5), "rational_polynomial": (8,)}
+
+
+def format_for_path(path: str | Path) -> str:
+    """The format :meth:`CameraModel.save` writes for ``path``'s extension: ``.json`` →
+    softarm JSON, ``.yml`` / ``.xml`` → OpenCV FileStorage, ``.yaml`` → ROS camera_info
+    (the name ROS' ``camera_calibration`` gives its ``ost.yaml``)."""
+    suffix = Path(path).suffix.lower()
+    by_suffix = {".json": "json", ".yml": "opencv", ".xml": "opencv", ".yaml": "ros"}
+    if suffix not in by_suffix:
+        raise ConfigError(
+            f"cannot tell the camera file format from the extension of {str(path)!r}: use "
+            f".json, .yml/.xml (OpenCV) or .yaml (ROS), or pass format= one of {FORMATS}"
+        )
+    return by_suffix[suffix]
+
+
+def read_camera_file(path: str | Path, text: str) -> tuple[str, dict[str, Any]]:
+    """(format, fields) of a camera file whose contents are ``text``; ``fields`` has
+    ``matrix``, ``distortion`` and ``image_size`` for the OpenCV and ROS formats and is
+    the parsed JSON object for softarm's own format."""
+    import json
+
+    body = text.lstrip("\ufeff \t\r\n")
+    if body.startswith("{"):
+        try:
+            data = json.loads(body)
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"camera file {str(path)!r} is not valid JSON: {exc}") from exc
+        if isinstance(data, dict) and "format" in data:
+            return "json", data
+        # OpenCV FileStorage writes JSON too: {"camera_matrix": {"type_id": "opencv-matrix"...
+    fs = _open(path, body)
+    try:
+        if not fs.root().isMap():
+            raise ConfigError(f"camera file {str(path)!r} is not a map of named fields")
+        node = _first(fs, ("camera_matrix", "cameraMatrix"))
+        if node is None:
+            raise ConfigError(
+                f"camera file {str(path)!r} has no camera_matrix: not a softarm JSON, "
+                "OpenCV FileStorage or ROS camera_info file"
+            )
+        if node.isMap() and node.getNode("dt").isNone():
+            return "ros", _read_ros(fs, path)
+        return "opencv", _read_opencv(fs, path)
+    finally:
+        fs.release()
+
+
+def write_opencv(model: CameraModel, path: str | Path) -> None:
+    """Write ``model`` as OpenCV's calibration sample does (YAML for .yml/.yaml, XML for
+    .xml, JSON for .json: FileStorage picks by extension)."""
+    try:
+        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    except cv2.error as exc:
+        raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
+    if not fs.isOpened():
+        raise ConfigError(f"cannot write camera file {str(path)!r}")
+    try:
+        if model.image_size is not None:
+            fs.write("image_width", int(model.image_size[0]))
+            fs.write("image_height", int(model.image_size[1]))
+        fs.write("camera_matrix", np.asarray(model.matrix, dtype=np.float64))
+        fs.write("distortion_coefficients", model.distortion.reshape(-1, 1).astype(np.float64))
+    finally:
+        fs.release()
+
+
+def write_ros(model: CameraModel, path: str | Path, camera_name: str = "camera") -> None:
+    """Write ``model`` as a ROS camera_info YAML (see the module docstring)."""
+    if model.image_size is None:
+        raise ConfigError("a ROS camera_info file needs the image size: model.image_size is None")
+    dist = np.asarray(model.distortion, dtype=np.float64)
+    if dist.size in (0, 4):
+        dist = np.concatenate([dist, np.zeros(5 - dist.size)])  # plumb_bob has k3
+    if dist.size not in _ROS_MODELS:
+        raise ConfigError(
+            f"ROS camera_info has no distortion model with {dist.size} coefficients "
+            "(plumb_bob: 5, rational_polynomial: 8)"
+        )
+    name = str(camera_name)
+    if not name or any(c in name for c in ":#{}[],&*!|>'\"%@`\n"):
+        raise ConfigError(f"camera_name must be a plain word for YAML, got {camera_name!r}")
+    k = np.asarray(model.matrix, dtype=np.float64)
+    proj = np.hstack([k, np.zeros((3, 1))])
+    width, height = model.image_size
+    lines = [
+        f"image_width: {int(width)}",
+        f"image_height: {int(height)}",
+        f"camera_name: {name}",
+        *_ros_matrix("camera_matrix", k),
+        f"distortion_model: {_ROS_MODELS[dist.size]}",
+        *_ros_matrix("distortion_coefficients", dist.reshape(1, -1)),
+        *_ros_matrix("rectification_matrix", np.eye(3)),
+        *_ros_matrix("projection_matrix", proj),
+    ]
+    try:
+        Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
+
+
+def _ros_matrix(name: str, mat: np.ndarray) -> list[str]:
+    # repr() of a float is the shortest string that reads back to the same double.
+    data = ", ".join(repr(float(v)) for v in mat.ravel())
+    rows, cols = mat.shape
+    return [f"{name}:", f"  rows: {rows}", f"  cols: {cols}", f"  data: [{data}]"]
+
+
+def _open(path: str | Path, body: str) -> Any:
+    flags = cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY
+    try:
+        fs = cv2.FileStorage(body, flags)
+    except (cv2.error, SystemError) as exc:  # some parse errors surface as SystemError
+        msg = str(exc).strip().splitlines()[-1] if str(exc).strip() else type(exc).__name__
+        raise ConfigError(f"cannot parse camera file {str(path)!r}: {msg}") from exc
+    if not fs.isOpened():
+        raise ConfigError(f"cannot parse camera file {str(path)!r}")
+    return fs
+
+
+def _first(fs: Any, names: tuple[str, ...]) -> Any:
+    for name in names:
+        node = fs.getNode(name)
+        if not node.isNone():
+            return node
+    return None
+
+
+def _size(fs: Any, path: str | Path) -> tuple[int, int] | None:
+    w, h = fs.getNode("image_width"), fs.getNode("image_height")
+    if w.isNone() and h.isNone():
+        return None
+    if w.isNone() or h.isNone() or not (w.isInt() or w.isReal()) or not (h.isInt() or h.isReal()):
+        raise ConfigError(
+            f"camera file {str(path)!r}: image_width and image_height must be numbers"
+        )
+    return int(w.real()), int(h.real())
+
+
+def _read_opencv(fs: Any, path: str | Path) -> dict[str, Any]:
+    mat = _first(fs, ("camera_matrix", "cameraMatrix")).mat()
+    if mat is None:
+        raise ConfigError(f"camera file {str(path)!r}: camera_matrix is not an opencv-matrix")
+    node = _first(fs, ("distortion_coefficients", "distCoeffs"))
+    dist = None if node is None else node.mat()
+    return {
+        "matrix": np.asarray(mat, dtype=np.float64),
+        # An empty matrix reads back as None: no distortion.
+        "distortion": np.zeros(0) if dist is None else np.asarray(dist, dtype=np.float64).ravel(),
+        "image_size": _size(fs, path),
+    }
+
+
+def _read_ros(fs: Any, path: str | Path) -> dict[str, Any]:
+    mat = _ros_data(fs, "camera_matrix", path, (3, 3))
+    model = fs.getNode("distortion_model")
+    name = "plumb_bob" if model.isNone() else model.string()
+    dist = np.zeros(0)
+    if not fs.getNode("distortion_coefficients").isNone():
+        dist = _ros_data(fs, "distortion_coefficients", path, None).ravel()
+    if name not in _ROS_LENGTHS:
+        raise ConfigError(
+            f"camera file {str(path)!r}: distortion_model {name!r} is not supported "
+            f"(supported: {', '.join(_ROS_LENGTHS)}; a fisheye lens needs another model)"
+        )
+    if dist.size not in (0, *_ROS_LENGTHS[name]):
+        raise ConfigError(
+            f"camera file {str(path)!r}: distortion_model {name!r} takes "
+            f"{' or '.join(map(str, _ROS_LENGTHS[name]))} coefficients, got {dist.size}"
+        )
+    return {"matrix": mat, "distortion": dist, "image_size": _size(fs, path)}
+
+
+def _ros_data(fs: Any, name: str, path: str | Path, shape: tuple[int, int] | None) -> np.ndarray:
+    node = fs.getNode(name)
+    data = node.getNode("data")
+    if not node.isMap() or not data.isSeq():
+        raise ConfigError(f"camera file {str(path)!r}: {name} must be a map with a data list")
+    try:
+        values = np.array([float(data.at(i).real()) for i in range(data.size())])
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"camera file {str(path)!r}: {name}.data must be numbers") from exc
+    rows, cols = node.getNode("rows"), node.getNode("cols")
+    r = int(rows.real()) if not rows.isNone() else (shape[0] if shape else 1)
+    c = int(cols.real()) if not cols.isNone() else (shape[1] if shape else values.size)
+    if r * c != values.size or (shape is not None and (r, c) != shape):
+        want = f"{shape[0]}x{shape[1]}" if shape else f"{r}x{c}"
+        raise ConfigError(
+            f"camera file {str(path)!r}: {name} must be {want} ({r} rows x {c} cols), "
+            f"got {values.size} values"
+        )
+    return values.reshape(r, c)
