@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (OST_YAML keeps the long lines camera_calibration writes)
 """Camera calibration files: OpenCV FileStorage and ROS camera_info besides softarm's JSON."""
 
 from pathlib import Path
@@ -116,7 +117,7 @@ def test_bad_files_and_formats(tmp_path: Path) -> None:
         CameraModel(K, np.zeros(14), (640, 480)).save(tmp_path / "cam.yaml")
     cases = {
         "fisheye.yaml": (OST_YAML.replace("plumb_bob", "equidistant"), "equidistant"),
-        "short.yaml": (OST_YAML.replace("0.000000, 0.000000, 1.000000]\ndist", "1.0]\ndist"), "3x3"),
+        "short.yaml": (OST_YAML.replace("0.000000, 1.000000]\ndist", "1.0]\ndist"), "3x3"),
         "nok.yml": ("%YAML:1.0\nimage_width: 640\n", "no camera_matrix"),
         "text.yml": ("this is not a calibration\n", "camera file"),
         "empty.yml": ("", "camera file"),
