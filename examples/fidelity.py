@@ -68,15 +68,15 @@ def run_rod(seeds: list[int], gravities: list[str], out: Path) -> None:
     import numpy as np
 
     import softarm
-    from softarm.calibration import PoseErrorStats
+    from softarm.calibration import PoseErrorStats, calibrate
     from softarm.calibration.excitation import excitation_set
     from softarm.calibration.sim import build_plant, calibrate_plant, true_poses
     from softarm.sim.arm import PlantConfig
 
     nominal = softarm.SoftArm.blackberry()
     print(
-        "| gravity | seed | nominal median / p95 (mm) | fitted median / p95 (mm) | ratio "
-        "| wall (s) |"
+        "| gravity | seed | nominal median / p95 (mm) | fitted median / p95 (mm) "
+        "| fitted + bias median / p95 (mm) | wall (s) |"
     )
     print("| --- | --- | --- | --- | --- | --- |")
     for g in gravities:
@@ -84,24 +84,26 @@ def run_rod(seeds: list[int], gravities: list[str], out: Path) -> None:
         for s in seeds:
             t = time.perf_counter()
             plant = build_plant(nominal, cfg, s + 1000)
-            cal, _, _ = calibrate_plant(plant, cfg, nominal, seed=s, settle=0.6, average=0.3)
+            cal, c, p = calibrate_plant(plant, cfg, nominal, seed=s, settle=0.6, average=0.3)
+            biased = calibrate(nominal, c, p, bias=True)
             test_c = excitation_set(nominal, 40, seed=s + 77)
             truth = true_poses(plant, test_c, settle=0.6)
-            fit = cal.evaluate(test_c, truth)
+            out.mkdir(parents=True, exist_ok=True)
+            np.savez(out / f"rod_{g}_{s}.npz", commands=c, poses=p, test_commands=test_c,
+                     test_poses=truth)  # fmt: skip
+            fit, fit_b = cal.evaluate(test_c, truth), biased.evaluate(test_c, truth)
             nom = PoseErrorStats.of(nominal.forward_batch(test_c), truth)
             wall = time.perf_counter() - t
-            ratio = nom.position_median_mm / fit.position_median_mm
             print(
                 f"| {g} | {s} | {nom.position_median_mm:.2f} / {nom.position_p95_mm:.2f} | "
-                f"{fit.position_median_mm:.2f} / {fit.position_p95_mm:.2f} | {ratio:.0f}x | "
-                f"{wall:.0f} |",
+                f"{fit.position_median_mm:.2f} / {fit.position_p95_mm:.2f} | "
+                f"{fit_b.position_median_mm:.2f} / {fit_b.position_p95_mm:.2f} | {wall:.0f} |",
                 flush=True,
             )
-            out.mkdir(parents=True, exist_ok=True)
             cal.save(out / f"model_{g}_{s}.toml")
-            gains = np.round(cal.actuator_gain, 4).tolist()
+            biased.save(out / f"model_bias_{g}_{s}.toml")
             row = {"gravity": g, "seed": s, "nominal": nom.as_dict(), "fitted": fit.as_dict()}
-            _emit(out, "rod", {**row, "gains": gains, "wall_s": wall})
+            _emit(out, "rod", {**row, "fitted_bias": fit_b.as_dict(), "wall_s": wall})
 
 
 def run_harvest(
@@ -120,8 +122,8 @@ def run_harvest(
         for m in models:
             for s in seeds:
                 cal = None
-                if m == "calibrated":
-                    path = out / f"model_{g}_{s}.toml"
+                if m != "nominal":
+                    path = out / f"model{'_bias' if m == 'bias' else ''}_{g}_{s}.toml"
                     if not path.exists():
                         run_rod([s], [g], out)
                     cal = Calibration.load(path)
@@ -157,7 +159,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", nargs="+", default=["1000-1019"], help="seeds or ranges a-b")
     ap.add_argument("--gravity", nargs="+", choices=sorted(GRAVITY), default=sorted(GRAVITY))
     ap.add_argument("--berries", type=int, default=5)
-    ap.add_argument("--model", nargs="+", choices=["nominal", "calibrated"],
+    ap.add_argument("--model", nargs="+", choices=["nominal", "calibrated", "bias"],
                     default=["nominal", "calibrated"])  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("out/fidelity"))
     a = ap.parse_args(argv)

@@ -54,3 +54,25 @@ def test_predict_and_model_toml_round_trip(fitted, tmp_path) -> None:
     np.testing.assert_allclose(
         back.commands_for(cal.elongations(pb.test_commands[:3])), pb.test_commands[:3]
     )
+
+
+def test_bias_recovers_a_bending_bias(tmp_path) -> None:
+    # A plant whose actuators carry a zero-mean offset per section (a constant bend, as
+    # gravity gives): the plain fit cannot express it, the bias fit can.
+    pb = synthetic_problem(1002)
+    offset = np.tile([0.002, -0.001, -0.001], 3)
+    from softarm.calibration.synthetic import noisy
+
+    rng = np.random.default_rng(5)
+    poses = noisy(pb.true_arm.forward_batch(pb.fit_commands * pb.true_gain + offset), rng,
+                  1e-4, math.radians(0.1))  # fmt: skip
+    truth = pb.true_arm.forward_batch(pb.test_commands * pb.true_gain + offset)
+    plain = calibrate(pb.nominal, pb.fit_commands, poses).evaluate(pb.test_commands, truth)
+    cal = calibrate(pb.nominal, pb.fit_commands, poses, bias=True)
+    biased = cal.evaluate(pb.test_commands, truth)
+    assert biased.position_median_mm <= 0.2 < plain.position_median_mm
+    np.testing.assert_allclose(cal.actuator_offset, offset, atol=3e-4)
+    cal.save(tmp_path / "m.toml")
+    back = Calibration.load(tmp_path / "m.toml")
+    np.testing.assert_allclose(back.actuator_offset, cal.actuator_offset)
+    np.testing.assert_allclose(back.predict(pb.test_commands), cal.predict(pb.test_commands))

@@ -94,6 +94,7 @@ def calibrate(
     angle_noise: float = math.radians(0.1),
     prior: float = 0.1,
     max_nfev: int = 100,
+    bias: bool = False,
 ) -> Calibration:
     """Fit per-section radius, rest length, plate offset and twist, and per-actuator
     gains (true elongation = gain x command), to measured end-effector poses.
@@ -107,6 +108,9 @@ def calibrate(
         prior: standard deviation of the prior toward the nominal arm (relative for
             lengths and gains, rad for twists); ``math.inf`` for plain least squares.
         max_nfev: most function evaluations of the solver.
+        bias: also fit a constant bending bias per section (zero-mean actuator offsets,
+            true elongation = gain x command + offset; 6 more parameters): the
+            gravity-aware term for an arm that sags (docs/fidelity.md).
 
     Raises:
         ShapeError: wrong shapes, or fewer samples than fitted parameters.
@@ -120,7 +124,7 @@ def calibrate(
     sprior = float(prior) if prior == math.inf else _positive("prior", prior)
     if not (isinstance(max_nfev, int) and max_nfev > 0):
         raise ParameterError(f"max_nfev = {max_nfev!r}: must be a positive integer")
-    pmap = ParameterMap(nominal_arm)
+    pmap = ParameterMap(nominal_arm, bias=bool(bias))
     if len(c) < pmap.size:
         raise ShapeError(
             f"commands, poses: {len(c)} samples, fewer than the {pmap.size} fitted parameters"
@@ -128,7 +132,7 @@ def calibrate(
     w_prior = 0.0 if math.isinf(sprior) else 1.0 / sprior
 
     def residuals(x: F64) -> F64:
-        pred = pmap.arm(x).forward_batch(c * pmap.gains(x))
+        pred = pmap.arm(x).forward_batch(pmap.elongations(x, c))
         rp = (pred[:, :3, 3] - meas[:, :3, 3]) / sp
         ro = rotation_residuals(pred, meas) / sa
         return np.concatenate([np.hstack([rp, ro]).ravel(), w_prior * x])
@@ -147,8 +151,8 @@ def calibrate(
         method="trf", x_scale="jac", max_nfev=max_nfev,
     )  # fmt: skip
     x = sol.x
-    arm, gains = pmap.arm(x), pmap.gains(x)
-    stats = PoseErrorStats.of(arm.forward_batch(c * gains), meas)
+    arm, gains, offsets = pmap.arm(x), pmap.gains(x), pmap.offsets(x)
+    stats = PoseErrorStats.of(arm.forward_batch(pmap.elongations(x, c)), meas)
     # Parameter standard deviations from the Gauss-Newton covariance, scaled by the
     # residuals' own variance (the noise levels may be mis-stated).
     dof = max(sol.fun.size - pmap.size, 1)
@@ -161,6 +165,7 @@ def calibrate(
     return Calibration(
         arm=arm,
         actuator_gain=gains,
+        actuator_offset=offsets,
         fit=stats,
         parameters=dict(zip(pmap.names(), x.tolist(), strict=True)),
         parameter_std=dict(zip(pmap.names(), std.tolist(), strict=True)),

@@ -61,6 +61,13 @@ class Calibration:
     parameter_std: dict[str, float] = field(default_factory=dict)
     converged: bool = True
     message: str = ""
+    #: (n,) elongation offsets (m): true elongation = gain x command + offset (zero
+    #: unless fitted with ``bias=True``).
+    actuator_offset: F64 | None = None
+
+    def __post_init__(self) -> None:
+        if self.actuator_offset is None:
+            self.actuator_offset = np.zeros(self.arm.n_actuators)
 
     def _commands(self, commands: npt.ArrayLike) -> F64:
         c = np.asarray(commands, dtype=np.float64)
@@ -73,20 +80,20 @@ class Calibration:
 
     def elongations(self, commands: npt.ArrayLike) -> F64:
         """True elongations (N, n) the fitted model expects for ``commands``."""
-        return self._commands(commands) * self.actuator_gain
+        return self._commands(commands) * self.actuator_gain + self.actuator_offset
 
     def commands_for(self, elongations: npt.ArrayLike) -> F64:
         """Commands that give ``elongations`` (m) on the fitted arm: elongation / gain."""
         e = np.asarray(elongations, dtype=np.float64)
         if e.shape[-1:] != (self.arm.n_actuators,) or not np.all(np.isfinite(e)):
             raise ShapeError(f"elongations: expected finite (..., {self.arm.n_actuators})")
-        return e / self.actuator_gain
+        return (e - self.actuator_offset) / self.actuator_gain
 
     def pressure_map(self, max_psi: float = 70.0) -> GainMap:
         """The elongation <-> psi map of the fitted actuators, for
         ``softarm.harvest.actuator.SafeActuator(bank, pressure_map=...)``: the model's
         (true) elongations become pressures through each actuator's own gain."""
-        return GainMap(max_psi, self.actuator_gain)
+        return GainMap(max_psi, self.actuator_gain, self.actuator_offset)
 
     def predict(self, commands: npt.ArrayLike) -> F64:
         """End-effector poses (N, 4, 4) the fitted model predicts for ``commands``."""
@@ -114,7 +121,9 @@ class Calibration:
         for s in self.arm.sections:
             out += ["[[arm.sections]]"] + [f"{k} = {getattr(s, k)!r}" for k in _SECTION_KEYS]
             out.append("")
-        out += ["[actuators]", f"gain = {[float(g) for g in self.actuator_gain]!r}", ""]
+        out += ["[actuators]", f"gain = {[float(g) for g in self.actuator_gain]!r}"]
+        offset = [float(o) for o in self.actuator_offset]  # type: ignore[union-attr]
+        out += [f"offset = {offset!r}", ""]
         out += ["[fit]"] + [f"{k} = {v!r}" for k, v in self.fit.as_dict().items()] + [""]
         out += ["[parameters]"]
         out += [f"{json.dumps(k)} = {float(v)!r}" for k, v in self.parameters.items()]
@@ -165,6 +174,13 @@ class Calibration:
             raise ConfigError(
                 f"{source}: actuators.gain: expected {arm.n_actuators} positive finite numbers"
             )
+        offset = np.asarray(data["actuators"].get("offset", [0.0] * arm.n_actuators), dtype=object)
+        if offset.shape != (arm.n_actuators,) or not all(
+            isinstance(o, int | float) and math.isfinite(o) for o in offset
+        ):
+            raise ConfigError(
+                f"{source}: actuators.offset: expected {arm.n_actuators} finite numbers"
+            )
         fit_d = data.get("fit", {})
         names = [f.name for f in fields(PoseErrorStats)]
         if set(fit_d) != set(names):
@@ -172,6 +188,7 @@ class Calibration:
         return cls(
             arm=arm,
             actuator_gain=gain.astype(np.float64),
+            actuator_offset=offset.astype(np.float64),
             fit=PoseErrorStats(**fit_d),
             parameters={str(k): float(v) for k, v in data.get("parameters", {}).items()},
             converged=bool(data.get("converged", True)),
@@ -179,28 +196,30 @@ class Calibration:
 
 
 class GainMap:
-    """``ElongationMap`` with one gain per actuator: psi = l / (gain x 1/2100 m/psi)."""
+    """``ElongationMap`` with a gain and an offset per actuator:
+    psi = (l - offset) / (gain x 1/2100 m/psi)."""
 
-    def __init__(self, max_psi: float, gain: F64) -> None:
+    def __init__(self, max_psi: float, gain: F64, offset: F64 | None = None) -> None:
         self.max_psi = float(max_psi)
         self.metres_per_psi = METRES_PER_PSI * np.asarray(gain, dtype=np.float64)
+        self.offset = np.zeros_like(self.metres_per_psi) if offset is None else offset
 
     @property
     def max_elongation(self) -> F64:
-        return self.max_psi * self.metres_per_psi
+        return self.max_psi * self.metres_per_psi + self.offset
 
     def to_psi(self, elongation: npt.ArrayLike, *, clamp: bool = True) -> F64:
         e = np.asarray(elongation, dtype=np.float64)
         if not np.all(np.isfinite(e)):
             raise NonFiniteError(f"elongation must be finite, got {e.tolist()!r}")
-        psi = e / self.metres_per_psi
+        psi = (e - self.offset) / self.metres_per_psi
         return np.clip(psi, 0.0, self.max_psi) if clamp else psi
 
     def to_elongation(self, psi: npt.ArrayLike, *, clamp: bool = True) -> F64:
         p = np.asarray(psi, dtype=np.float64)
         if not np.all(np.isfinite(p)):
             raise NonFiniteError(f"psi must be finite, got {p.tolist()!r}")
-        return (np.clip(p, 0.0, self.max_psi) if clamp else p) * self.metres_per_psi
+        return (np.clip(p, 0.0, self.max_psi) if clamp else p) * self.metres_per_psi + self.offset
 
 
 def load_calibration(path: str | Path) -> Calibration:
