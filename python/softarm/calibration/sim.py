@@ -70,6 +70,7 @@ def calibrate_plant(
     on_pose: Callable[[int, F64], None] | None = None,
     settle: float = 1.0,
     average: float = 0.5,
+    bias: bool = False,
 ) -> tuple[Calibration, F64, F64]:
     """Drive ``plant`` through ``n_poses`` excitation poses measured by a tracker with
     ``config``'s noise, and fit; returns the calibration and the data (commands, poses)."""
@@ -81,7 +82,7 @@ def calibrate_plant(
     c, p = collect(
         commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose, settle=settle, average=average
     )
-    return calibrate(nominal, c, p), c, p
+    return calibrate(nominal, c, p, bias=bias), c, p
 
 
 def true_poses(plant: object, commands: F64, settle: float = 1.0) -> F64:

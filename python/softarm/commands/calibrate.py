@@ -28,6 +28,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--seed", type=int, default=0, help="seed of the simulated plant (as harvest)")
     p.add_argument("--poses", type=int, default=80, help="excitation poses, 22..100 (default 80)")
     p.add_argument("--out", type=Path, default=Path("model.toml"), help="fitted model file")
+    p.add_argument(
+        "--bias",
+        action="store_true",
+        help="also fit a constant bending bias per section (the gravity-aware term)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(run=run)
 
@@ -77,8 +82,9 @@ def _sim(args: argparse.Namespace, progress: object) -> object:
     # The harvest rig draws its plant from seed + 1000 (softarm.harvest.sim_rig).
     plant = build_plant(nominal, config, args.seed + 1000)
     cal, _, _ = calibrate_plant(
-        plant, config, nominal, n_poses=args.poses, seed=args.seed, on_pose=progress
-    )
+        plant, config, nominal, n_poses=args.poses, seed=args.seed, on_pose=progress,
+        bias=args.bias,
+    )  # fmt: skip
     return cal
 
 
@@ -108,4 +114,4 @@ def _hardware(args: argparse.Namespace, progress: object) -> object:
         )
     finally:
         rig.close()  # vents the arm
-    return calibrate(nominal, c, p)
+    return calibrate(nominal, c, p, bias=args.bias)
