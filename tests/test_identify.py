@@ -169,3 +169,13 @@ def test_cli_bad_inputs_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert not out.exists()
     assert main(["identify", "--config", str(hw), "--plant", str(bad), "--out", str(out)]) == 2
     assert "--plant: works with --sim only" in capsys.readouterr().err
+
+
+def test_no_pressure_monitor_is_refused_not_guessed() -> None:
+    from softarm.errors import HardwareError
+    from softarm.identification import identify
+
+    rig = SimIdentificationRig(seed=2026, pressure_monitor=False)
+    with pytest.raises(HardwareError, match="pressure readings equal the commands"):
+        identify(rig, design=Design(budget_s=30.0))
+    assert (rig.bank.last_sent == 0.0).all()  # vented before the estimate

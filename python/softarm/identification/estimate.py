@@ -35,6 +35,9 @@ def estimate(
     """
     n = rec.sent.shape[1]
     if np.allclose(rec.pressure, rec.sent, atol=1e-9):
+        # Without a monitor NidaqPressureBank echoes the commands: the lag is invisible
+        # in the readings. (Fitting it from the poses' transients alone was tried and is
+        # not reliable: the tracker's filter and the play hide the regulator's response.)
         raise HardwareError(
             "the pressure readings equal the commands: connect the regulators' pressure "
             "monitor (the Arduino pressure board) so that the lag can be measured"

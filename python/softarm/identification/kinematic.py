@@ -45,7 +45,14 @@ from scipy.signal import lfilter
 from softarm._core import Section, SoftArm
 from softarm.identification.record import Recording
 
-__all__ = ["KinematicFit", "fit_kinematics", "play_states"]
+__all__ = [
+    "KinematicFit",
+    "filter_gain",
+    "fit_kinematics",
+    "play_states",
+    "pose_residual",
+    "tracked",
+]
 
 F64 = npt.NDArray[np.float64]
 
@@ -86,7 +93,9 @@ def play_states(pressure: F64, p0: F64, width: F64) -> F64:
 
 
 def _arm(nominal: SoftArm, geom: F64) -> SoftArm:
-    g = geom.reshape(-1, 4)
+    # A trial step of the solver may leave the physical range: clip the log-scales to a
+    # factor of e (any real arm is far inside) so that every trial is a valid arm.
+    g = np.clip(geom.reshape(-1, 4), -1.0, 1.0)
     return SoftArm(
         [
             Section(
@@ -107,6 +116,32 @@ def _vee_skew(r: F64) -> F64:
     return 0.5 * np.stack(
         [r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1
     )
+
+
+def filter_gain(rec: Recording) -> float:
+    """The tracker filter's gain per period (1: no filter)."""
+    return 1.0 - math.exp(-rec.pose_cutoff * rec.period) if rec.pose_cutoff else 1.0
+
+
+def tracked(arm: SoftArm, q: F64, keep: float) -> F64:
+    """Tracker readings (K, 4, 4) for elongations ``q`` (K + 1, n), whose first row is
+    the state before the first sample: the poses, low-passed like the tracker does. The
+    rotation block is filtered element-wise, which is the SO(3) filter to first order in
+    the (small) innovation of one period."""
+    raw = arm.forward_batch(q)
+    if keep >= 1.0:
+        return raw[1:]
+    flat = raw.reshape(len(raw), 16)
+    out, _ = lfilter([keep], [1.0, -(1.0 - keep)], flat[1:], axis=0, zi=(1 - keep) * flat[:1])
+    return np.asarray(out).reshape(-1, 4, 4)
+
+
+def pose_residual(pred: F64, measured: F64) -> F64:
+    """Position (per 0.1 mm) and rotation (per 0.1 deg) errors, flattened."""
+    dp = (pred[:, :3, 3] - measured[:, :3, 3]) / SIGMA_POSITION
+    rot = measured[:, :3, :3] @ np.transpose(pred[:, :3, :3], (0, 2, 1))
+    da = _vee_skew(rot) / SIGMA_ANGLE
+    return np.concatenate([dp, da], axis=1).ravel()
 
 
 def fit_kinematics(
@@ -132,7 +167,7 @@ def fit_kinematics(
     m0 = rec.metres_per_psi
     n_geom = 4 * nominal.n_sections if fit_geometry else 0
     width = np.full(n, width0)
-    keep = 1.0 - math.exp(-rec.pose_cutoff * rec.period) if rec.pose_cutoff else 1.0
+    keep = filter_gain(rec)
 
     def unpack(x: F64) -> tuple[F64, F64, F64]:
         geom = np.zeros(4 * nominal.n_sections)
@@ -141,24 +176,12 @@ def fit_kinematics(
         return geom, np.exp(x[n_geom : n_geom + n]), np.abs(x[n_geom + n :])
 
     def predict(x: F64, z: F64) -> F64:
-        """Tracker readings (N, 4, 4) the model predicts at the fitted samples; the
-        rotation block is filtered element-wise, which is the SO(3) filter to first
-        order in the (small) innovation of one period."""
         geom, gain, w = unpack(x)
         q = m0 * gain * (pressure + 0.5 * z * w)
-        raw = _arm(nominal, geom).forward_batch(q)
-        if keep >= 1.0:
-            return raw[1:][idx]
-        flat = raw.reshape(len(raw), 16)
-        out, _ = lfilter([keep], [1.0, -(1.0 - keep)], flat[1:], axis=0, zi=(1 - keep) * flat[:1])
-        return out.reshape(-1, 4, 4)[idx]
+        return tracked(_arm(nominal, geom), q, keep)[idx]
 
     def residual(x: F64, z: F64) -> F64:
-        pred = predict(x, z)
-        dp = (pred[:, :3, 3] - measured[:, :3, 3]) / SIGMA_POSITION
-        rot = measured[:, :3, :3] @ np.transpose(pred[:, :3, :3], (0, 2, 1))
-        da = _vee_skew(rot) / SIGMA_ANGLE
-        return np.concatenate([dp, da], axis=1).ravel()
+        return pose_residual(predict(x, z), measured)
 
     x = np.concatenate([np.zeros(n_geom), np.zeros(n), width])
     # Typical sizes (a few % of geometry and gain, a psi of band) set the trust region;

@@ -68,8 +68,11 @@ class _SimPressures:
     """The :class:`~softarm.hardware.simulated.PressurePlant` face of a SimulatedArm that
     also keeps the tracker's last measurement."""
 
-    def __init__(self, arm: SimulatedArm, noise_psi: float = 0.0, seed: int = 0) -> None:
+    def __init__(
+        self, arm: SimulatedArm, noise_psi: float = 0.0, seed: int = 0, monitor: bool = True
+    ) -> None:
         self.arm = arm
+        self.monitor = monitor
         self.command = np.zeros(arm.n)
         self.measured = arm.reset(self.command)
         self.noise_psi = noise_psi
@@ -79,6 +82,8 @@ class _SimPressures:
         self.command = np.asarray(psi, dtype=np.float64).copy()
 
     def pressures(self) -> F64:
+        if not self.monitor:  # as NidaqPressureBank without a monitor: the command
+            return self.command.copy()
         p = self.arm.pressure
         if self.noise_psi > 0.0:  # a pressure monitor's reading noise
             p = p + self.rng.normal(0.0, self.noise_psi, p.shape)
@@ -100,6 +105,8 @@ class SimIdentificationRig:
         period: control period (s).
         reading_noise_psi: standard deviation of the pressure readings' noise (psi); the
             plant's regulators are exact, a real pressure monitor is not.
+        pressure_monitor: False: the readings echo the commands, as on hardware with no
+            pressure board (the lag is then identified from the poses).
     """
 
     def __init__(
@@ -109,13 +116,16 @@ class SimIdentificationRig:
         model: SoftArm | None = None,
         period: float = 0.05,
         reading_noise_psi: float = 0.0,
+        pressure_monitor: bool = True,
     ) -> None:
         self.model = model if model is not None else SoftArm.blackberry()
         self.plant = plant if plant is not None else PlantConfig()
         self.arm = SimulatedArm(self.model, self.plant, seed=sim_plant_seed(seed))
         if not (np.isfinite(reading_noise_psi) and reading_noise_psi >= 0.0):
             raise ParameterError(f"reading_noise_psi = {reading_noise_psi}: must be >= 0")
-        self._sim = _SimPressures(self.arm, reading_noise_psi, sim_plant_seed(seed) + 1)
+        self._sim = _SimPressures(
+            self.arm, reading_noise_psi, sim_plant_seed(seed) + 1, pressure_monitor
+        )
         self.period = period
         self.pose_cutoff: float | None = self.plant.cutoff
         self.metres_per_psi = METRES_PER_PSI
