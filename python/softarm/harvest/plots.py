@@ -1,5 +1,6 @@
-"""Plots of a simulated harvest: the gripper's path and the arm at each grasp among the
-berries and canes, and the position and orientation errors against time per berry."""
+"""Plots of a simulated harvest: the gripper's path and the arm and gripper at each grasp
+among the berries and canes, and the position and orientation errors against time per
+berry. Each berry has one colour in every panel (its tag written beside it)."""
 
 from __future__ import annotations
 
@@ -7,51 +8,182 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from softarm.harvest.report import HarvestReport
 from softarm.harvest.sim_rig import SimRig
+from softarm.viz.arm import arm_line, clip_to_box
+from softarm.viz.gripper import gripper_polylines
 
-__all__ = ["plot_errors", "plot_run", "plot_scene"]
+__all__ = ["berry_colours", "berry_paths", "plot_errors", "plot_run", "plot_scene"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def berry_colours(tags: list[int]) -> dict[int, str]:
+    """One matplotlib colour per berry tag, in the bush's order (the same in every panel)."""
+    return {tag: f"C{k % 10}" for k, tag in enumerate(tags)}
 
 
 def plot_run(rig: SimRig, report: HarvestReport, path: str | Path) -> None:
-    """Both figures side by side in one image at ``path``."""
+    """The scene (whole, and zoomed on the berries) and the errors in one image."""
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(15, 6.5))
-    plot_scene(fig.add_subplot(1, 2, 1, projection="3d"), rig, report)
-    ax_p = fig.add_subplot(2, 2, 2)
-    ax_o = fig.add_subplot(2, 2, 4, sharex=ax_p)
-    plot_errors(ax_p, ax_o, rig.machine.log.records)
+    colours = berry_colours([b.tag_id for b in rig.bush.berries])
+    fig = plt.figure(figsize=(19, 6.8))
+    grid = fig.add_gridspec(2, 3, width_ratios=(1.0, 1.0, 1.25))
+    plot_scene(fig.add_subplot(grid[:, 0], projection="3d"), rig, report, colours)
+    ax_z = fig.add_subplot(grid[:, 1], projection="3d")
+    plot_scene(ax_z, rig, report, colours, zoom=True)
+    ax_p = fig.add_subplot(grid[0, 2])
+    ax_o = fig.add_subplot(grid[1, 2], sharex=ax_p)
+    plot_errors(ax_p, ax_o, rig.machine.log.records, colours)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
-def plot_scene(ax: Any, rig: SimRig, report: HarvestReport) -> None:
-    """3D: canes, berries (green harvested, red not), the true gripper path and the arm
-    at every grasp."""
-    for branch in rig.bush.branches:
-        p = branch.points(60)
-        ax.plot(p[:, 0], p[:, 1], p[:, 2], color="saddlebrown", lw=2)
+def berry_paths(
+    trajectory: list[FloatArray], period: float, records: list[dict[str, Any]]
+) -> tuple[dict[int, list[FloatArray]], list[FloatArray]]:
+    """The true gripper path cut into each berry's approach (from the start of initial
+    placement to the grasp: a list of pieces per tag, a berry may be tried twice) and the
+    rest (ramps to and from the ready pose).
+
+    ``trajectory`` holds one position after every clock step of ``period`` seconds (the
+    rig's :class:`~softarm.harvest.sim_devices.ArmWatch`); the stages' times come from the
+    run log's transitions."""
+    path = np.asarray(trajectory, dtype=np.float64).reshape(-1, 3)
+    times = period * np.arange(1, len(path) + 1)
+    windows: list[tuple[int, float, float]] = []
+    start: tuple[int, float] | None = None
+    for r in records:
+        if r["kind"] != "transition":
+            continue
+        if r["new"] == "initial_placement":
+            start = (r["berry"], r["t"])
+        elif start is not None and r["new"] in ("grasp", "return_home", "done", "fault"):
+            windows.append((start[0], start[1], r["t"]))
+            start = None
+    approach: dict[int, list[FloatArray]] = {}
+    inside = np.zeros(len(path), dtype=bool)
+    for tag, t0, t1 in windows:
+        sel = (times >= t0 - 1e-9) & (times <= t1 + 1e-9)
+        if sel.any():
+            approach.setdefault(tag, []).append(path[sel])
+            inside |= sel
+    rest = [path[idx] for idx in _runs(~inside)]
+    return approach, rest
+
+
+def _runs(mask: npt.NDArray[np.bool_]) -> list[npt.NDArray[np.intp]]:
+    """Index runs where ``mask`` is True, each grown by one on both sides so that the
+    pieces of a cut line still meet."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    out = []
+    for part in np.split(idx, breaks + 1):
+        lo, hi = max(part[0] - 1, 0), min(part[-1] + 1, mask.size - 1)
+        out.append(np.arange(lo, hi + 1))
+    return out
+
+
+def plot_scene(
+    ax: Any,
+    rig: SimRig,
+    report: HarvestReport,
+    colours: dict[int, str] | None = None,
+    zoom: bool = False,
+) -> None:
+    """3D: canes, berries (filled: harvested, hollow: not, labelled by tag), the true
+    gripper path per berry (thin, the berry's colour; ramps to the ready pose grey), and
+    the true arm with its gripper at every grasp. ``zoom``: only the box around the
+    berries and the approaches (everything clipped to it), without the legend."""
+    tags = [b.tag_id for b in rig.bush.berries]
+    colours = colours or berry_colours(tags)
+    offset = rig.machine.config.grasp_offset
+    records = rig.machine.log.records
+    period = rig.machine.config.period
+    traj = rig.watch.trajectory
+    berries = np.array([b.position for b in rig.bush.berries]).reshape(-1, 3)
+    # The path is cut by time; only when every step lasted one period (as the servo
+    # sleeps) do the positions' times follow from their count.
+    approach: dict[int, list[FloatArray]] = {}
+    rest: list[FloatArray] = []
+    if traj and abs(len(traj) * period - rig.clock.now()) <= period / 2:
+        approach, rest = berry_paths(traj, period, records)
+    elif traj:
+        rest = [np.asarray(traj)]
+    if zoom:
+        # The last centimetres of each approach and the gripper around its berry.
+        lo, hi = _cube(berries.min(0) - 0.05, berries.max(0) + 0.05)
+    else:
+        lo, hi = _cube(np.vstack([berries, np.asarray(traj).reshape(-1, 3), np.zeros((1, 3))]))
+
+    def line(pts: Any, **style: Any) -> None:
+        ax.plot(*clip_to_box(pts, lo, hi).T, **style)
+
+    for i, branch in enumerate(rig.bush.branches):
+        line(branch.points(120), color="saddlebrown", lw=2, alpha=0.8,
+             label="canes" if i == 0 else None)  # fmt: skip
+    for k, piece in enumerate(rest):
+        line(piece, color="0.55", lw=0.6, alpha=0.7,
+             label="gripper path to/from the ready pose" if k == 0 else None)  # fmt: skip
+    for n, (tag, pieces) in enumerate(approach.items()):
+        for piece in pieces:
+            line(piece, color=colours.get(tag, "k"), lw=0.9,
+                 label="gripper path, approach (berry's colour)" if n == 0 else None)  # fmt: skip
+    # The plant's shape is kept at every grasp (SimGripper.grasp_errors), right after fine
+    # positioning ends: the berry of each is the one whose fine positioning ended.
+    grasped = [r["berry"] for r in records if r["kind"] == "transition"
+               and r["old"] == "fine_positioning" and r["new"] in ("grasp", "done")]  # fmt: skip
+    arm = rig.plant.arm
+    for k, q in enumerate(rig.gripper.grasp_shapes):
+        colour = colours.get(grasped[k], "k") if k < len(grasped) else "k"
+        line(arm_line(arm, q, 40), color="0.35", lw=2.5, alpha=0.45,
+             label="arm at grasp" if k == 0 else None)  # fmt: skip
+        for j, part in enumerate(gripper_polylines(np.asarray(arm.forward(q)), offset)):
+            line(part, color=colour, lw=2.5 if zoom else 1.5,
+                 label="gripper at grasp" if k == 0 and j == 0 else None)  # fmt: skip
     done = {b.tag_id for b in report.berries if b.harvested}
     for b in rig.bush.berries:
-        ax.scatter(*b.position, color="green" if b.tag_id in done else "red", s=40)
-    path = np.array(rig.watch.trajectory)
-    if len(path):
-        ax.plot(path[:, 0], path[:, 1], path[:, 2], color="tab:blue", lw=0.8, label="gripper")
-    for q in rig.gripper.grasp_shapes:
-        bb = rig.plant.arm.backbone(q, 20)
-        ax.plot(bb[:, 0], bb[:, 1], bb[:, 2], color="0.4", lw=3, alpha=0.6)
-    pts = np.concatenate([path, [[0, 0, 0]], [b.position for b in rig.bush.berries]])
-    centre, half = pts.mean(0), 0.5 * np.ptp(pts, 0).max()
-    ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half))
-    ax.set(zlim=(centre[2] - half, centre[2] + half), xlabel="x (m)", ylabel="y (m)")
+        c = colours[b.tag_id]
+        ax.scatter(*b.position, s=45 if zoom else 50, depthshade=False, alpha=0.85, edgecolor=c,
+                   linewidth=1.5, facecolor=c if b.tag_id in done else "none")  # fmt: skip
+        lift = 0.06 * (hi[2] - lo[2])
+        ax.text(*np.add(b.position, (0.0, 0.0, lift)), str(b.tag_id), color=c,
+                fontsize=9 if zoom else 8, ha="center", weight="bold")  # fmt: skip
+    ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), zlim=(lo[2], hi[2]))
+    ax.set(xlabel="x (m)", ylabel="y (m)")
     ax.set_zlabel("z (m)")
+    ax.set_box_aspect((1, 1, 1))
+    if zoom:
+        ax.set_title("around the berries (tags above, same colours as the errors)")
+        return
+    ax.scatter([], [], s=40, color="0.3", label="berry harvested (its tag above)")
+    ax.scatter([], [], s=40, facecolor="none", edgecolor="0.3", label="berry not harvested")
+    ax.legend(loc="upper left", fontsize=7, framealpha=0.85)
     ax.set_title(f"seed {rig.bush.seed}: {len(done)}/{len(report.berries)} harvested")
 
 
-def plot_errors(ax_p: Any, ax_o: Any, records: list[dict[str, Any]]) -> None:
+def _cube(lo: Any, hi: Any | None = None) -> tuple[FloatArray, FloatArray]:
+    """The cube (equal axes) around the box lo..hi, or around the points ``lo``."""
+    if hi is None:
+        pts = np.asarray(lo)
+        lo, hi = pts.min(0), pts.max(0)
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    centre, half = (lo + hi) / 2, 0.55 * float((hi - lo).max())
+    return centre - half, centre + half
+
+
+def plot_errors(
+    ax_p: Any,
+    ax_o: Any,
+    records: list[dict[str, Any]],
+    colours: dict[int, str] | None = None,
+) -> None:
     """Position error (mm, log scale) and pointing error (deg) against time from each
     berry's start, in placement and fine positioning (as the cameras measured them)."""
     berries: dict[int, list[dict[str, Any]]] = {}
@@ -59,8 +191,9 @@ def plot_errors(ax_p: Any, ax_o: Any, records: list[dict[str, Any]]) -> None:
         if r["kind"] == "step" and r["position_error"] is not None:
             if r["state"] in ("initial_placement", "fine_positioning"):
                 berries.setdefault(r["berry"], []).append(r)
-    for k, (tag, steps) in enumerate(berries.items()):
-        t0, colour = steps[0]["t"], f"C{k % 10}"
+    colours = colours or berry_colours(list(berries))
+    for tag, steps in berries.items():
+        t0, colour = steps[0]["t"], colours.get(tag, "k")
         for stage, style in (("initial_placement", "--"), ("fine_positioning", "-")):
             part = [s for s in steps if s["state"] == stage]
             t = [s["t"] - t0 for s in part]

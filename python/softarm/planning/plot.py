@@ -17,6 +17,7 @@ import numpy.typing as npt
 
 from softarm import _core
 from softarm.planning.scenarios import COLLISION_DISTANCE, SUBSTEPS, Result, Scenario
+from softarm.viz.arm import clip_to_box
 
 __all__ = ["first_contact", "plot_plan", "snapshot_iterations"]
 
@@ -127,10 +128,7 @@ def _box(chain: Any, configs: Sequence[Any], goal: FloatArray) -> tuple[FloatArr
 
 def _clip(points: Any, box: tuple[FloatArray, FloatArray]) -> FloatArray:
     """``points`` (n, 3) with those outside ``box`` set to NaN (a break in the line)."""
-    pts = np.array(points, dtype=np.float64, ndmin=2)
-    lo, hi = box
-    pts[~np.all((pts >= lo - 1e-9) & (pts <= hi + 1e-9), axis=1)] = np.nan
-    return pts
+    return clip_to_box(points, *box)
 
 
 def _scene(

@@ -26,6 +26,7 @@ import numpy.typing as npt
 
 from softarm.errors import InputError, ShapeError
 from softarm.harvest.states import HarvestState
+from softarm.viz.arm import arm_polylines
 from softarm.viz.gripper import gripper_outline
 from softarm.viz.rerun_sdk import TIMELINE
 
@@ -126,15 +127,20 @@ class ArmDrawer:
         stream.log(f"{path}/gripper", rr.TransformAxes3D(0.03), static=True)
 
     def draw(self, backbone: FloatArray, pose: FloatArray) -> None:
-        """``backbone``: (n_sections * samples, 3) points, or any (n, 3) centre line
-        (one strip); ``pose``: the end effector's 4x4 pose."""
+        """``backbone``: any (n, 3) centre line (one strip, e.g. a Cosserat rod's);
+        ``pose``: the end effector's 4x4 pose."""
+        self._log([np.asarray(backbone, dtype=np.float64)], self.colours[:1], pose)
+
+    def draw_arm(self, arm: Any, q: FloatArray) -> None:
+        """The arm at ``q``: one colour per section, the rigid links (plates, the
+        gripper's body) grey, and the gripper at the end-effector frame."""
+        arcs, links = arm_polylines(arm, q, self.samples)
+        grey = (110, 110, 110, self.colours[0][3])
+        self._log([*arcs, *links], [*self.colours, *[grey] * len(links)],
+                  np.asarray(arm.forward(q)))  # fmt: skip
+
+    def _log(self, strips: list[FloatArray], colours: list[Any], pose: FloatArray) -> None:
         rr = self.rr
-        pts = np.asarray(backbone, dtype=np.float64)
-        if pts.shape[0] == self.n_sections * self.samples:
-            strips = list(pts.reshape(self.n_sections, self.samples, 3))
-            colours = self.colours
-        else:
-            strips, colours = [pts], self.colours[:1]
         self.stream.log(
             f"{self.path}/backbone", rr.LineStrips3D(strips, colors=colours, radii=self.radius)
         )
@@ -216,9 +222,8 @@ class RecordLogger:
             log("harvest/state_index", rr.Scalars(STATE_INDEX[state]))
         if self.model is not None and r.get("q") is not None:
             q = as_vector(r["q"], "q", self.model.n_actuators)
-            pts = np.asarray(self.model.backbone(q, 20))
             assert self._arm is not None
-            self._arm.draw(pts, np.asarray(self.model.forward(q)))
+            self._arm.draw_arm(self.model, q)
         if r.get("pose") is not None:
             pose = as_pose(r["pose"], "pose")
             log("world/estimate/ee", rr.Transform3D(translation=pose[:3, 3], mat3x3=pose[:3, :3]))

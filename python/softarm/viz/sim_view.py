@@ -119,11 +119,10 @@ class SimView:
         self.stream.set_time(TIMELINE, duration=t)
         plant = rig.plant
         q, pose = plant.q(), plant.pose()
-        if self._centreline is not None:
-            backbone = np.asarray(self._centreline())
+        if self._centreline is not None:  # the rod itself, not arcs
+            self._arm.draw(np.asarray(self._centreline()), pose)
         else:
-            backbone = np.asarray(plant.arm.backbone(q, 20))
-        self._arm.draw(backbone, pose)
+            self._arm.draw_arm(plant.arm, q)
         c2 = pose @ rig.vision.fusion.T_ee_c2
         self.stream.log("world/c2", rr.Transform3D(translation=c2[:3, 3], mat3x3=c2[:3, :3]))
         self._berries()
