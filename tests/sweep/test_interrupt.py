@@ -1,5 +1,5 @@
-"""Ctrl-C in the middle of a sweep: the driver stops within seconds, the table holds every
-trial that finished, and none of the Ray processes it started is left running."""
+"""Ctrl-C (or SIGTERM) in the middle of a sweep: the driver stops within seconds, the table
+holds every trial that finished, and none of the Ray processes it started is left running."""
 
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def on_trial(trial, rows):
 spec = parse_spec({"sweep": {"seeds": list(range(12)), "berries": 1,
                              "plant": {"pressure_tau": [0.08]}}})
 out = run_sweep(spec, sys.argv[1], cpus=1, trial_fn=slow, progress=False, on_trial=on_trial)
-print("INTERRUPTED" if out.interrupted else "COMPLETED", out.ran, flush=True)
+print("INTERRUPTED" if out.interrupted else "COMPLETED", out.ran, out.signal, flush=True)
 """
 
 
@@ -55,7 +55,8 @@ def _processes_mentioning(text: str) -> list[str]:
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="reads /proc")
-def test_ctrl_c_keeps_finished_trials_and_stops_ray(tmp_path: Path) -> None:
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_keeps_finished_trials_and_stops_ray(tmp_path: Path, sig: signal.Signals) -> None:
     script = tmp_path / "driver.py"
     script.write_text(DRIVER)
     out = tmp_path / "out"
@@ -66,7 +67,7 @@ def test_ctrl_c_keeps_finished_trials_and_stops_ray(tmp_path: Path) -> None:
         line = proc.stdout.readline()  # blocks until the first trial is written
         assert line.startswith("SESSION "), (line, proc.stderr.read() if proc.stderr else "")
         session = Path(line.split(maxsplit=1)[1].strip()).name
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
         stdout, stderr = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
@@ -75,6 +76,7 @@ def test_ctrl_c_keeps_finished_trials_and_stops_ray(tmp_path: Path) -> None:
     last = stdout.strip().splitlines()[-1]
     assert last.startswith("INTERRUPTED"), stdout
     ran = int(last.split()[1])
+    assert int(last.split()[2]) == sig  # SIGTERM is told apart (exit status 143)
     assert 1 <= ran < 12
     rows = pq.read_table(out / "results.parquet").to_pylist()
     assert len(rows) == ran  # every finished trial, and only those

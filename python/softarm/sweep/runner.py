@@ -79,6 +79,10 @@ def init_ray(address: str | None = None, cpus: int | None = None) -> bool:
     return True
 
 
+#: The last SIGTERM our handler saw (see :func:`_sigterm_as_interrupt`).
+_last_signal: list[int | None] = [None]
+
+
 class _Stopped(KeyboardInterrupt):
     """SIGTERM, taking the Ctrl-C path."""
 
@@ -88,20 +92,27 @@ class _Stopped(KeyboardInterrupt):
 
 
 @contextmanager
-def _sigterm_as_interrupt() -> Iterator[None]:
-    """SIGTERM (a batch system stopping the job) takes the Ctrl-C path. ray.init installs
-    its own SIGTERM handler, so this is entered after it."""
+def _sigterm_as_interrupt() -> Iterator[Callable[[], None]]:
+    """SIGTERM (a batch system stopping the job) takes the Ctrl-C path. ``ray.init``
+    installs its own SIGTERM handler (exit at once): call the yielded function after it
+    to take SIGTERM back."""
 
     def handler(signum: int, frame: object) -> None:
+        # Remember it: inside ray.wait Ray turns any exception from a signal handler
+        # into a plain KeyboardInterrupt.
+        _last_signal[0] = signum
         raise _Stopped(signum)
+
+    def arm() -> None:
+        signal.signal(signal.SIGTERM, handler)
 
     try:
         previous = signal.signal(signal.SIGTERM, handler)
     except ValueError:  # not the main thread: leave signals alone
-        yield
+        yield lambda: None
         return
     try:
-        yield
+        yield arm
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -153,18 +164,28 @@ def run_sweep(
     done = table.finished() if resume else {}
     todo = [t for t in trials if not done.get(t.trial_id, False)]
     outcome = SweepOutcome(table.path, len(trials), len(trials) - len(todo), 0, 0, 0, 0.0)
-    started = init_ray(address, cpus) if todo else False
+    ours = not ray.is_initialized()  # a Ray we start, we stop
+    _last_signal[0] = None
     try:
-        if todo:
-            outcome.cpus = float(ray.cluster_resources().get("CPU", math.nan))
-            with _sigterm_as_interrupt():
+        with _sigterm_as_interrupt() as rearm:
+            if todo:
+                try:
+                    init_ray(address, cpus)
+                except SystemExit as exc:
+                    # ray.init's own SIGTERM handler (active while it starts) exits with
+                    # the signal number: take the same path as a SIGTERM after it.
+                    if exc.code == signal.SIGTERM:
+                        raise _Stopped(signal.SIGTERM) from None
+                    raise
+                rearm()
+                outcome.cpus = float(ray.cluster_resources().get("CPU", math.nan))
                 _drive(ray, todo, table, outcome, progress, trial_fn, max_retries, on_trial)
     except KeyboardInterrupt as exc:
         outcome.interrupted = True
-        outcome.signal = getattr(exc, "signum", signal.SIGINT)
+        outcome.signal = getattr(exc, "signum", None) or _last_signal[0] or signal.SIGINT
     finally:
         table.flush()
-        if started:
+        if ours and ray.is_initialized():
             ray.shutdown()
     return outcome
 
