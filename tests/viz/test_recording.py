@@ -153,3 +153,26 @@ def test_a_viewer_that_cannot_start_is_one_line(tmp_path, monkeypatch) -> None:
     monkeypatch.setattr("softarm.viz.rerun_sdk.shutil.which", lambda name: "/opt/bin/rerun")
     with pytest.raises(ViewerUnavailableError, match=r"viewer: Failed to find Rerun Viewer[^\n]*$"):
         open_recording("x", tmp_path / "x.rrd", spawn=True)
+
+
+@pytest.mark.slow
+def test_the_viewer_loads_the_recording_and_its_layout(harvest_run) -> None:
+    """The rerun executable the wheel installs verifies the file as the viewer loads it;
+    the default layout (blueprint) travels in the file."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from rerun.chunk import RrdReader
+
+    _, rrd = harvest_run
+    assert RrdReader(rrd).blueprints()
+    beside = Path(sys.executable).with_name("rerun")
+    exe = shutil.which("rerun") or (str(beside) if beside.exists() else None)
+    if exe is None:
+        pytest.skip("the rerun executable is not installed")
+    done = subprocess.run(
+        [exe, "rrd", "verify", str(rrd)], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr[-2000:]

@@ -137,8 +137,8 @@ def _scene(
     """The obstacle curves (clipped to ``box``), the goal and the axes."""
     us = np.linspace(0.0, 1.0, 600)
     for i, curve in enumerate(scenario.curves):
-        lo, hi = curve.u_range
-        pts = _clip(curve(lo + (hi - lo) * us), box)
+        u0, u1 = curve.u_range
+        pts = _clip(curve(u0 + (u1 - u0) * us), box)
         ax.plot(
             *pts.T, color="tab:brown", lw=2, label="obstacle curve" if i == 0 and labels else None
         )

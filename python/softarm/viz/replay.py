@@ -10,6 +10,7 @@ from typing import Any
 
 from softarm.errors import InputError
 from softarm.harvest.log import read_log
+from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import RecordLogger
 from softarm.viz.rerun_sdk import close_recording, open_recording, require_rerun
 
@@ -38,7 +39,7 @@ def replay(
 
         model = softarm.SoftArm.blackberry()
     path = Path(log)
-    stream = open_recording(f"replay {path.name}", record, spawn)
+    stream = open_recording(f"replay {path.name}", record, spawn, harvest_blueprint(False))
     logger = RecordLogger(stream, require_rerun(), model, grasp_offset, berries_from_results=True)
     n = 0
     try:

@@ -49,9 +49,12 @@ def require_rerun() -> Any:
         ) from None
 
 
-def open_recording(name: str, record: str | Path | None = None, spawn: bool = False) -> Any:
+def open_recording(
+    name: str, record: str | Path | None = None, spawn: bool = False, blueprint: Any = None
+) -> Any:
     """A ``rerun.RecordingStream`` named ``name`` that writes to the file ``record``
-    (``.rrd``), streams to a spawned viewer (``spawn``), or both.
+    (``.rrd``), streams to a spawned viewer (``spawn``), or both; ``blueprint`` is the
+    viewer's default layout (:mod:`softarm.viz.layout`).
 
     Its own stream, not rerun's global one, so that two recordings in one process (tests,
     a replay beside a live run) never mix. Nothing goes to the network except the local
@@ -71,6 +74,8 @@ def open_recording(name: str, record: str | Path | None = None, spawn: bool = Fa
     else:
         stream.save(str(record))
     stream.send_recording_name(name)
+    if blueprint is not None:  # the viewer's default layout, saved in the file too
+        stream.send_blueprint(blueprint)
     return stream
 
 

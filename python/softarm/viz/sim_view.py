@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softarm.errors import ParameterError
+from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import ArmDrawer, RecordLogger
 from softarm.viz.rerun_sdk import TIMELINE, close_recording, open_recording, require_rerun
 
@@ -229,5 +230,6 @@ def attach(
 ) -> SimView:
     """A :class:`SimView` of ``rig`` recording to ``record`` (.rrd), a spawned viewer, or
     both; call its ``close()`` after the run."""
-    stream = open_recording(name or f"harvest seed {rig.bush.seed}", record, spawn)
+    name = name or f"harvest seed {rig.bush.seed}"
+    stream = open_recording(name, record, spawn, harvest_blueprint(cameras=True))
     return SimView(rig, stream, image_every).attach()
