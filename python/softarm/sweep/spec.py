@@ -184,7 +184,7 @@ def parse_spec(data: Mapping[str, Any], source: str = "<spec>") -> SweepSpec:
         raise r.error("sweep", "seeds", f"must be integers >= 0, got {seeds!r}")
     if len(set(seeds)) != len(seeds):
         raise r.error("sweep", "seeds", f"has duplicates: {seeds!r}")
-    berries = sweep.get("berries")
+    berries: Any = sweep.get("berries")
     if not _is_int(berries) or not 1 <= berries <= 64:
         raise r.error("sweep", "berries", f"must be an integer in 1..64, got {berries!r}")
 
