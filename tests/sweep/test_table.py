@@ -45,6 +45,13 @@ def test_rows_stream_to_parts_and_the_table(tmp_path: Path) -> None:
     assert not list(tmp_path.rglob(".*tmp"))  # no temporary file left behind
 
 
+def test_nothing_finished_leaves_no_table(tmp_path: Path) -> None:
+    # A sweep stopped before its first trial must not block the next attempt.
+    table = _table(tmp_path)
+    table.flush()
+    assert not table.exists() and not (tmp_path / "results.parquet").exists()
+
+
 def test_a_table_without_its_parts_resumes(tmp_path: Path) -> None:
     table = _table(tmp_path)
     t0, t1 = SPEC.trials()[:2]

@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
 
     import pyarrow.parquet as pq
 
-    rows = pq.read_table(outcome.table).to_pylist()
+    rows = pq.read_table(outcome.table).to_pylist() if outcome.table.exists() else []
     if rows:
         (args.out / "summary.md").write_text(markdown_summary(rows, spec.swept_keys))
         plot_summary(rows, spec.swept_keys, args.out / "summary.png")

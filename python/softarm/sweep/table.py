@@ -139,7 +139,10 @@ class ResultsTable:
         return self.pa.concat_tables(list(keep.values()), promote_options="permissive")
 
     def flush(self) -> None:
-        """Rewrite ``results.parquet`` from the parts of ``trial_ids``."""
+        """Rewrite ``results.parquet`` from the parts of ``trial_ids`` (nothing to write
+        before the first trial: an empty table would only block the next attempt)."""
+        if not self.parts.is_dir() and not self.path.exists():
+            return
         self.out.mkdir(parents=True, exist_ok=True)
         self._write(self.read(self.trial_ids), self.path)
         self._last_flush = time.monotonic()
