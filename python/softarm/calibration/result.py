@@ -63,10 +63,10 @@ class Calibration:
     message: str = ""
     #: (n,) elongation offsets (m): true elongation = gain x command + offset (zero
     #: unless fitted with ``bias=True``).
-    actuator_offset: F64 | None = None
+    actuator_offset: F64 = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
-        if self.actuator_offset is None:
+        if self.actuator_offset.size == 0:
             self.actuator_offset = np.zeros(self.arm.n_actuators)
 
     def _commands(self, commands: npt.ArrayLike) -> F64:
@@ -122,7 +122,7 @@ class Calibration:
             out += ["[[arm.sections]]"] + [f"{k} = {getattr(s, k)!r}" for k in _SECTION_KEYS]
             out.append("")
         out += ["[actuators]", f"gain = {[float(g) for g in self.actuator_gain]!r}"]
-        offset = [float(o) for o in self.actuator_offset]  # type: ignore[union-attr]
+        offset = [float(o) for o in self.actuator_offset]
         out += [f"offset = {offset!r}", ""]
         out += ["[fit]"] + [f"{k} = {v!r}" for k, v in self.fit.as_dict().items()] + [""]
         out += ["[parameters]"]

@@ -5,9 +5,16 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from softarm.errors import HardwareUnavailableError
+
+if TYPE_CHECKING:
+    from softarm.calibration import Calibration
+
+Progress = Callable[[int, Any], None]
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -67,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
     return 0 if cal.converged else 1
 
 
-def _sim(args: argparse.Namespace, progress: object) -> object:
+def _sim(args: argparse.Namespace, progress: Progress) -> Calibration:
     from softarm._core import SoftArm
     from softarm.calibration.sim import build_plant, calibrate_plant
     from softarm.sim.arm import PlantConfig
@@ -88,7 +95,7 @@ def _sim(args: argparse.Namespace, progress: object) -> object:
     return cal
 
 
-def _hardware(args: argparse.Namespace, progress: object) -> object:
+def _hardware(args: argparse.Namespace, progress: Progress) -> Calibration | None:
     from softarm._core import Section, SoftArm
     from softarm.calibration import calibrate
     from softarm.calibration.collect import collect
@@ -110,7 +117,7 @@ def _hardware(args: argparse.Namespace, progress: object) -> object:
             m.actuator.send,
             m.clock.sleep,
             lambda: m.servo.tracker.track(m.clock.now()),
-            on_pose=progress,  # type: ignore[arg-type]
+            on_pose=progress,
         )
     finally:
         rig.close()  # vents the arm

@@ -188,7 +188,7 @@ class RodArm:
         rod.rest_kappa[:] = 0.0
         self._ne = ne
 
-        class Sim(ea.BaseSystemCollection, ea.Constraints, ea.Forcing, ea.Damping):
+        class Sim(ea.BaseSystemCollection, ea.Constraints, ea.Forcing, ea.Damping):  # type: ignore[misc, name-defined]
             pass
 
         sim = Sim()
