@@ -179,3 +179,21 @@ def test_no_pressure_monitor_is_refused_not_guessed() -> None:
     with pytest.raises(HardwareError, match="pressure readings equal the commands"):
         identify(rig, design=Design(budget_s=30.0))
     assert (rig.bank.last_sent == 0.0).all()  # vented before the estimate
+
+
+def test_interrupted_run_vents() -> None:
+    rig = SimIdentificationRig(seed=2027)
+    calls = [0]
+    advance = rig.advance
+
+    def stop_after_a_while() -> None:
+        calls[0] += 1
+        if calls[0] == 100:
+            raise KeyboardInterrupt
+        advance()
+
+    rig.advance = stop_after_a_while  # type: ignore[method-assign]
+    with pytest.raises(KeyboardInterrupt):
+        run_experiment(rig, Design().segments(), 120.0)
+    assert (rig.bank.last_sent == 0.0).all()
+    assert rig.bank.vent_log[-1].reason == "identification aborted"

@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from softarm.errors import HardwareError, SafetyError
 from softarm.identification.protocol import Segment
 from softarm.identification.rig import IdentificationRig
 
@@ -137,10 +136,7 @@ def run_experiment(
         # Down under the rate limit (no whip), then vent.
         while np.max(rig.bank.last_sent) > 0.0 and rig.now() - t0 < budget_s:
             step(np.zeros(n))
-    except (SafetyError, HardwareError):
-        rig.bank.vent("identification aborted")
-        raise
-    except BaseException:
+    except BaseException:  # device errors, a refused command, SIGINT/SIGTERM alike
         rig.bank.vent("identification aborted")
         raise
     rig.bank.vent("identification done")
