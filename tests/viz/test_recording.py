@@ -176,3 +176,19 @@ def test_the_viewer_loads_the_recording_and_its_layout(harvest_run) -> None:
         [exe, "rrd", "verify", str(rrd)], capture_output=True, text=True, timeout=300
     )
     assert done.returncode == 0, done.stderr[-2000:]
+
+
+@pytest.mark.slow
+def test_replay_draws_the_runs_bush_and_refuses_another(harvest_run, tmp_path, capsys) -> None:
+    log, _ = harvest_run
+    out = tmp_path / "scene.rrd"
+    assert (
+        main(["replay", str(log), "--record", str(out), "--sim-seed", "0", "--berries", "1"]) == 0
+    )
+    rows = read_rrd(out)
+    assert "/world/canes" in rows
+    (bush,) = rows["/world/bush/berries"]
+    assert bush["Points3D:labels"] == ["tag 10"]
+    other = ["replay", str(log), "--record", str(out), "--sim-seed", "3", "--berries", "1"]
+    assert main(other) == 2
+    assert "tag 10 is not a berry of the simulated bush of seed 3" in capsys.readouterr().err

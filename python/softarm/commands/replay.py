@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from softarm.commands._args import config_file, output_file
+from softarm.commands._args import config_file, int_range, non_negative_int, output_file
+from softarm.commands.harvest import MAX_BERRIES
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -25,6 +26,19 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         action="store_true",
         help="also start the rerun viewer (the default without --record)",
     )
+    p.add_argument(
+        "--sim-seed",
+        type=non_negative_int,
+        metavar="SEED",
+        help="draw the simulated bush of `harvest --sim --seed SEED` (canes, true berries); "
+        "checked against the log's berries",
+    )
+    p.add_argument(
+        "--berries",
+        type=int_range(1, MAX_BERRIES),
+        default=5,
+        help="berries of that run's bush (its --berries; with --sim-seed)",
+    )
     p.set_defaults(run=run)
 
 
@@ -32,7 +46,8 @@ def run(args: argparse.Namespace) -> int:
     """Write the recording; returns 0."""
     from softarm.viz.replay import replay
 
-    n = replay(args.log, args.record, spawn=args.view or args.record is None)
+    scene = None if args.sim_seed is None else (args.sim_seed, args.berries)
+    n = replay(args.log, args.record, spawn=args.view or args.record is None, scene=scene)
     where = f"recording: {args.record}" if args.record is not None else "sent to the viewer"
     print(f"{n} records of {args.log}; {where}")
     return 0

@@ -8,13 +8,21 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from softarm.errors import InputError
 from softarm.harvest.log import read_log
 from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import RecordLogger
 from softarm.viz.rerun_sdk import close_recording, open_recording, require_rerun
+from softarm.viz.scene import log_berries, log_canes
 
 __all__ = ["replay"]
+
+
+#: How far (m) a berry the log estimated may lie from the rebuilt bush's berry of the same
+#: tag: a few mm of vision error, far below the spacing of two berries.
+SCENE_MATCH = 0.02
 
 
 def replay(
@@ -23,35 +31,75 @@ def replay(
     spawn: bool = False,
     model: Any | None = None,
     grasp_offset: float = 0.03,
+    scene: tuple[int, int] | None = None,
 ) -> int:
     """Log every record of ``log`` to ``record`` (.rrd), a spawned viewer, or both;
     returns the number of records. ``model``: the arm the run controlled (default the
-    nominal blackberry arm), on which the commanded elongations are drawn.
+    nominal blackberry arm), on which the commanded elongations are drawn. ``scene`` =
+    (seed, berries) of a ``harvest --sim`` run: its bush is rebuilt and drawn (the canes
+    and the true berries at ``world/bush``), after checking that the log's berries are
+    that bush's.
 
     Raises:
-        InputError: a line is not JSON or a record is malformed (the message names the
-            record's number and the field).
+        InputError: a line is not JSON, a record is malformed (the message names the
+            record's number and the field), or the log's berries are not the scene's.
         MissingDependencyError: rerun-sdk (the ``viz`` extra) is not installed.
     """
-    require_rerun()  # before reading a large log
+    rr = require_rerun()  # before reading a large log
+    path = Path(log)
+    records = _read(path)
+    bush = None if scene is None else _bush(path, records, *scene)
     if model is None:
         import softarm
 
         model = softarm.SoftArm.blackberry()
-    path = Path(log)
     stream = open_recording(f"replay {path.name}", record, spawn, harvest_blueprint(False))
-    logger = RecordLogger(stream, require_rerun(), model, grasp_offset, berries_from_results=True)
-    n = 0
     try:
-        for n, rec in enumerate(read_log(path), start=1):
+        if bush is not None:
+            log_canes(stream, rr, bush.branches)
+            log_berries(stream, rr, "world/bush/berries", bush.berries, static=True)
+        logger = RecordLogger(stream, rr, model, grasp_offset, berries_from_results=True)
+        for n, rec in enumerate(records, start=1):
             try:
                 logger.log(rec)
             except InputError as exc:
                 raise type(exc)(f"{path}: record {n}: {exc}") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}: record {n + 1} is not JSON ({exc.msg})") from None
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{path}: not UTF-8 text (byte offset {exc.start})") from None
     finally:
         close_recording(stream)
-    return n
+    return len(records)
+
+
+def _read(path: Path) -> list[Any]:
+    records: list[Any] = []
+    try:
+        for rec in read_log(path):
+            records.append(rec)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}: record {len(records) + 1} is not JSON ({exc.msg})") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not UTF-8 text (byte offset {exc.start})") from None
+    return records
+
+
+def _bush(path: Path, records: list[Any], seed: int, berries: int) -> Any:
+    """The bush of ``harvest --sim --seed seed --berries berries``, checked against the
+    berries the log estimated (a log of another run would draw a wrong scene)."""
+    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+
+    bush = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed)).bush
+    true = {b.tag_id: np.asarray(b.position) for b in bush.berries}
+    for r in records:
+        if not isinstance(r, dict) or r.get("kind") != "berry_result" or r.get("target") is None:
+            continue
+        tag = r.get("tag_id")
+        off = (
+            np.inf
+            if tag not in true
+            else float(np.linalg.norm(np.subtract(r["target"], true[tag])))
+        )
+        if not off <= SCENE_MATCH:
+            raise InputError(
+                f"{path}: berry tag {tag} is not a berry of the simulated bush of seed {seed} "
+                f"with {berries} berries (--sim-seed/--berries must be the run's --seed/--berries)"
+            )
+    return bush

@@ -29,14 +29,12 @@ from softarm.errors import ParameterError
 from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import ArmDrawer, RecordLogger
 from softarm.viz.rerun_sdk import TIMELINE, close_recording, open_recording, require_rerun
+from softarm.viz.scene import log_berries, log_canes
 
 if TYPE_CHECKING:
     from softarm.harvest.sim_rig import SimRig
 
 __all__ = ["SimView", "attach"]
-
-#: Berry colours: ripe, unripe, selected (RGB).
-RIPE, UNRIPE, SELECTED = (200, 30, 60), (90, 170, 60), (255, 0, 255)
 
 
 class SimView:
@@ -74,12 +72,7 @@ class SimView:
 
     def _log_static(self) -> None:
         rr, rig = self.rr, self.rig
-        canes = [b.points(60) for b in rig.bush.branches]
-        self.stream.log(
-            "world/canes",
-            rr.LineStrips3D(canes, colors=[(139, 69, 19)], radii=0.004),
-            static=True,
-        )
+        log_canes(self.stream, rr, rig.bush.branches)
         self.stream.log(
             "world/base", rr.Points3D([[0.0, 0.0, 0.0]], radii=0.01, labels=["base"]), static=True
         )
@@ -161,21 +154,7 @@ class SimView:
         if key == self._berries_key:
             return
         self._berries_key = key
-        rr = self.rr
-        colours = [
-            SELECTED if b.tag_id == selected else RIPE if b.ripeness >= 0.5 else UNRIPE
-            for b in on_bush
-        ]
-        self.stream.log(
-            "world/berries",
-            rr.Points3D(
-                [b.position for b in on_bush] or np.zeros((0, 3)),
-                labels=[f"tag {b.tag_id}" for b in on_bush],
-                colors=colours,
-                radii=0.01,
-                show_labels=True,
-            ),
-        )
+        log_berries(self.stream, self.rr, "world/berries", on_bush, selected)
 
     # --- cameras ----------------------------------------------------------------------
 
