@@ -197,3 +197,10 @@ def test_interrupted_run_vents() -> None:
         run_experiment(rig, Design().segments(), 120.0)
     assert (rig.bank.last_sent == 0.0).all()
     assert rig.bank.vent_log[-1].reason == "identification aborted"
+
+
+def test_cosserat_plant_is_refused_with_the_key() -> None:
+    from softarm.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="plant.model = 'cosserat'"):
+        SimIdentificationRig(PlantConfig(model="cosserat"))

@@ -120,6 +120,13 @@ class SimIdentificationRig:
     ) -> None:
         self.model = model if model is not None else SoftArm.blackberry()
         self.plant = plant if plant is not None else PlantConfig()
+        if self.plant.model != "pcc":
+            # The estimator's pose model is the constant-curvature one (eq. 3): a rod
+            # sagging under gravity is not, and a 2-minute rod run costs many minutes.
+            raise ParameterError(
+                f"plant.model = {self.plant.model!r}: identify --sim runs on the 'pcc' "
+                "plant only (use softarm calibrate for the Cosserat plant's geometry)"
+            )
         self.arm = SimulatedArm(self.model, self.plant, seed=sim_plant_seed(seed))
         if not (np.isfinite(reading_noise_psi) and reading_noise_psi >= 0.0):
             raise ParameterError(f"reading_noise_psi = {reading_noise_psi}: must be >= 0")
