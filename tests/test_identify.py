@@ -202,5 +202,5 @@ def test_interrupted_run_vents() -> None:
 def test_cosserat_plant_is_refused_with_the_key() -> None:
     from softarm.errors import ParameterError
 
-    with pytest.raises(ParameterError, match="plant.model = 'cosserat'"):
+    with pytest.raises(ParameterError, match=r"plant\.model = 'cosserat'"):
         SimIdentificationRig(PlantConfig(model="cosserat"))
