@@ -124,7 +124,7 @@ class SyntheticCamera:
         self._corners = model.normalize(grid.reshape(-1, 2)).reshape(grid.shape).astype(np.float32)
         s = self.supersample
         self._offsets = ((np.arange(s) + 0.5) / s).astype(np.float32)  # sub-sample centres
-        self._ray_table: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]] | None = None
+        self._ray_table: npt.NDArray[np.float32] | None = None
         self._patches: OrderedDict[tuple[object, ...], Any] = OrderedDict()
         self._planes: dict[tuple[object, ...], tuple[TexturedPlane, Box | None]] = {}
         self._vignette_cache: tuple[float, npt.NDArray[np.float32]] | None = None
@@ -276,31 +276,28 @@ class SyntheticCamera:
         pose = item.T_camera_plane
         rot, t = pose[:3, :3], pose[:3, 3]
         x0, y0, x1, y1 = layer.box
-        x, y = self._rays(layer.box)
+        rays = self._rays(layer.box)
         # Ray-plane intersection as a homography: (u, v, 1) ∝ [r1 r2 t]⁻¹ (x, y, 1).
         hinv = np.linalg.inv(np.column_stack([rot[:, 0], rot[:, 1], t]))
         tex = item.texture
         th, tw = tex.shape
-        # Fold the metric-to-texel map (texel centres at integer map coordinates, the
-        # cv2.remap convention) into the homography: one projective map, float32.
+        # Fold the metric-to-texel map into the homography: one projective map. Texel
+        # centres are at integer map coordinates (the cv2.remap convention), shifted by the
+        # one transparent texel padded around each texture (see _premultiplied).
         to_tex = np.array(
             [
-                [tw / item.width, 0.0, 0.5 * tw - 0.5],
-                [0.0, -th / item.height, 0.5 * th - 0.5],
+                [tw / item.width, 0.0, 0.5 * tw + 0.5],
+                [0.0, -th / item.height, 0.5 * th + 0.5],
                 [0, 0, 1],
             ]
         )
-        hom = (to_tex @ hinv).astype(np.float32)
-        den = hom[2, 0] * x + hom[2, 1] * y + hom[2, 2]
-        behind = den <= 1e-12  # rays that miss the plane (it lies behind the camera)
-        den[behind] = 1.0
-        np.reciprocal(den, out=den)
-        mx = (hom[0, 0] * x + hom[0, 1] * y + hom[0, 2]) * den
-        my = (hom[1, 0] * x + hom[1, 1] * y + hom[1, 2]) * den
-        mx[behind] = -10.0
+        # One pass in C++ (double precision inside). A ray that misses the plane (w <= 0)
+        # maps outside the texture, since the whole plane lies in front of the camera
+        # (_bbox); perspectiveTransform sends w ≈ 0 to (0, 0), the transparent pad texel.
+        maps = cv2.perspectiveTransform(rays, to_tex @ hinv)
         # Fixed-point maps: the same 1/32-texel rounding that remap applies to float maps
-        # block by block, done in one pass (a quarter less time, the same pixels).
-        fixed, frac = cv2.convertMaps(mx, my, cv2.CV_16SC2)
+        # block by block, done in one pass.
+        fixed, frac = cv2.convertMaps(maps, None, cv2.CV_16SC2)
         shade = self._shade(layer.normal)
         light = self.lighting
         ink = shade * light.black
@@ -321,21 +318,16 @@ class SyntheticCamera:
         color = ink * alpha + paper * refl
         return alpha, color
 
-    def _rays(self, box: Box) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-        """Normalised (x, y) of the sub-samples of ``box``, rows of sub-samples first."""
+    def _rays(self, box: Box) -> npt.NDArray[np.float32]:
+        """Normalised (x, y) of the sub-samples of ``box`` (rows of sub-samples, columns,
+        2), a view of the whole frame's table where it is kept."""
         x0, y0, x1, y1 = box
         s = self.supersample
         if self._ray_table is None and 8 * self.width * self.height * s * s <= MAX_RAY_TABLE_BYTES:
-            rays = self._interpolate((0, 0, self.width, self.height))
-            self._ray_table = (
-                np.ascontiguousarray(rays[..., 0]),
-                np.ascontiguousarray(rays[..., 1]),
-            )
+            self._ray_table = self._interpolate((0, 0, self.width, self.height))
         if self._ray_table is not None:
-            tx, ty = self._ray_table
-            return tx[y0 * s : y1 * s, x0 * s : x1 * s], ty[y0 * s : y1 * s, x0 * s : x1 * s]
-        rays = self._interpolate(box)
-        return rays[..., 0], rays[..., 1]
+            return self._ray_table[y0 * s : y1 * s, x0 * s : x1 * s]
+        return self._interpolate(box)
 
     def _interpolate(self, box: Box) -> npt.NDArray[np.float32]:
         """Sub-sample rays of ``box`` by bilinear interpolation of the corner table
@@ -448,12 +440,14 @@ _AFFINE_CACHE: dict[
 
 
 def _affine(tex: npt.NDArray[np.float32], offset: float, gain: float) -> npt.NDArray[np.float32]:
-    """``offset + gain * tex`` (float32), kept for the next frame of the same marker."""
+    """``offset + gain * tex`` (float32) in a one-texel frame of zeros (no change), kept
+    for the next frame of the same marker."""
     key = (id(tex), offset, gain)
     hit = _AFFINE_CACHE.get(key)
     if hit is not None and hit[0] is tex:
         return hit[1]
-    out = (np.float32(offset) + np.float32(gain) * tex).astype(np.float32)
+    out = np.zeros((tex.shape[0] + 2, tex.shape[1] + 2), np.float32)
+    out[1:-1, 1:-1] = np.float32(offset) + np.float32(gain) * tex
     if len(_AFFINE_CACHE) > 64:
         _AFFINE_CACHE.clear()
     _AFFINE_CACHE[key] = (tex, out)
@@ -464,14 +458,15 @@ _PREMULT_CACHE: dict[int, tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]
 
 
 def _premultiplied(tex: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
-    """Two-channel (reflectance, alpha=1) texture; outside it cv2.remap returns (0, 0)."""
+    """Two-channel (reflectance, alpha=1) texture in a one-texel frame of (0, 0), the
+    value cv2.remap also returns outside it."""
     key = id(tex)
     hit = _PREMULT_CACHE.get(key)
     if hit is not None and hit[0] is tex:
         return hit[1]
-    out = np.empty((*tex.shape, 2), np.float32)
-    out[..., 0] = tex
-    out[..., 1] = 1.0
+    out = np.zeros((tex.shape[0] + 2, tex.shape[1] + 2, 2), np.float32)
+    out[1:-1, 1:-1, 0] = tex
+    out[1:-1, 1:-1, 1] = 1.0
     if len(_PREMULT_CACHE) > 64:
         _PREMULT_CACHE.clear()
     _PREMULT_CACHE[key] = (tex, out)
