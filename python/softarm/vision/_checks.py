@@ -59,27 +59,25 @@ def as_array(value: Any, shape: tuple[int | None, ...], name: str) -> FloatArray
     return arr
 
 
+_EYE3 = np.eye(3)
+
+
 def as_pose(value: Any, name: str, tol: float = 1e-6) -> FloatArray:
     """Check a 4x4 homogeneous pose: finite, last row [0, 0, 0, 1], rotation in SO(3)."""
     try:
         arr = as_array(value, (4, 4), name)
     except (ShapeError, NonFiniteError) as exc:
         raise PoseError(str(exc)) from exc
-    # The tests of np.allclose(a, b, atol=tol) (|a - b| <= tol + 1e-5 |b|) on plain floats:
-    # poses are checked wherever one is built, and numpy's general path costs ~100 µs here.
+    # The tests of np.allclose(a, b, atol=tol), |a - b| <= tol + 1e-5 |b|, written out:
+    # poses are checked wherever one is built, and allclose's general path costs ~100 µs.
     m = arr.tolist()
     last = zip(m[3], (0.0, 0.0, 0.0, 1.0), strict=True)
     if not all(abs(v - e) <= tol + 1e-5 * e for v, e in last):
         raise PoseError(f"{name} last row must be [0, 0, 0, 1], got {m[3]}")
-    cols = [(m[0][j], m[1][j], m[2][j]) for j in range(3)]
-    for i in range(3):
-        for j in range(i, 3):
-            dot = sum(a * b for a, b in zip(cols[i], cols[j], strict=True))
-            expect = 1.0 if i == j else 0.0
-            if not abs(dot - expect) <= tol + 1e-5 * expect:
-                raise PoseError(f"{name} rotation block is not orthonormal with determinant +1")
+    rot = arr[:3, :3]
     (a, b, c), (d, e, f), (g, h, k) = m[0][:3], m[1][:3], m[2][:3]
-    if a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g) < 0.0:
+    det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g)
+    if not np.all(np.abs(rot.T @ rot - _EYE3) <= tol + 1e-5 * _EYE3) or det < 0.0:
         raise PoseError(f"{name} rotation block is not orthonormal with determinant +1")
     return np.ascontiguousarray(arr)
 

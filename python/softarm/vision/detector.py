@@ -129,7 +129,7 @@ class MarkerDetector:
         self._cells = int(get_dictionary(dictionary).markerSize) + 2
         self._parameters = default_parameters() if parameters is None else parameters
         self._detector = cv2.aruco.ArucoDetector(get_dictionary(dictionary), self._parameters)
-        self._crop_detectors: dict[tuple[int, int], Any] = {}
+        self._crop: tuple[Any, Any] | None = None  # parameters and detector for crops
 
     def detect(
         self, image: npt.NDArray[Any] | None, camera: CameraModel | None = None
@@ -180,27 +180,25 @@ class MarkerDetector:
         return partial(refine_marker_corners, patch, corners, camera, self._cells, at)
 
     def _crop_detector(self, full_size: tuple[int, int], shape: tuple[int, ...]) -> Any:
-        """A detector for crops of shape ``shape`` from a ``full_size`` frame: OpenCV's
+        """The detector for a crop of shape ``shape`` from a ``full_size`` frame: OpenCV's
         perimeter limits in pixels are ``int(rate * max(cols, rows))`` (aruco_detector.cpp),
         so the rates are rescaled to give the full frame's integer limits."""
+        if self._crop is None:
+            base = self._parameters
+            params = cv2.aruco.DetectorParameters()
+            for name in dir(base):
+                if not name.startswith("_") and not callable(getattr(base, name)):
+                    setattr(params, name, getattr(base, name))
+            detector = cv2.aruco.ArucoDetector(get_dictionary(self.dictionary), params)
+            self._crop = (params, detector)
+        params, detector = self._crop
         side, crop_side = max(full_size), max(shape[:2])
-        key = (side, crop_side)
-        hit = self._crop_detectors.get(key)
-        if hit is not None:
-            return hit
         base = self._parameters
-        params = cv2.aruco.DetectorParameters()
-        for name in dir(base):
-            if not name.startswith("_") and not callable(getattr(base, name)):
-                setattr(params, name, getattr(base, name))
         # +0.5 keeps int() on the full frame's integer after the float round trip.
         params.minMarkerPerimeterRate = (int(base.minMarkerPerimeterRate * side) + 0.5) / crop_side
         params.maxMarkerPerimeterRate = (int(base.maxMarkerPerimeterRate * side) + 0.5) / crop_side
-        if len(self._crop_detectors) > 64:
-            self._crop_detectors.clear()
-        hit = cv2.aruco.ArucoDetector(get_dictionary(self.dictionary), params)
-        self._crop_detectors[key] = hit
-        return hit
+        detector.setDetectorParameters(params)
+        return detector
 
 
 def square_marker_poses(
