@@ -62,7 +62,6 @@ def refine_marker_corners(
     fraction = margin + (1.0 - 2.0 * margin) * index / (counts[side] - 1)
     centre_px = quad[side] + fraction[:, None] * sides[side]  # (N, 2) points on the sides
     normal = normals[side]
-    pts64 = centre_px[:, None, :] + offsets[None, :, None] * normal[:, None, :]  # (N, m, 2)
     # Every sample lies within ``reach`` of the quad's sides.
     lo = np.floor(quad.min(axis=0) - reach - 1).astype(int)
     hi = np.ceil(quad.max(axis=0) + reach + 1).astype(int)
@@ -70,8 +69,10 @@ def refine_marker_corners(
         return quad
     # Work on a float copy of the marker's neighbourhood only (a full-frame copy costs ~1 ms).
     crop = gray[lo[1] - oy : hi[1] + 1 - oy, lo[0] - ox : hi[0] + 1 - ox].astype(np.float32)
-    pts = (pts64 - lo).astype(np.float32)
-    prof = cv2.remap(crop, pts[..., 0], pts[..., 1], cv2.INTER_LINEAR)  # (N, m)
+    # Profile sample positions (N, m, 2) in the neighbourhood's pixels.
+    across = offsets[None, :, None] * normal[:, None, :]
+    pts = ((centre_px - lo)[:, None, :] + across).astype(np.float32)
+    prof = cv2.remap(crop, pts, None, cv2.INTER_LINEAR)  # (N, m)
     # Signed gradient: for a box-filtered step sampled bilinearly its centroid is exactly the
     # step position (a squared or absolute gradient is biased by the sub-pixel phase or by
     # noise), and pixel noise adds zero-mean terms only.
