@@ -192,3 +192,27 @@ def test_replay_draws_the_runs_bush_and_refuses_another(harvest_run, tmp_path, c
     other = ["replay", str(log), "--record", str(out), "--sim-seed", "3", "--berries", "1"]
     assert main(other) == 2
     assert "tag 10 is not a berry of the simulated bush of seed 3" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_viewer_closed_before_the_end_does_not_fail_the_run(tmp_path, caplog) -> None:
+    """The recording streams to a viewer that is gone (nothing listens on its port) and
+    to a file: closing warns, and the file is complete."""
+    import socket
+
+    import rerun as rr
+
+    from softarm.viz.rerun_sdk import close_recording
+
+    with socket.socket() as s:  # a free port: no viewer there
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    stream = rr.RecordingStream("softarm", recording_id="gone")
+    out = tmp_path / "both.rrd"
+    stream.set_sinks(rr.GrpcSink(f"rerun+http://127.0.0.1:{port}/proxy"), rr.FileSink(str(out)))
+    for i in range(3):
+        stream.set_time("sim_time", duration=0.1 * i)
+        stream.log("errors/x", rr.Scalars(float(i)))
+    close_recording(stream, viewer=True)
+    assert "viewer went away" in caplog.text
+    assert [v for _, v in column(read_rrd(out), "/errors/x", SCALARS)] == [[0.0], [1.0], [2.0]]

@@ -65,7 +65,7 @@ def replay(
             except InputError as exc:
                 raise type(exc)(f"{path}: record {n}: {exc}") from None
     finally:
-        close_recording(stream)
+        close_recording(stream, viewer=spawn)
     return len(records)
 
 

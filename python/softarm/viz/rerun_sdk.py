@@ -4,6 +4,7 @@ asked for, with a one-line error that says how to install it."""
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 import shutil
 import sys
@@ -25,6 +26,9 @@ INSTALL = "pip install 'softarm[viz]' (or pip install rerun-sdk)"
 
 #: Name of the recordings' application in the viewer.
 APPLICATION = "softarm"
+
+#: The longest wait (s) for a viewer to take the last data when the run ends.
+VIEWER_FLUSH_S = 10.0
 
 #: The one timeline every entity is logged on: the harvest's own (simulated) clock.
 TIMELINE = "sim_time"
@@ -79,11 +83,29 @@ def open_recording(
     return stream
 
 
-def close_recording(stream: Any) -> None:
+def close_recording(stream: Any, viewer: bool = False) -> None:
     """Flush ``stream`` and close its sinks: an ``.rrd`` file gets its footer (the index
-    readers use) and is complete."""
-    stream.flush()
+    readers use) and is complete.
+
+    With a ``viewer`` (spawned), a viewer closed by the user before the end makes the
+    flush fail: that is logged as a warning and the rest (a file beside it) still
+    closes, since a run must not fail for a closed window; the wait is bounded so that
+    an unresponsive viewer cannot hang the command.
+    """
+    try:
+        stream.flush(timeout_sec=VIEWER_FLUSH_S if viewer else 1e38)
+    except RuntimeError as exc:
+        if not viewer:
+            raise SoftarmError(
+                f"the recording could not be completed: {_first_line(exc)}"
+            ) from None
+        logging.getLogger(__name__).warning("the rerun viewer went away: %s", _first_line(exc))
     stream.disconnect()
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else repr(exc)
 
 
 def _spawn_viewer(rr: Any, stream: Any) -> None:
@@ -109,5 +131,4 @@ def _spawn_viewer(rr: Any, stream: Any) -> None:
     try:
         rr.spawn(connect=False, executable_path=exe, recording=stream)
     except (RuntimeError, OSError) as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc)
-        raise ViewerUnavailableError(f"cannot start the rerun viewer: {first}") from None
+        raise ViewerUnavailableError(f"cannot start the rerun viewer: {_first_line(exc)}") from None

@@ -56,6 +56,8 @@ class SimView:
         self.rr = rr = require_rerun()
         self.rig, self.stream = rig, stream
         self.image_every, self.jpeg_quality = int(image_every), int(jpeg_quality)
+        #: Streams to a spawned viewer (which the user may close before the end).
+        self.viewer = False
         offset = rig.machine.config.grasp_offset
         self.records = RecordLogger(stream, rr, rig.model, offset)
         self._drained = 0
@@ -139,7 +141,7 @@ class SimView:
         """The last records, then close the recording: the file gets its footer and is
         complete (a spawned viewer keeps what it got)."""
         self.drain()
-        close_recording(self.stream)
+        close_recording(self.stream, viewer=self.viewer)
 
     def _selected(self) -> Any:
         tag = self.rig.vision.selected.tag_id
@@ -211,4 +213,6 @@ def attach(
     both; call its ``close()`` after the run."""
     name = name or f"harvest seed {rig.bush.seed}"
     stream = open_recording(name, record, spawn, harvest_blueprint(cameras=True))
-    return SimView(rig, stream, image_every).attach()
+    view = SimView(rig, stream, image_every)
+    view.viewer = spawn
+    return view.attach()
