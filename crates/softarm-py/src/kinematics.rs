@@ -3,7 +3,7 @@
 
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyType;
+use pyo3::types::{PyList, PyTuple, PyType};
 use softarm_core::chain::{forward_jacobian_into, forward_unchecked, SectionModel};
 use softarm_core::{self as core, Kinematics};
 
@@ -11,11 +11,36 @@ use crate::convert::{
     array, count, dmatrix_out, mat4_out, matrix3x_out, points_out, real, vec3_out, vector,
     write_dmatrix, write_frame, write_mat4,
 };
-use crate::errors::IntoPyResult;
+use crate::errors::{InputError, IntoPyResult};
 
 /// Converts a Python section index, rejecting negative and too large values by name.
 fn section_index<M: SectionModel>(model: &M, section: &Bound<'_, PyAny>) -> PyResult<usize> {
     count(section, "section", 0, model.n_sections().saturating_sub(1))
+}
+
+/// The `sections` argument: a list or tuple of `Section`, anything else named.
+fn sections_arg(obj: &Bound<'_, PyAny>) -> PyResult<Vec<core::Section>> {
+    let items = if let Ok(l) = obj.cast::<PyList>() {
+        l.iter().collect::<Vec<_>>()
+    } else if let Ok(t) = obj.cast::<PyTuple>() {
+        t.iter().collect()
+    } else {
+        return Err(InputError::new_err(format!(
+            "sections: expected a list of Section, got {}",
+            obj.get_type().name()?
+        )));
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(k, item)| match item.cast::<Section>() {
+            Ok(s) => Ok(s.get().inner),
+            Err(_) => Err(InputError::new_err(format!(
+                "sections[{k}]: expected a Section, got {}",
+                item.get_type().name()?
+            ))),
+        })
+        .collect()
 }
 
 /// An (N, n) batch of configurations, checked and copied. The copy is taken while the GIL
@@ -265,8 +290,8 @@ pub struct SoftArm {
 
 kinematic_methods!(SoftArm, {
     #[new]
-    fn new(sections: Vec<PyRef<'_, Section>>) -> PyResult<Self> {
-        let secs = sections.iter().map(|s| s.inner).collect();
+    fn new(sections: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let secs = sections_arg(sections)?;
         Ok(SoftArm {
             inner: core::SoftArm::new(secs).py()?,
         })

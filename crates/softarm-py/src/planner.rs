@@ -305,9 +305,17 @@ fn path_clearance(
 #[pyfunction]
 fn paper_scenario<'py>(
     py: Python<'py>,
-    name: &str,
+    name: &Bound<'py, PyAny>,
 ) -> PyResult<(Bound<'py, numpy::PyArray1<f64>>, Vec<PolynomialCurve>)> {
-    let sc = scenarios::scenario(name).py()?;
+    let name = name.cast::<pyo3::types::PyString>().map_err(|_| {
+        InputError::new_err(format!(
+            "name: expected a str, got {}",
+            name.get_type()
+                .name()
+                .map_or_else(|_| "?".to_owned(), |n| n.to_string())
+        ))
+    })?;
+    let sc = scenarios::scenario(name.to_str()?).py()?;
     let curves = sc
         .curves
         .iter()

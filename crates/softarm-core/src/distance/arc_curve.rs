@@ -315,7 +315,9 @@ impl Query {
             if b.u - a.u <= tol {
                 break;
             }
-            let mut u = (a.u * gb - b.u * ga) / (gb - ga);
+            // The secant root as a fraction of the bracket: no product of u and g, which
+            // could overflow for long parameter ranges.
+            let mut u = a.u + (b.u - a.u) * (ga / (ga - gb));
             if !(u > a.u && u < b.u) {
                 u = 0.5 * (a.u + b.u);
             }
@@ -434,10 +436,13 @@ impl Query {
     /// A branch that is flat at both ends at the level of the best distance (a curve
     /// parallel to the arc or its circle): the distance there is already the best.
     fn flat(a: &Sample, b: &Sample, k: usize) -> bool {
+        // g = (F_o − p)·F_o' is in m² per unit of u: it is compared with the speed (m per
+        // unit of u) times a length, so that the test reads the same for any scale of u
+        // (with an absolute 1e-12, every g of a curve parametrised over 1e50 passed).
         let tol = 1e-12 * (1.0 + a.d[k]);
         (a.d[k] - b.d[k]).abs() <= tol
-            && a.g[k].abs() <= tol * (1.0 + a.speed)
-            && b.g[k].abs() <= tol * (1.0 + b.speed)
+            && a.g[k].abs() <= tol * a.speed
+            && b.g[k].abs() <= tol * b.speed
     }
 
     /// Lower bound of branch `k` on a bracket where it is convex: `d_k²` lies above its
@@ -448,9 +453,11 @@ impl Query {
         if ga >= gb {
             return 0.0;
         }
-        let u = (db - da + 2.0 * ga * a.u - 2.0 * gb * b.u) / (2.0 * (ga - gb));
-        let u = u.clamp(a.u, b.u);
-        (da + 2.0 * ga * (u - a.u)).max(0.0).sqrt()
+        // The tangents meet at a + x; measured from a, so that no product of u (which may be
+        // large, e.g. 1e96) and a slope cancels.
+        let w = b.u - a.u;
+        let x = ((db - da - 2.0 * gb * w) / (2.0 * (ga - gb))).clamp(0.0, w);
+        (da + 2.0 * ga * x).max(0.0).sqrt()
     }
 
     /// Bound `M ≥ |g_k'|` on [a, b] (`None` near the circle's axis):
@@ -633,9 +640,26 @@ pub fn closest_arc_curve(arc: &PlacedArc, curve: &PolynomialCurve) -> ArcCurveHi
     })
 }
 
+/// Curve extent, in arc lengths, above which a grid interval near the arc is split before
+/// the search. The search's certificates hold when the curve does not turn on the scale of
+/// one grid interval *relative to the arc*: a grid interval holding kilometres of curve
+/// can pass a 1 m arc's circle twice (two minima of one branch, only one of which a
+/// bracket finds). Pieces no longer than this are in the regime the search is tested in.
+const LONG_PIECE: f64 = 8.0;
+
+/// Most bounding spheres computed while splitting one long curve: enough to go from 1e100 m
+/// down to a millimetre arc (about 340 halvings) along a few approaches.
+const SPLIT_BUDGET: usize = 8192;
+
 /// [`closest_arc_curve`] when closer than `cutoff`, else `None` (exact either way). A
 /// bounding-sphere test (the arc lies within `L/2` of its middle point) skips far pairs
 /// without sampling, and every bound prunes against `cutoff` from the start.
+///
+/// A curve whose grid intervals near the arc are long compared with the arc (their
+/// bounding spheres wider than 8 arc lengths) is first split: those intervals are halved,
+/// keeping only halves whose sphere can come closer than the best distance so far, until
+/// each piece is at most 8 arc lengths across; each piece is then searched as a curve of
+/// its own (same polynomial, its own grid), nearest first.
 pub fn closest_arc_curve_within(
     arc: &PlacedArc,
     curve: &PolynomialCurve,
@@ -643,10 +667,75 @@ pub fn closest_arc_curve_within(
 ) -> Option<ArcCurveHit> {
     let (centre, radius) = curve.bounding_sphere();
     let middle = arc.point(0.5);
-    let gap = (middle - centre).norm() - radius - 0.5 * arc.arc.params.length;
+    let half = 0.5 * arc.arc.params.length;
+    let gap = (middle - centre).norm() - radius - half;
     if gap >= cutoff {
         return None;
     }
+    let long = LONG_PIECE * arc.arc.params.length;
+    let needs_split = curve
+        .interval_spheres()
+        .iter()
+        .any(|(c, r)| *r > long && (middle - c).norm() - r - half < cutoff);
+    if needs_split {
+        closest_in_pieces(arc, curve, cutoff)
+    } else {
+        search_curve(arc, curve, cutoff)
+    }
+}
+
+/// The split search of [`closest_arc_curve_within`] for curves long compared with the arc.
+fn closest_in_pieces(arc: &PlacedArc, curve: &PolynomialCurve, cutoff: f64) -> Option<ArcCurveHit> {
+    let middle = arc.point(0.5);
+    let half = 0.5 * arc.arc.params.length;
+    let long = LONG_PIECE * arc.arc.params.length;
+    let lower = |(c, r): (Vec3, f64)| ((middle - c).norm() - r - half).max(0.0);
+    // An upper bound of the distance from actual curve points (piece midpoints): pieces
+    // whose lower bound exceeds it cannot hold the minimum.
+    let mut upper = cutoff;
+    let mut leaves: Vec<(f64, f64, f64)> = Vec::new();
+    let grid = curve.grid();
+    let mut stack: Vec<(f64, f64, (Vec3, f64))> = grid
+        .windows(2)
+        .zip(curve.interval_spheres())
+        .map(|(w, s)| (w[0], w[1], *s))
+        .collect();
+    let mut spent = 0usize;
+    while let Some((a, b, sphere)) = stack.pop() {
+        let lo = lower(sphere);
+        if lo > upper {
+            continue;
+        }
+        let m = 0.5 * (a + b);
+        upper = upper.min(arc.closest_to_point(&curve.eval(m)).2);
+        if sphere.1 <= long || spent >= SPLIT_BUDGET || !(m > a && m < b) {
+            leaves.push((lo, a, b));
+            continue;
+        }
+        spent += 2;
+        stack.push((a, m, curve.sphere_over(a, m)));
+        stack.push((m, b, curve.sphere_over(m, b)));
+    }
+    leaves.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut best: Option<ArcCurveHit> = None;
+    let mut limit = cutoff;
+    let mut evaluations = 0;
+    for &(lo, a, b) in &leaves {
+        if lo > upper || lo >= limit {
+            continue;
+        }
+        if let Some(h) = search_curve(arc, &curve.piece(a, b), limit) {
+            evaluations += h.evaluations;
+            limit = h.distance;
+            best = Some(h);
+        }
+    }
+    best.map(|h| ArcCurveHit { evaluations, ..h })
+}
+
+/// The search of one curve (the module docs), without splitting.
+fn search_curve(arc: &PlacedArc, curve: &PolynomialCurve, cutoff: f64) -> Option<ArcCurveHit> {
+    let middle = arc.point(0.5);
     let local = &arc.arc;
     let theta = local.theta();
     let params = local.params;

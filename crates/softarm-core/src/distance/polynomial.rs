@@ -99,6 +99,14 @@ impl PolynomialCurve {
         while coeffs.len() > 1 && coeffs.last().is_some_and(|c| *c == Vec3::zeros()) {
             coeffs.pop();
         }
+        let curve = Self::build(coeffs, u_min, u_max);
+        check_evaluation(&curve.speed, &curve.accel, &curve.spheres, curve.sphere)?;
+        Ok(curve)
+    }
+
+    /// The grid, bounds and spheres of `coeffs` (trailing zeros dropped) over
+    /// `[u_min, u_max]`, unchecked.
+    fn build(coeffs: Vec<Vec3>, u_min: f64, u_max: f64) -> Self {
         let degree = coeffs.len() - 1;
         let n = (8 + 4 * degree).min(MAX_INTERVALS);
         let grid: Vec<f64> = (0..=n)
@@ -135,8 +143,7 @@ impl PolynomialCurve {
             .map(|w| bounding_sphere(&coeffs, w[0], w[1]))
             .collect();
         let sphere = bounding_sphere(&coeffs, u_min, u_max);
-        check_evaluation(&speed, &accel, &spheres, sphere)?;
-        Ok(PolynomialCurve {
+        PolynomialCurve {
             coeffs,
             u_min,
             u_max,
@@ -145,7 +152,19 @@ impl PolynomialCurve {
             accel,
             spheres,
             sphere,
-        })
+        }
+    }
+
+    /// The same polynomial restricted to `[a, b]` (inside the range, `a < b`), with its own
+    /// grid: the closest-point search splits long curves into such pieces. Its bounds are
+    /// over a sub-interval of a checked curve, so they need no new check.
+    pub(crate) fn piece(&self, a: f64, b: f64) -> Self {
+        Self::build(self.coeffs.clone(), a, b)
+    }
+
+    /// A sphere (centre, radius) holding the curve over `[a, b]`.
+    pub(crate) fn sphere_over(&self, a: f64, b: f64) -> (Vec3, f64) {
+        bounding_sphere(&self.coeffs, a, b)
     }
 
     /// A curve from a (3, d + 1) row-major array: row 0 holds x(u)'s coefficients.
@@ -317,11 +336,24 @@ fn taylor(p: &[Vec3], m: f64, h: f64) -> Vec<Vec3> {
     e
 }
 
-/// A sphere holding `P([a, b])`: centre `P(m)`, radius `Σ_{j≥1} |e_j|`.
+/// A bound of the rounding error of [`taylor`] summed over all its coefficients: the same
+/// shift of the absolute values (no cancellation) at `|m|`, times `4 n ε` (each coefficient
+/// is a sum of at most `n` products, each rounded). Relative to the sizes involved, so that
+/// it holds for curves far from the origin and for any scale of `u` (an absolute guard of
+/// ε would swamp the speed bound of a curve parametrised over 1e96).
+fn taylor_rounding(p: &[Vec3], m: f64, h: f64) -> f64 {
+    let abs: Vec<Vec3> = p.iter().map(|c| c.abs()).collect();
+    let total: f64 = taylor(&abs, m.abs(), h.abs()).iter().map(|c| c.sum()).sum();
+    4.0 * (p.len() as f64 + 1.0) * f64::EPSILON * total
+}
+
+/// A sphere holding `P([a, b])`: centre `P(m)`, radius `Σ_{j≥1} |e_j|` (plus the rounding
+/// of the shift).
 fn bounding_sphere(p: &[Vec3], a: f64, b: f64) -> (Vec3, f64) {
-    let e = taylor(p, 0.5 * (a + b), 0.5 * (b - a));
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    let e = taylor(p, m, h);
     let r: f64 = e.iter().skip(1).map(|c| c.norm()).sum();
-    (e[0], r * (1.0 + 1e-12) + f64::EPSILON)
+    (e[0], r + taylor_rounding(p, m, h) + f64::MIN_POSITIVE)
 }
 
 /// An upper bound of `|P(u)|` for `u ∈ [a, b]`, `P` given by ascending vector
@@ -330,12 +362,10 @@ fn speed_bound(p: &[Vec3], a: f64, b: f64) -> f64 {
     if p.is_empty() {
         return 0.0;
     }
-    let bound: f64 = taylor(p, 0.5 * (a + b), 0.5 * (b - a))
-        .iter()
-        .map(|c| c.norm())
-        .sum();
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    let bound: f64 = taylor(p, m, h).iter().map(|c| c.norm()).sum();
     // Guard against rounding in the shift.
-    bound * (1.0 + 1e-12) + f64::EPSILON
+    bound + taylor_rounding(p, m, h)
 }
 
 /// A line segment from `a` to `b`: the degree-1 curve `a + u (b − a)`, `u ∈ [0, 1]`.
