@@ -150,3 +150,18 @@ def test_opencv_baselines_with_corner_refinement(
 def test_baseline_refinement_is_checked(cube: MarkerCube) -> None:
     with pytest.raises(ParameterError, match="refinement"):
         OpenCVBaseline(cube, "contour-ish")
+
+
+def test_window_around_chosen_markers_still_shows_the_others(camera: CameraModel) -> None:
+    cam = SyntheticCamera(camera, 1280, 720, supersample=2)
+    far = SceneMarker(1, "DICT_4X4_50", 0.08, facing_pose(0.8, -0.3, 0.0))
+    near = SceneMarker(2, "DICT_4X4_50", 0.08, facing_pose(0.8, 0.25, 0.0))
+    mine = SceneMarker(3, "DICT_4X4_50", 0.08, facing_pose(0.8, 0.15, 0.0))
+    items = [far, near, mine]
+    crop = cam.render_crop(items, around=lambda item: item is mine)
+    assert crop.shape[1] < 300  # the window holds marker 3, not marker 1 far away
+    (x0, y0), (h, w) = crop.origin, crop.shape
+    # Marker 2 reaches into the window and is drawn there as in the whole frame.
+    np.testing.assert_array_equal(cam.render(items)[y0 : y0 + h, x0 : x0 + w], crop)
+    assert np.any(np.asarray(crop)[:, -5:] != 128)
+    assert [d.marker_id for d in MarkerDetector().detect(crop)] == [3]

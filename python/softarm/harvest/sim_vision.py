@@ -46,8 +46,9 @@ class SimCameras:
 
     ``scale`` multiplies both image sizes and focal lengths (0.5 = a quarter of the pixels).
     ``crop`` (default) renders and searches only the window of each frame that holds the
-    markers (:meth:`~softarm.sim.SyntheticCamera.render_crop`: the same pixels there, the
-    same detections, a fraction of the time); False renders whole frames.
+    markers looked for (:meth:`~softarm.sim.SyntheticCamera.render_crop`: the same pixels
+    there, the same detections, a fraction of the time; in C1 the cube and berry tags while
+    tracking, the base tag while registering); False renders whole frames.
     """
 
     T_base_c1: FloatArray
@@ -119,8 +120,14 @@ def sim_vision(
         items = [base_tag]
         T_c1_cube = T_c1_base @ true_pose() @ cams.T_ee_cube
         items += cube_scene_markers(cube.markers, cube.marker_length, DICT, T_c1_cube)
-        if with_berries and not hide(t):
+        if not with_berries:  # registration: the base tag is what is looked for
+            return render1(items)
+        if not hide(t):
             items += tags(T_c1_base, still)
+        if cams.crop:
+            # Tracking looks for the cube and the berries: the window holds those (the
+            # base tag, which only registers C1, is drawn if it reaches into it).
+            return c1.render_crop(items, around=lambda item: item is not base_tag)
         return render1(items)
 
     def frame2(t: float) -> np.ndarray:

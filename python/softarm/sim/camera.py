@@ -25,7 +25,7 @@ Speed (the simulated harvest renders two images per control period):
 from __future__ import annotations
 
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, overload
 
@@ -141,6 +141,7 @@ class SyntheticCamera:
         scene: Scene | Sequence[SceneItem],
         background: float | None = None,
         margin: int = 16,
+        around: Callable[[SceneItem], bool] | None = None,
     ) -> ImageCrop:
         """Render only the window of the frame that holds ``scene``'s visible planes, grown
         by ``margin`` pixels (and by the blur's reach) on each side and clipped to the frame.
@@ -149,13 +150,18 @@ class SyntheticCamera:
         ``blur`` = 0; with blur, up to the frame's own border handling, which the margin
         keeps away from the planes); the noise has the same distribution, drawn for the
         window only. With nothing visible the window is the frame's top-left 16 x 16 pixels.
+
+        ``around`` picks the planes the window is made to hold (a region of interest: the
+        markers a tracker looks for); every plane that reaches into the window is drawn
+        in it all the same, so the window shows the scene as the whole frame would.
         """
         if int(margin) < 0:
             raise ParameterError(f"margin must be >= 0, got {margin!r}")
         scene = _as_scene(scene, background)
         layers = self._layers(scene)
-        if layers:
-            boxes = np.array([layer.box for layer in layers])
+        held = layers if around is None else [la for la in layers if around(la.item)]
+        if held:
+            boxes = np.array([layer.box for layer in held])
             grow = int(margin) + int(np.ceil(4.0 * self.blur))
             box = (
                 max(int(boxes[:, 0].min()) - grow, 0),
