@@ -125,7 +125,7 @@ def test_bad_coordinates_are_rejected_by_every_obstacle_class(
     ],
 )
 def test_curve_that_overflows_is_rejected(coeffs: list[list[float]], u_range: tuple) -> None:
-    with pytest.raises(errors.ParameterError, match="coeffs|u_range"):
+    with pytest.raises(errors.ParameterError, match=r"coeffs|u_range"):
         _core.PolynomialCurve(coeffs, u_range)
 
 

@@ -78,7 +78,7 @@ pub fn check_q_arcs<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<()
     check_q(model, q)?;
     for i in 0..model.n_sections() {
         let length = state(model, q, i).arc.length;
-        if !(length > 0.0) {
+        if length.is_nan() || length <= 0.0 {
             return Err(Error::parameter(
                 &format!("q[{}..{}]", 3 * i, 3 * i + 3),
                 length,

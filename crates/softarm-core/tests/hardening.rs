@@ -118,7 +118,13 @@ fn point_obstacles_are_validated_by_every_query() {
         assert!(Obstacle::point(p).is_err());
         let ob = Obstacle::Point(p);
         assert!(closest(&chain, &q, &ob).is_err());
-        assert!(path_clearance(&chain, &[q.clone()], &[ob.clone()], 1).is_err());
+        assert!(path_clearance(
+            &chain,
+            std::slice::from_ref(&q),
+            std::slice::from_ref(&ob),
+            1
+        )
+        .is_err());
         let planner = PotentialFieldPlanner::new(chain.clone(), PlannerOptions::default()).unwrap();
         let r = planner.plan(&q, &Vec3::new(0.3, 0.0, 1.5), &[ob]);
         assert!(

@@ -244,6 +244,7 @@ impl PointCloud {
     }
 
     /// Pickling and `copy.deepcopy`: rebuilt from its points (the hierarchy is rebuilt).
+    #[allow(clippy::type_complexity)]
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
     ) -> PyResult<(Bound<'py, PyType>, (Bound<'py, PyArray2<f64>>,))> {

@@ -232,6 +232,7 @@ impl Section {
     }
 
     /// Pickling and `copy.deepcopy`: rebuilt through the validating constructor.
+    #[allow(clippy::type_complexity)]
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
     ) -> (Bound<'py, PyType>, (f64, f64, f64, f64, f64, f64)) {

@@ -289,7 +289,7 @@ fn check_evaluation(
     let far = std::iter::once(sphere)
         .chain(spheres.iter().copied())
         .map(reach)
-        .find(|v| !(*v <= MAX_POSITION));
+        .find(|v| v.is_nan() || *v > MAX_POSITION);
     if let Some(v) = far {
         return Err(Error::parameter(
             "coeffs",
@@ -304,7 +304,7 @@ fn check_evaluation(
         .iter()
         .chain(accel)
         .copied()
-        .find(|v| !(*v <= MAX_PARAMETER))
+        .find(|v| v.is_nan() || *v > MAX_PARAMETER)
     {
         return Err(Error::parameter(
             "coeffs",
