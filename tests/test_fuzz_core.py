@@ -93,8 +93,8 @@ junk = st.one_of(
     st.just(np.complex128(0.5 + 0.5j)),
     st.just(np.array([np.nan])),
 )
-scalars = st.one_of(floats, floats, ints, junk)
-counts = st.one_of(ints, ints, junk, floats)
+scalars = st.one_of(st.floats(-2.0, 2.0), floats, floats, ints, junk)
+counts = st.one_of(st.integers(0, 40), ints, ints, junk, floats)
 
 
 def vectors(n: int, elements: st.SearchStrategy[Any] = floats) -> st.SearchStrategy[Any]:
@@ -114,9 +114,10 @@ def vectors(n: int, elements: st.SearchStrategy[Any] = floats) -> st.SearchStrat
 
 def near(base: np.ndarray, scale: float) -> st.SearchStrategy[np.ndarray]:
     """Valid-looking arrays: `base` plus noise, with a hostile value now and then."""
+    hit = st.tuples(st.integers(0, base.size - 1), floats)
     return st.tuples(
         st.lists(st.floats(-scale, scale), min_size=base.size, max_size=base.size),
-        st.one_of(st.none(), st.tuples(st.integers(0, base.size - 1), floats)),
+        st.one_of(st.none(), st.none(), st.none(), hit),
     ).map(lambda t: _perturb(base, t[0], t[1]))
 
 
@@ -182,11 +183,17 @@ model_names = st.sampled_from(sorted(MODELS))
 
 
 def configurations(name: str) -> st.SearchStrategy[Any]:
-    return st.one_of(near(Q[name], SCALE[name]), vectors(MODELS[name].n_dofs))
+    """Mostly valid-looking configurations (3 in 4), else hostile ones."""
+    valid = near(Q[name], SCALE[name])
+    return st.one_of(valid, valid, valid, vectors(MODELS[name].n_dofs))
 
 
 obstacles = st.one_of(
-    st.sampled_from(OBSTACLES), near(np.array([0.1, 0.1, 0.3]), 1.0), vectors(3), junk
+    st.sampled_from(OBSTACLES),
+    st.sampled_from(OBSTACLES),
+    near(np.array([0.1, 0.1, 0.3]), 1.0),
+    vectors(3),
+    junk,
 )
 
 
