@@ -16,10 +16,13 @@ It prints wall and CPU seconds per berry (the run only; building the rig is repo
 its own), and compares each report with the first variant's: the harvested set and the
 fine-positioning errors. The reports go to ``--out``.
 
-    git worktree add /tmp/softarm-before <commit before the change>
-    cp python/softarm/_core*.so /tmp/softarm-before/python/softarm/
+    git worktree add /tmp/before HEAD   # then the camera and vision files as before:
+    git -C /tmp/before checkout c200ecf -- python/softarm/sim/camera.py \\
+        python/softarm/sim/markers.py python/softarm/harvest/sim_vision.py \\
+        python/softarm/vision/{detector,refine,_checks,camera_model,baseline}.py
+    cp python/softarm/_core*.so /tmp/before/python/softarm/
     python examples/bench_sim_rig.py --seeds 100 101 --berries 4 \\
-        --baseline /tmp/softarm-before --noise-control
+        --baseline /tmp/before --noise-control
 """
 
 from __future__ import annotations
