@@ -5,6 +5,7 @@ from softarm.vision.base_registration import BaseRegistration
 from softarm.vision.baseline import OpenCVBaseline
 from softarm.vision.calibration import calibrate_charuco, calibrate_chessboard
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.crop import ImageCrop
 from softarm.vision.cube import CubePose, CubeTracker, MarkerCube
 from softarm.vision.detector import (
     Detection,
@@ -27,6 +28,7 @@ __all__ = [
     "CubeTracker",
     "Detection",
     "FusionEstimate",
+    "ImageCrop",
     "MarkerCube",
     "MarkerDetector",
     "MarkerPose",
