@@ -103,6 +103,9 @@ def test_explicit_format_overrides_the_extension(tmp_path: Path) -> None:
         path = tmp_path / f"cam-{fmt}.txt"
         model.save(path, format=fmt)
         assert CameraModel.load(path) == model
+    path = tmp_path / "opencv.json"  # FileStorage's JSON, told from softarm's by content
+    model.save(path, format="opencv")
+    assert '"opencv-matrix"' in path.read_text() and CameraModel.load(path) == model
 
 
 def test_bad_files_and_formats(tmp_path: Path) -> None:
