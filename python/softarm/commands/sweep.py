@@ -34,7 +34,11 @@ def run(args: argparse.Namespace) -> int:
     from softarm.sweep.runner import run_sweep
     from softarm.sweep.summary import markdown_summary, plot_summary
 
+    from softarm.sweep._deps import require
+
     spec = load_spec(args.spec)
+    for module in ("ray", "pyarrow", "tqdm"):  # the sweep extra, before anything starts
+        require(module)
     if args.gains is not None:
         spec = spec.with_gains(load_gains(args.gains))
     if args.cpus is not None and args.cpus < 1:

@@ -32,7 +32,11 @@ def run(args: argparse.Namespace) -> int:
     from softarm.sweep import load_spec
     from softarm.sweep.tune import run_tune
 
+    from softarm.sweep._deps import require
+
     spec = load_spec(args.spec)
+    for module in ("ray.tune", "optuna", "pyarrow", "tqdm"):  # the sweep extra, up front
+        require(module)
     if args.cpus is not None and args.cpus < 1:
         raise ConfigError(f"--cpus: must be >= 1, got {args.cpus}")
     outcome = run_tune(
