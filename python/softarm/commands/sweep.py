@@ -31,10 +31,9 @@ def run(args: argparse.Namespace) -> int:
     """Exit 0 when every trial ran, 1 if some failed, 2 on a bad spec, 130 if interrupted."""
     from softarm.errors import ConfigError
     from softarm.sweep import load_gains, load_spec
+    from softarm.sweep._deps import require
     from softarm.sweep.runner import run_sweep
     from softarm.sweep.summary import markdown_summary, plot_summary
-
-    from softarm.sweep._deps import require
 
     spec = load_spec(args.spec)
     for module in ("ray", "pyarrow", "tqdm"):  # the sweep extra, before anything starts

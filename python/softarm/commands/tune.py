@@ -30,9 +30,8 @@ def run(args: argparse.Namespace) -> int:
     """Exit 0 with the gains written, 2 on a bad spec."""
     from softarm.errors import ConfigError
     from softarm.sweep import load_spec
-    from softarm.sweep.tune import run_tune
-
     from softarm.sweep._deps import require
+    from softarm.sweep.tune import run_tune
 
     spec = load_spec(args.spec)
     for module in ("ray.tune", "optuna", "pyarrow", "tqdm"):  # the sweep extra, up front
