@@ -30,6 +30,7 @@ from softarm.hardware.limits import (
     WATCHDOG_TIMEOUT_S,
     Limit,
 )
+from softarm.units import MAX_PSI, METRES_PER_PSI, PA_PER_PSI
 
 __all__ = [
     "ArmConfig",
@@ -105,11 +106,11 @@ class ChannelsConfig:
 
     names: tuple[str, ...] = tuple(f"Dev1/ao{i}" for i in range(9))
     voltage_range: tuple[float, float] = (0.0, 5.0)
-    full_scale_psi: float = 0.5e6 / 6894.757293168361  # ITV1031: 0.5 MPa (assumed)
-    p_max: float = 70.0
+    full_scale_psi: float = 0.5e6 / PA_PER_PSI  # ITV1031: 0.5 MPa (assumed)
+    p_max: float = MAX_PSI
     max_rate_psi_per_s: float = 100.0
     watchdog_timeout_s: float = 0.5
-    metres_per_psi: float = 1.0 / 2100.0
+    metres_per_psi: float = METRES_PER_PSI
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ import numpy.typing as npt
 from softarm._core import Section, SoftArm
 from softarm.calibration.metrics import PoseErrorStats
 from softarm.errors import ConfigError, NonFiniteError, ShapeError, SoftarmError
-from softarm.hardware.pressure_map import METRES_PER_PSI
+from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["Calibration", "GainMap", "load_calibration", "load_model"]
 
@@ -89,7 +89,7 @@ class Calibration:
             raise ShapeError(f"elongations: expected finite (..., {self.arm.n_actuators})")
         return (e - self.actuator_offset) / self.actuator_gain
 
-    def pressure_map(self, max_psi: float = 70.0) -> GainMap:
+    def pressure_map(self, max_psi: float = MAX_PSI) -> GainMap:
         """The elongation <-> psi map of the fitted actuators, for
         ``softarm.harvest.actuator.SafeActuator(bank, pressure_map=...)``: the model's
         (true) elongations become pressures through each actuator's own gain."""

@@ -16,8 +16,8 @@ from softarm.calibration.excitation import excitation_set
 from softarm.calibration.fit import calibrate
 from softarm.calibration.result import Calibration
 from softarm.sim.arm import PlantConfig
-from softarm.sim.pressure import METRES_PER_PSI
 from softarm.sim.tracker import PoseTracker
+from softarm.units import METRES_PER_PSI
 
 __all__ = ["PlantDriver", "build_plant", "calibrate_plant", "true_poses"]
 

@@ -13,6 +13,7 @@ from softarm._core import Resolver
 from softarm.sim.arm import SimulatedArm
 from softarm.sim.pressure import to_psi
 from softarm.sim.tracker import log_so3
+from softarm.units import METRES_PER_PSI
 
 F64 = npt.NDArray[np.float64]
 
@@ -29,7 +30,7 @@ def orientation_error(target: F64, pose: F64, mask: F64 = XZ) -> float:
 
 def start_configuration(rng: np.random.Generator, n: int, psi: float = 35.0) -> F64:
     """The paper's start: a small feasible pressure with a small perturbation (m)."""
-    return (psi + rng.uniform(-0.5, 0.5, n)) / 2100.0
+    return (psi + rng.uniform(-0.5, 0.5, n)) * METRES_PER_PSI
 
 
 def bush_pressures(

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from softarm.experiments.common import Trace
+from softarm.units import MAX_PSI
 
 
 def mean_std(values: Sequence[float], scale: float = 1.0) -> dict[str, float]:
@@ -50,7 +51,7 @@ def plot_comparison(
     traces: dict[str, Trace],
     *,
     orientation: bool = False,
-    max_psi: float = 70.0,
+    max_psi: float = MAX_PSI,
 ) -> None:
     """Error vs time for each controller (A), then the commanded pressures of each (B, C...),
     like Fig. 7-9. Pressures outside [0, max_psi] are infeasible."""

@@ -29,6 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import NonFiniteError, OutOfRangeError, ParameterError
+from softarm.units import MAX_PSI, METRES_PER_PSI, PA_PER_PSI
 
 __all__ = [
     "ITV1031_FULL_SCALE_PSI",
@@ -41,10 +42,7 @@ __all__ = [
 FloatArray = npt.NDArray[np.float64]
 ArrayLike = npt.ArrayLike
 
-#: Pascals per psi (exact by definition of the pound-force and the inch).
-PA_PER_PSI = 6894.757293168361
-#: The paper's measured actuator elongation per psi (section IV-A).
-METRES_PER_PSI = 1.0 / 2100.0
+# PA_PER_PSI and METRES_PER_PSI are defined once in softarm.units and re-exported here.
 #: Assumed full scale of the ITV1031 regulator: 0.5 MPa in psi (≈ 72.52).
 ITV1031_FULL_SCALE_PSI = 0.5e6 / PA_PER_PSI
 
@@ -72,7 +70,7 @@ class ElongationMap:
         metres_per_psi: elongation per psi, the paper's 1/2100 m by default.
     """
 
-    max_psi: float = 70.0
+    max_psi: float = MAX_PSI
     metres_per_psi: float = METRES_PER_PSI
 
     def __post_init__(self) -> None:

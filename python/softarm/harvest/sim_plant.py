@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from softarm._core import SoftArm
 from softarm.sim.arm import SimulatedArm
-from softarm.sim.pressure import METRES_PER_PSI
+from softarm.units import METRES_PER_PSI
 
 __all__ = ["ArmPlant"]
 

@@ -19,7 +19,7 @@ from softarm.errors import ParameterError
 from softarm.hardware.safety import SafePressureBank
 from softarm.hardware.simulated import SimulatedPressureBank
 from softarm.sim.arm import PlantConfig, SimulatedArm
-from softarm.sim.pressure import MAX_PSI, METRES_PER_PSI
+from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["IdentificationRig", "SimIdentificationRig", "sim_plant_seed"]
 

@@ -24,8 +24,9 @@ from softarm._core import Section, SoftArm
 from softarm.errors import ParameterError, ShapeError
 from softarm.sim.hysteresis import PlayHysteresis
 from softarm.sim.plant_file import plant_from_mapping, validate_plant_value
-from softarm.sim.pressure import MAX_PSI, METRES_PER_PSI, PressureDynamics, to_psi
+from softarm.sim.pressure import PressureDynamics, to_psi
 from softarm.sim.tracker import PoseTracker
+from softarm.units import MAX_PSI, METRES_PER_PSI
 
 F64 = npt.NDArray[np.float64]
 

@@ -11,10 +11,10 @@ import numpy.typing as npt
 
 from softarm.errors import ParameterError
 
-#: Paper IV-A: actuator elongation per psi (m / psi).
-METRES_PER_PSI = 1.0 / 2100.0
-#: Largest regulator pressure (psi); 70 psi = 0.0333 m, the blackberry arm's upper limit.
-MAX_PSI = 70.0
+# The map's constants are defined once in softarm.units; re-exported here for the plant.
+from softarm.units import MAX_PSI, METRES_PER_PSI
+
+__all__ = ["MAX_PSI", "METRES_PER_PSI", "PressureDynamics", "to_metres", "to_psi"]
 
 F64 = npt.NDArray[np.float64]
 
