@@ -1,6 +1,8 @@
 """Rendering and detecting only the window that holds the markers (the fast simulated rig),
 deferred edge refinement, and the OpenCV baselines with corner refinement."""
 
+import pickle
+
 import cv2
 import numpy as np
 import pytest
@@ -112,6 +114,9 @@ def test_a_slice_of_a_crop_is_refused(renderer: SyntheticCamera) -> None:
     assert empty.shape == (16, 16) and MarkerDetector().detect(empty) == []
     full = crop.full(128)
     assert full.shape == (720, 1280)
+    back = pickle.loads(pickle.dumps(crop))
+    assert back.origin == crop.origin and back.full_size == crop.full_size
+    np.testing.assert_array_equal(back, crop)
 
 
 def test_refinement_is_deferred_and_reads_a_copy(

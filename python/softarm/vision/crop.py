@@ -29,8 +29,8 @@ class ImageCrop(np.ndarray):
     (width, height) frame. Raises :class:`~softarm.errors.ParameterError` if the window
     does not lie inside the frame."""
 
-    origin: tuple[int, int] | None
-    full_size: tuple[int, int] | None
+    origin: tuple[int, int] | None = None
+    full_size: tuple[int, int] | None = None
 
     def __new__(
         cls, pixels: npt.ArrayLike, origin: tuple[int, int], full_size: tuple[int, int]
@@ -56,6 +56,15 @@ class ImageCrop(np.ndarray):
         same = getattr(obj, "shape", (None, None))[:2] == self.shape[:2]
         self.origin = getattr(obj, "origin", None) if same else None
         self.full_size = getattr(obj, "full_size", None) if same else None
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # ndarray pickles its pixels only: carry the window along.
+        ctor, args, state = super().__reduce__()[:3]
+        return ctor, args, (state, self.origin, self.full_size)
+
+    def __setstate__(self, state: Any) -> None:
+        pixels, self.origin, self.full_size = state
+        super().__setstate__(pixels)
 
     def full(self, fill: float = 0.0) -> npt.NDArray[Any]:
         """The full frame as a plain array: this window pasted on ``fill``."""
