@@ -296,7 +296,8 @@ def test_closest(data: st.DataObject, name: str, obstacle: Any) -> None:
     c = call(lambda: _core.closest(model, q, obstacle))
     if c is not None:
         check_closest(c, model)
-    call(lambda: _core.closest(data.draw(junk), Q[name], OBSTACLES[0]))
+    not_an_arm = data.draw(junk)
+    call(lambda: _core.closest(not_an_arm, Q[name], OBSTACLES[0]))
 
 
 # --- planning ------------------------------------------------------------------------------

@@ -254,3 +254,13 @@ def test_mesh_tolerance_below_a_micron_is_refused_and_above_is_met() -> None:
     exact = float(0.5 - np.max(pts[:, 2]))
     got = _core.closest(chain, q, mesh).distance
     assert exact - 1e-6 - 1e-12 <= got <= exact + 1e-12
+
+
+def test_curve_evaluation_is_checked_against_its_range() -> None:
+    """Found by the fuzz test: a NaN parameter evaluated to NaN points."""
+    for u in (math.nan, 2.5, -1e300):
+        with pytest.raises(errors.OutOfRangeError, match="u"):
+            CURVE(u)
+    with pytest.raises(errors.OutOfRangeError, match=r"u\[1\]"):
+        CURVE(np.array([0.0, math.nan]))
+    assert np.isfinite(CURVE(np.linspace(*CURVE.u_range, 9))).all()

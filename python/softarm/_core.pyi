@@ -287,7 +287,7 @@ class PolynomialCurve:
     @property
     def degree(self) -> int: ...
     def __call__(self, u: float | _ArrayLike) -> _F64:
-        """Point (3,) at a scalar u, or points (N, 3) at an array of u."""
+        """Point (3,) at a scalar u, or points (N, 3) at an array of u, inside u_range."""
     def sample(self, n: int) -> _F64:
         """n points evenly spaced in u, (n, 3)."""
     def __reduce__(

@@ -119,12 +119,19 @@ impl PolynomialCurve {
         self.curve().degree()
     }
 
-    /// Points at the parameters `u` (scalar → (3,), array (N,) → (N, 3)).
+    /// Points at the parameters `u` (scalar → (3,), array (N,) → (N, 3)), each inside
+    /// `u_range`: the curve is defined there, and its evaluation is only checked to be
+    /// finite there.
     fn __call__<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let (lo, hi) = self.curve().u_range();
         if let Ok(v) = real(u, "u") {
+            core::error::check_range("u", v, lo, hi).py()?;
             return Ok(vec3_out(py, &self.curve().eval(v)).into_any());
         }
         let (us, _) = array(u, "u", &[None])?;
+        if let Some(i) = us.iter().position(|v| !(lo..=hi).contains(v)) {
+            core::error::check_range(&format!("u[{i}]"), us[i], lo, hi).py()?;
+        }
         let pts: Vec<Vec3> = us.iter().map(|&v| self.curve().eval(v)).collect();
         Ok(points_out(py, &pts)?.into_any())
     }

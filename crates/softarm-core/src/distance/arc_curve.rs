@@ -673,10 +673,12 @@ pub fn closest_arc_curve_within(
         return None;
     }
     let long = LONG_PIECE * arc.arc.params.length;
-    let needs_split = curve
-        .interval_spheres()
-        .iter()
-        .any(|(c, r)| *r > long && (middle - c).norm() - r - half < cutoff);
+    // Usual curves (intervals shorter than 8 arc lengths) skip the loop: one comparison.
+    let needs_split = curve.longest_interval() > long
+        && curve
+            .interval_spheres()
+            .iter()
+            .any(|(c, r)| *r > long && (middle - c).norm() - r - half < cutoff);
     if needs_split {
         closest_in_pieces(arc, curve, cutoff)
     } else {

@@ -29,6 +29,8 @@ pub struct PolynomialCurve {
     spheres: Vec<(Vec3, f64)>,
     /// Bounding sphere of the whole curve: centre and radius.
     sphere: (Vec3, f64),
+    /// The largest radius of the interval spheres (whether the search may need to split).
+    longest: f64,
 }
 
 impl PolynomialCurve {
@@ -143,6 +145,7 @@ impl PolynomialCurve {
             .map(|w| bounding_sphere(&coeffs, w[0], w[1]))
             .collect();
         let sphere = bounding_sphere(&coeffs, u_min, u_max);
+        let longest = spheres.iter().map(|s| s.1).fold(0.0, f64::max);
         PolynomialCurve {
             coeffs,
             u_min,
@@ -152,6 +155,7 @@ impl PolynomialCurve {
             accel,
             spheres,
             sphere,
+            longest,
         }
     }
 
@@ -222,6 +226,11 @@ impl PolynomialCurve {
     /// A sphere (centre, radius) holding the whole curve.
     pub fn bounding_sphere(&self) -> (Vec3, f64) {
         self.sphere
+    }
+
+    /// The largest radius of [`PolynomialCurve::interval_spheres`].
+    pub(crate) fn longest_interval(&self) -> f64 {
+        self.longest
     }
 
     /// A sphere (centre, radius) holding the curve over each grid interval.
