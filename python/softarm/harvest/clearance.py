@@ -16,16 +16,12 @@ import numpy.typing as npt
 
 from softarm._core import PolynomialCurve, closest
 
+# The radii are defined once in softarm.geometry (the Cosserat plant uses them too).
+from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
+
 __all__ = ["ACTUATOR_RADIUS", "CANE_RADIUS", "GRIPPER_RADIUS", "Clearance"]
 
 FloatArray = npt.NDArray[np.float64]
-
-#: Radius (m) of one pneumatic artificial muscle (5/8" braided sleeve, section II-A).
-ACTUATOR_RADIUS = 0.008
-#: Radius (m) of the gripper with its fingers, around its axis.
-GRIPPER_RADIUS = 0.025
-#: Radius (m) of a blackberry cane.
-CANE_RADIUS = 0.005
 
 
 class Clearance:

@@ -1,60 +1,10 @@
-"""Adapter from the pressure bank (psi) to the simulated arm of :mod:`softarm.sim.arm`."""
+"""Re-export of :class:`softarm.sim.plant.ArmPlant`, the simulated plant, from its old path.
+
+The plant lives in :mod:`softarm.sim.plant` so that :mod:`softarm.sim` (the Cosserat
+plant subclasses it) imports nothing from the harvest layer."""
 
 from __future__ import annotations
 
-import numpy as np
-import numpy.typing as npt
-
-from softarm._core import SoftArm
-from softarm.sim.arm import SimulatedArm
-from softarm.units import METRES_PER_PSI
+from softarm.sim.plant import ArmPlant
 
 __all__ = ["ArmPlant"]
-
-FloatArray = npt.NDArray[np.float64]
-
-
-class ArmPlant:
-    """A :class:`~softarm.hardware.simulated.PressurePlant` on a
-    :class:`~softarm.sim.arm.SimulatedArm` (true geometry, per-actuator gains, regulator
-    lag and hysteresis, all differing from the controller's model), advanced by the
-    simulated clock.
-
-    The regulator set-points (psi) become the arm's elongation command through the
-    nominal map (1/2100 m per psi, section IV-A); the arm applies its own true gains.
-    """
-
-    def __init__(self, arm: SimulatedArm, start: FloatArray | None = None) -> None:
-        self.sim = arm
-        self._command = np.zeros(arm.n) if start is None else np.asarray(start, dtype=float)
-        arm.reset(self._command)
-
-    @classmethod
-    def seeded(cls, model: SoftArm, seed: int) -> ArmPlant:
-        """A plant around ``model`` drawn from ``seed``, starting vented."""
-        return cls(SimulatedArm(model, seed=seed))
-
-    @property
-    def arm(self) -> SoftArm:
-        """The TRUE arm (for ground truth and clearance)."""
-        return self.sim.true_arm
-
-    def command_pressures(self, psi: FloatArray) -> None:
-        """Regulator set-points (psi)."""
-        self._command = np.asarray(psi, dtype=np.float64) * METRES_PER_PSI
-
-    def pressures(self) -> FloatArray:
-        """Regulator pressures (psi)."""
-        return self.sim.pressure
-
-    def advance(self, dt: float) -> None:
-        """Let ``dt`` seconds pass with the current set-points."""
-        self.sim.apply(self._command, dt)
-
-    def q(self) -> FloatArray:
-        """True elongations (m)."""
-        return self.sim.elongation
-
-    def pose(self) -> FloatArray:
-        """True ``T_base_ee``."""
-        return self.sim.true_pose()

@@ -162,12 +162,16 @@ class SimulatedArm:
         p = self.dynamics.saturate(self._check(psi, "psi"))
         return self.true_arm.forward(p * self.metres_per_psi)
 
-    def apply(self, q: npt.ArrayLike, dt: float) -> F64:
+    def step(self, q: npt.ArrayLike, dt: float) -> None:
         """Holds command ``q`` (m, may be infeasible: the regulators saturate it) for
-        ``dt`` seconds; returns the tracker's measured pose (4, 4)."""
+        ``dt`` seconds, without a tracker measurement (for plants measured otherwise)."""
         if not (math.isfinite(dt) and dt > 0.0):
             raise ParameterError(f"dt = {dt}: must be positive and finite")
         p = self.dynamics.advance(to_psi(self._check(q, "q")), dt)
         self.hysteresis(p)
         self.time += dt
+
+    def apply(self, q: npt.ArrayLike, dt: float) -> F64:
+        """:meth:`step`, then the tracker's measured pose (4, 4)."""
+        self.step(q, dt)
         return self.tracker.measure(self.true_pose(), dt)

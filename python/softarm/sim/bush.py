@@ -19,7 +19,7 @@ import numpy.typing as npt
 
 from softarm._core import PolynomialCurve
 from softarm.errors import ParameterError
-from softarm.harvest.ik import cone_axes
+from softarm.geometry import cone_axes
 
 __all__ = ["Berry", "Branch", "Bush"]
 
@@ -141,7 +141,7 @@ class Bush:
         else:
             raise ParameterError(f"could not place {n_berries} berries {min_spacing} m apart")
         # Approach lines: along +Y and along every axis of the cone the planner may tilt to
-        # (softarm.harvest.ik.cone_axes), so no straight approach meets a cane.
+        # (softarm.geometry.cone_axes), so no straight approach meets a cane.
         segments = [
             (b.position - corridor * a, b.position + 0.02 * a)
             for b in berries

@@ -33,9 +33,9 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 from softarm.sim.markers import SceneMarker, TexturedPlane
-from softarm.vision._checks import FloatArray
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 

@@ -15,8 +15,8 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray, as_pose, positive
 from softarm.errors import ParameterError
-from softarm.vision._checks import FloatArray, as_pose, positive
 from softarm.vision.dictionaries import check_marker_id, get_dictionary
 
 # Texture resolution is chosen per frame (texels per marker cell) so that one texel is

@@ -3,7 +3,7 @@
 PyElastica is the optional extra ``cosserat`` (``pip install 'softarm[cosserat]'``); it
 is imported only when a rod is built, and :func:`require_elastica` says how to install it
 when it is absent. :class:`~softarm.sim.cosserat.plant.CosseratPlant` is the plant (the
-interface of ``softarm.harvest.sim_plant.ArmPlant``), :class:`~softarm.sim.cosserat.rod.RodArm`
+interface of ``softarm.sim.plant.ArmPlant``), :class:`~softarm.sim.cosserat.rod.RodArm`
 the rod, :mod:`~softarm.sim.cosserat.params` its masses and stiffness.
 """
 

@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import PolynomialCurve
-from softarm.harvest.clearance import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
+from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
 
 __all__ = ["RodClearance"]
 

@@ -7,7 +7,7 @@ geometry from the seed); the elongations then set the intrinsic strains of a
 :class:`~softarm.sim.cosserat.rod.RodArm` built on the same perturbed geometry, with
 gravity ``config.gravity`` in the base frame. The rod starts at its static equilibrium
 and then follows its damped dynamics in real time (``RodArm.advance``). Same interface as
-:class:`softarm.harvest.sim_plant.ArmPlant`.
+:class:`softarm.sim.plant.ArmPlant`.
 """
 
 from __future__ import annotations
@@ -16,10 +16,10 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
-from softarm.harvest.sim_plant import ArmPlant
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.cosserat.params import RodParameters
 from softarm.sim.cosserat.rod import RodArm
+from softarm.sim.plant import ArmPlant
 
 __all__ = ["CosseratPlant"]
 
@@ -59,7 +59,7 @@ class CosseratPlant(ArmPlant):
         """Let ``dt`` seconds pass with the current set-points: the pressures move (lag,
         saturation, hysteresis), then the rod's damped dynamics run for ``dt`` under the
         elongations they reached."""
-        self.sim.apply(self._command, dt)
+        self.sim.step(self._command, dt)
         self.rod.set_elongations(self.sim.elongation)
         self.rod.advance(dt)
 

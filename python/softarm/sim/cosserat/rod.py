@@ -43,6 +43,7 @@ from scipy.spatial.transform import Rotation
 
 from softarm._core import SoftArm
 from softarm.errors import NonFiniteError, ShapeError
+from softarm.geometry import ACTUATOR_RADIUS
 from softarm.sim.cosserat import require_elastica
 from softarm.sim.cosserat.params import RodParameters
 
@@ -110,7 +111,7 @@ class RodArm:
         ei = np.where(self.kinds >= 0, 1.0, 10.0) * ei_sec[sec_of]
         r_ring = r_sec[sec_of]
         m_line = line[sec_of]
-        body = r_ring + 0.008  # body radius: ring + one muscle (harvest clearance model)
+        body = r_ring + ACTUATOR_RADIUS  # body radius: ring + one muscle (as the clearance)
         density = m_line / (math.pi * body**2)
         rod = ea.CosseratRod.straight_rod(
             n, nodes[:, 0].copy(), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]),

@@ -1,0 +1,38 @@
+"""Body geometry shared by the simulation and the harvest layer: the radii of the arm's
+surfaces and the cane, and the fan of approach axes around a direction.
+
+This module imports only numpy, so :mod:`softarm.sim` (the bush generator, the Cosserat
+clearance) and :mod:`softarm.harvest` (clearance, placement) both take these from below
+(see ``docs/architecture.md``, "Layers").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["ACTUATOR_RADIUS", "CANE_RADIUS", "GRIPPER_RADIUS", "cone_axes"]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Radius (m) of one pneumatic artificial muscle (5/8" braided sleeve, section II-A).
+ACTUATOR_RADIUS = 0.008
+#: Radius (m) of the gripper with its fingers, around its axis.
+GRIPPER_RADIUS = 0.025
+#: Radius (m) of a blackberry cane.
+CANE_RADIUS = 0.005
+
+
+def cone_axes(axis: FloatArray, cone_deg: float, rings: int = 2, per_ring: int = 8) -> FloatArray:
+    """(1 + rings * per_ring, 3) unit axes: ``axis``, then rings at growing angles up to
+    ``cone_deg`` around it."""
+    a = axis / np.linalg.norm(axis)
+    u = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    out = [a]
+    for k in range(1, rings + 1):
+        t = np.radians(cone_deg) * k / rings
+        for phi in np.linspace(0, 2 * np.pi, per_ring, endpoint=False):
+            out.append(np.cos(t) * a + np.sin(t) * (np.cos(phi) * u + np.sin(phi) * v))
+    return np.array(out)

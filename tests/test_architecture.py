@@ -1,0 +1,142 @@
+"""The structural rules of docs/architecture.md, checked on the source: each unit constant
+is defined once, and ``softarm.sim`` imports nothing above it."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+import softarm
+
+PACKAGE = Path(softarm.__file__).parent
+
+
+def _modules(root: Path) -> list[Path]:
+    return sorted(p for p in root.rglob("*.py") if "__pycache__" not in p.parts)
+
+
+def _numbers(tree: ast.AST) -> list[float]:
+    """Every numeric literal in the code, with ``1.0 / 2100.0`` folded to its value."""
+    out: list[float] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
+            out.append(float(node.value))
+        if (
+            isinstance(node, ast.BinOp)
+            and isinstance(node.op, ast.Div)
+            and isinstance(node.left, ast.Constant)
+            and isinstance(node.right, ast.Constant)
+            and isinstance(node.right.value, int | float)
+            and node.right.value != 0
+        ):
+            out.append(float(node.left.value) / float(node.right.value))
+    return out
+
+
+def test_the_pressure_map_constant_is_written_once() -> None:
+    """Only softarm/units.py spells the 1/2100 m per psi map (docstrings may mention it)."""
+    offenders = [
+        str(path.relative_to(PACKAGE))
+        for path in _modules(PACKAGE)
+        if path.name != "units.py"
+        and any(v in (2100.0, 1.0 / 2100.0) for v in _numbers(ast.parse(path.read_text())))
+    ]
+    assert offenders == []
+
+
+def test_every_module_uses_the_same_unit_objects() -> None:
+    from softarm import units
+    from softarm.config import ChannelsConfig
+    from softarm.hardware import pressure_map
+    from softarm.sim import pressure
+
+    assert pressure_map.METRES_PER_PSI is units.METRES_PER_PSI
+    assert pressure.METRES_PER_PSI is units.METRES_PER_PSI
+    assert pressure.MAX_PSI is units.MAX_PSI
+    assert pressure_map.ElongationMap().max_psi == units.MAX_PSI
+    assert ChannelsConfig().metres_per_psi == units.METRES_PER_PSI == 1.0 / 2100.0
+    assert ChannelsConfig().p_max == units.MAX_PSI == 70.0
+
+
+#: What ``softarm.sim`` may not import: the layers above it, and private vision modules.
+FORBIDDEN = ("softarm.harvest", "softarm.commands", "softarm.cli")
+
+
+def _imports(tree: ast.AST) -> list[str]:
+    names: list[str] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.extend(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.append(node.module)
+            names.extend(f"{node.module}.{alias.name}" for alias in node.names)
+    return names
+
+
+def _violations(name: str) -> bool:
+    if any(name == f or name.startswith(f + ".") for f in FORBIDDEN):
+        return True
+    parts = name.split(".")
+    return len(parts) >= 3 and parts[:2] == ["softarm", "vision"] and parts[2].startswith("_")
+
+
+@pytest.mark.parametrize(
+    "path", _modules(PACKAGE / "sim"), ids=lambda p: str(p.relative_to(PACKAGE))
+)
+def test_sim_imports_nothing_above_it(path: Path) -> None:
+    bad = [n for n in _imports(ast.parse(path.read_text())) if _violations(n)]
+    assert bad == [], f"{path.relative_to(PACKAGE)} imports {bad}"
+
+
+def test_the_layer_check_can_fail() -> None:
+    tree = ast.parse(
+        "from softarm.harvest.ik import cone_axes\n"
+        "from softarm.vision._checks import finite\n"
+        "import softarm.cli\n"
+        "from softarm.vision import detector\n"
+    )
+    assert [n for n in _imports(tree) if _violations(n)] == [
+        "softarm.harvest.ik",
+        "softarm.harvest.ik.cone_axes",
+        "softarm.vision._checks",
+        "softarm.vision._checks.finite",
+        "softarm.cli",
+    ]
+
+
+def test_moved_helpers_are_the_same_objects_or_give_the_same_results() -> None:
+    import numpy as np
+
+    from softarm import checks, geometry
+    from softarm.harvest import clearance, ik, sim_plant
+    from softarm.sim import plant
+    from softarm.vision import _checks
+
+    assert sim_plant.ArmPlant is plant.ArmPlant
+    assert (_checks.as_pose, _checks.as_array, _checks.positive) == (
+        checks.as_pose,
+        checks.as_array,
+        checks.positive,
+    )
+    assert clearance.ACTUATOR_RADIUS is geometry.ACTUATOR_RADIUS
+    for axis in ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.3, -0.2, 0.9]):
+        a = np.array(axis)
+        np.testing.assert_array_equal(geometry.cone_axes(a, 35.0), ik.cone_axes(a, 35.0))
+
+
+def test_plant_step_advances_like_apply_without_measuring() -> None:
+    import numpy as np
+
+    from softarm.sim.arm import SimulatedArm
+
+    a, b = SimulatedArm(seed=3), SimulatedArm(seed=3)
+    q = np.full(9, 0.02)
+    for _ in range(5):
+        measured = a.apply(q, 0.05)
+        b.step(q, 0.05)
+    np.testing.assert_array_equal(a.pressure, b.pressure)
+    np.testing.assert_array_equal(a.true_pose(), b.true_pose())
+    assert measured.shape == (4, 4)
+    assert a.time == b.time
