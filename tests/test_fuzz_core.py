@@ -5,7 +5,7 @@ complex numbers, strings, wrong shapes, ...) mixed with valid input, and must ei
 raise a typed ``softarm.errors.SoftarmError`` or return a finite result inside its limits:
 never another exception type, never a crash (a crash ends the pytest process).
 
-The default is bounded for CI (about 20 s). Longer runs, and the figures in
+The default is bounded for CI (5 to 20 s). Longer runs, and the figures in
 docs/reliability.md::
 
     SOFTARM_FUZZ_EXAMPLES=2000 SOFTARM_FUZZ_RANDOM=1 SOFTARM_FUZZ_REPORT=fuzz.json \\
