@@ -12,20 +12,21 @@ import numpy.typing as npt
 from softarm._core import Resolver
 from softarm.sim.arm import SimulatedArm
 from softarm.sim.pressure import to_psi
-from softarm.sim.tracker import log_so3
 from softarm.units import METRES_PER_PSI
 
 F64 = npt.NDArray[np.float64]
 
 #: Control period (s): one resolver step per tracker sample.
 CONTROL_PERIOD = 0.05
-#: The paper's X/Z orientation mask.
-XZ = np.array([1.0, 0.0, 1.0])
 
 
-def orientation_error(target: F64, pose: F64, mask: F64 = XZ) -> float:
-    """Masked norm (rad) of the rotation vector of R_target R_currentᵀ."""
-    return float(np.linalg.norm(mask * log_so3(target[:3, :3] @ pose[:3, :3].T)))
+def orientation_error(judge: Resolver, q: F64, target: F64, pose: F64) -> float:
+    """The core's masked orientation error (rad) of ``pose`` against ``target``: the
+    norm of the rotation vector of R_target R_currentᵀ over the paper's X/Z axes
+    (``judge``'s ``axis_mask``), as ``StepResult.orientation_error`` returns it with
+    ``pose`` as the measured pose. The step's command is discarded: only the error is
+    read, so Python never recomputes e_ζ."""
+    return judge.step(q, target, pose).orientation_error
 
 
 def start_configuration(rng: np.random.Generator, n: int, psi: float = 35.0) -> F64:
@@ -101,6 +102,8 @@ def closed_loop(
     full_pose = pose_target.shape == (4, 4)
     p_target = pose_target[:3, 3] if full_pose else pose_target
     q = np.asarray(q0, dtype=np.float64).copy()
+    # Scores the true pose with the default X/Z mask, whatever the controller's gains.
+    judge = Resolver(plant.model, "hybrid")
     measured = plant.reset(q)
     trace = Trace()
     for k in range(round(duration / period)):
@@ -115,5 +118,7 @@ def closed_loop(
         trace.time.append((k + 1) * period)
         trace.command_psi.append(to_psi(q))
         trace.position_error.append(float(np.linalg.norm(p_target - true[:3, 3])))
-        trace.orientation_error.append(orientation_error(pose_target, true) if full_pose else 0.0)
+        trace.orientation_error.append(
+            orientation_error(judge, q, pose_target, true) if full_pose else 0.0
+        )
     return trace

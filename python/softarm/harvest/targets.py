@@ -4,14 +4,16 @@ The gripper approaches every berry along ``approach`` (the bush lies along +Y of
 frame, section IV-F). Only the direction of the gripper's z axis is prescribed: its roll
 about that axis is free, so the target rotation is the smallest rotation that turns the
 current z axis onto ``approach``, applied to the current orientation. The full orientation
-error of the resolver (rotation vector of R_target · R_currentᵀ, DESIGN.md) is then exactly
-the pointing error.
+error of the resolver (rotation vector of R_target · R_currentᵀ, docs/architecture.md) is
+then exactly the pointing error.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
+
+from softarm import so3
 
 __all__ = ["align_z", "approach_pose", "grasp_point", "pointing_error", "tool_pose"]
 
@@ -20,20 +22,11 @@ FloatArray = npt.NDArray[np.float64]
 
 def align_z(rotation: FloatArray, axis: FloatArray) -> FloatArray:
     """``rotation`` (3, 3) turned by the smallest rotation taking its z column onto the
-    unit vector ``axis`` (Rodrigues' formula)."""
-    z = rotation[:, 2]
-    v = np.cross(z, axis)
-    c = float(np.clip(z @ axis, -1.0, 1.0))
-    s = float(np.linalg.norm(v))
-    if s < 1e-12:
-        if c > 0:
-            return rotation.copy()
+    unit vector ``axis`` (:func:`softarm.so3.rotation_between`)."""
+    turn = so3.rotation_between(rotation[:, 2], axis)
+    if turn is None:
         # Antiparallel: turn by pi about the current x axis.
-        k = rotation[:, 0]
-        return (2.0 * np.outer(k, k) - np.eye(3)) @ rotation
-    k = v / s
-    kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    turn = np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
+        turn = so3.exp(np.pi * rotation[:, 0])
     return turn @ rotation
 
 

@@ -9,30 +9,10 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from softarm import so3
 from softarm.errors import ParameterError
 
 F64 = npt.NDArray[np.float64]
-
-
-def exp_so3(w: F64) -> F64:
-    """Rotation matrix of rotation vector ``w`` (Rodrigues)."""
-    theta = float(np.linalg.norm(w))
-    k = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-    if theta < 1e-12:
-        return np.eye(3) + k
-    a = math.sin(theta) / theta
-    b = (1.0 - math.cos(theta)) / theta**2
-    return np.eye(3) + a * k + b * (k @ k)
-
-
-def log_so3(r: F64) -> F64:
-    """Rotation vector of a rotation matrix (angles below pi)."""
-    c = max(-1.0, min(1.0, (np.trace(r) - 1.0) / 2.0))
-    theta = math.acos(c)
-    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    if theta < 1e-9:
-        return 0.5 * v
-    return theta / (2.0 * math.sin(theta)) * v
 
 
 class PoseTracker:
@@ -71,7 +51,7 @@ class PoseTracker:
         """One measurement of ``true_pose`` taken ``dt`` seconds after the last."""
         noisy = true_pose.copy()
         noisy[:3, 3] += self.rng.normal(0.0, self.position_noise, 3)
-        noisy[:3, :3] = exp_so3(self.rng.normal(0.0, self.angle_noise, 3)) @ true_pose[:3, :3]
+        noisy[:3, :3] = so3.exp(self.rng.normal(0.0, self.angle_noise, 3)) @ true_pose[:3, :3]
         if self.filtered is None:
             self.filtered = noisy
             return noisy.copy()
@@ -79,6 +59,6 @@ class PoseTracker:
         f = self.filtered
         out = np.eye(4)
         out[:3, 3] = f[:3, 3] + k * (noisy[:3, 3] - f[:3, 3])
-        out[:3, :3] = exp_so3(k * log_so3(noisy[:3, :3] @ f[:3, :3].T)) @ f[:3, :3]
+        out[:3, :3] = so3.exp(k * so3.log(noisy[:3, :3] @ f[:3, :3].T)) @ f[:3, :3]
         self.filtered = out
         return out.copy()

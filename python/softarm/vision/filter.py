@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
+from softarm import so3
 from softarm.errors import InputError
 from softarm.vision._checks import FloatArray, as_pose, positive
 
@@ -48,8 +48,7 @@ class PoseLowPassFilter:
         a = 1.0 - np.exp(-self.cutoff * dt)
         pose = np.eye(4)
         pose[:3, 3] = self._pose[:3, 3] + a * (meas[:3, 3] - self._pose[:3, 3])
-        cur = Rotation.from_matrix(self._pose[:3, :3])
-        step = (cur.inv() * Rotation.from_matrix(meas[:3, :3])).as_rotvec()
-        pose[:3, :3] = (cur * Rotation.from_rotvec(a * step)).as_matrix()
+        cur = self._pose[:3, :3]
+        pose[:3, :3] = cur @ so3.exp(a * so3.log(cur.T @ meas[:3, :3]))
         self._pose, self._time = pose, t
         return pose.copy()
