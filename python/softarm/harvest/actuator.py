@@ -34,8 +34,3 @@ class SafeActuator:
     def vent(self, reason: str) -> None:
         """Vent every channel; the safety layer logs ``reason``."""
         self.bank.vent(reason)
-
-    @property
-    def commanded(self) -> FloatArray:
-        """The elongations (m) matching the pressures last forwarded (after rate limit)."""
-        return self.pressure_map.to_elongation(self.bank.last_sent)
