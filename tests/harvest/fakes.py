@@ -124,6 +124,10 @@ class FakeGripper:
     closed: bool = False
     fail_on_close: Exception | None = None
 
+    @property
+    def position(self) -> float:
+        return 1.0 if self.closed else 0.0
+
     def open(self) -> None:
         self.closed = False
 

@@ -3,6 +3,12 @@
 The machine never talks to a camera, a DAQ board or the simulated arm directly: the
 simulated rig (:mod:`softarm.harvest.sim_rig`), the hardware rig and the test fakes each
 provide these few objects.
+
+The devices have one vocabulary, :mod:`softarm.hardware.protocols` (``PressureBank``,
+``Gripper``, ``RipenessSensor``, ``Camera``); the machine takes a ``Gripper`` and a
+``RipenessSensor`` from there. ``GripperDevice`` and ``RipenessProbe`` are their old names
+here, kept as aliases so that existing imports keep working. What is defined here is what
+the harvest loop adds on top of the devices: the estimates, the controller, the clock.
 """
 
 from __future__ import annotations
@@ -13,25 +19,30 @@ from typing import Literal, Protocol
 import numpy as np
 import numpy.typing as npt
 
+from softarm.hardware.protocols import Gripper, RipenessSensor
+
 __all__ = [
     "BerryFix",
     "BerryLocator",
     "BerryTarget",
-    "Camera",
+    "CameraName",
     "Clock",
     "Controller",
     "EndEffectorTracker",
+    "Gripper",
     "GripperDevice",
     "GroundTruth",
     "PlacementPlanner",
     "PressureActuator",
     "RipenessProbe",
+    "RipenessSensor",
 ]
 
 FloatArray = npt.NDArray[np.float64]
 #: Which camera the berry position came from; ``held`` = the most recent one, kept while
-#: the berry is hidden (section III-D).
-Camera = Literal["eye_to_hand", "eye_in_hand", "held"]
+#: the berry is hidden (section III-D). (A name, not a device: the device protocol is
+#: :class:`softarm.hardware.protocols.Camera`.)
+CameraName = Literal["eye_to_hand", "eye_in_hand", "held"]
 
 
 @dataclass(frozen=True)
@@ -49,7 +60,7 @@ class BerryFix:
     and its ``age`` (s since it was measured; 0 for a fresh measurement)."""
 
     position: FloatArray
-    camera: Camera
+    camera: CameraName
     age: float = 0.0
 
 
@@ -125,24 +136,9 @@ class PressureActuator(Protocol):
         ...
 
 
-class GripperDevice(Protocol):
-    """The soft gripper."""
-
-    def open(self) -> None:
-        """Open the fingers."""
-        ...
-
-    def close(self) -> None:
-        """Close the fingers."""
-        ...
-
-
-class RipenessProbe(Protocol):
-    """The NIR ripeness sensor in the palm."""
-
-    def read(self) -> float:
-        """Ripeness index in [0, 1]."""
-        ...
+#: Old names of the device protocols of :mod:`softarm.hardware.protocols`.
+GripperDevice = Gripper
+RipenessProbe = RipenessSensor
 
 
 class GroundTruth(Protocol):

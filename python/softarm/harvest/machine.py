@@ -34,11 +34,11 @@ from softarm.harvest.interfaces import (
     Controller,
     EndEffectorTracker,
     FloatArray,
-    GripperDevice,
+    Gripper,
     GroundTruth,
     PlacementPlanner,
     PressureActuator,
-    RipenessProbe,
+    RipenessSensor,
 )
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.report import BerryResult, HarvestReport
@@ -71,8 +71,8 @@ class HarvestMachine:
         locator: BerryLocator,
         controller: Controller,
         actuator: PressureActuator,
-        gripper: GripperDevice,
-        ripeness: RipenessProbe,
+        gripper: Gripper,
+        ripeness: RipenessSensor,
         n_actuators: int = 9,
         config: HarvestConfig | None = None,
         log: HarvestLog | None = None,

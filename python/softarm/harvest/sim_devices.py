@@ -52,6 +52,7 @@ class SimGripper:
         self.plant, self.vision, self.on_bush = plant, vision, on_bush
         self.offset, self.workspace = offset, workspace
         self.holding: Berry | None = None
+        self._closed = False
         self.delivered: list[int] = []
         #: True elongations at each grasp, for plots of the arm.
         self.grasp_shapes: list[FloatArray] = []
@@ -65,17 +66,24 @@ class SimGripper:
 
     def close(self) -> None:
         """Close the fingers; catch the selected berry if it is between them."""
+        self._closed = True
         berry = self._berry(self.vision.selected.tag_id)  # type: ignore[attr-defined]
         near = berry is not None and np.linalg.norm(self._grasp_point() - berry.position)
         self.holding = berry if berry is not None and near <= self.workspace else None
 
     def open(self) -> None:
         """Open; a berry carried away from the bush is delivered (removed from it)."""
+        self._closed = False
         b = self.holding
         if b is not None and np.linalg.norm(self._grasp_point() - b.position) > self.workspace:
             self.on_bush.remove(b)
             self.delivered.append(b.tag_id)
         self.holding = None
+
+    @property
+    def position(self) -> float:
+        """Closure fraction (:class:`softarm.hardware.protocols.Gripper`): 0 open, 1 closed."""
+        return 1.0 if self._closed else 0.0
 
     def read(self) -> float:
         """Ripeness of the berry in the fingers; 0.0 (unripe) when there is none."""
