@@ -1,5 +1,5 @@
 """pytest-benchmark: kinematics from Python against a numpy implementation of the same
-equations (eq. 1-3), run side by side. Targets (DESIGN.md): one forward/jacobian call
+equations (eq. 1-3), run side by side. Targets (docs/architecture.md): one forward/jacobian call
 <= 2 us; batch >= 5 million poses per second per core.
 
 Run with ``make bench`` (benchmarks are skipped in ``make test``)."""

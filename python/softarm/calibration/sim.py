@@ -31,8 +31,8 @@ def build_plant(model: SoftArm, config: PlantConfig, seed: int) -> object:
         from softarm.sim.cosserat import CosseratPlant
 
         return CosseratPlant(model, config, seed=seed)
-    from softarm.harvest.sim_plant import ArmPlant
     from softarm.sim.arm import SimulatedArm
+    from softarm.sim.plant import ArmPlant
 
     return ArmPlant(SimulatedArm(model, config, seed=seed))
 
