@@ -155,7 +155,8 @@ def run_harvest(
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="fidelity.py", description=__doc__.split("\n\n")[0])
-    ap.add_argument("part", choices=["cc", "rod", "harvest"])
+    # Optional for argparse so that an unknown option is reported before a missing part.
+    ap.add_argument("part", nargs="?", choices=["cc", "rod", "harvest"])
     ap.add_argument("--seeds", nargs="+", default=["1000-1019"], help="seeds or ranges a-b")
     ap.add_argument("--gravity", nargs="+", choices=sorted(GRAVITY), default=sorted(GRAVITY))
     ap.add_argument("--berries", type=int, default=5)
@@ -163,6 +164,8 @@ def main(argv: list[str] | None = None) -> int:
                     default=["nominal", "calibrated"])  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("out/fidelity"))
     a = ap.parse_args(argv)
+    if a.part is None:
+        ap.error("the part to run is required: cc, rod or harvest")
     seeds = _seeds(a.seeds)
     if a.part == "cc":
         run_cc(seeds, a.out)

@@ -80,6 +80,6 @@ def test_plan_command_writes_a_plot(tmp_path: Path) -> None:
     from softarm.commands import plan
 
     out = tmp_path / "tree.png"
-    status = plan.run(argparse.Namespace(scenario="tree", plot=str(out), repeats=1))
+    status = plan.run(argparse.Namespace(scenario="tree", plot=str(out), repeats=1, json=False))
     assert status == 0
     assert out.stat().st_size > 10_000
