@@ -85,7 +85,25 @@ pub fn closest_piece_within(
 ) -> Option<BodyClosest> {
     let mut best: Option<BodyClosest> = None;
     let mut limit = cutoff;
+    let spheres = match obstacle {
+        Obstacle::Curve(c) => Some(c.interval_spheres()),
+        Obstacle::Segment(s) => Some(s.as_curve().interval_spheres()),
+        _ => None,
+    };
     for p in pieces {
+        if let Some(spheres) = spheres {
+            // Cull by the curve's per-interval bounding spheres (the whole-curve sphere of
+            // a long cane holds most of the arm): a piece lies within half its length of
+            // its middle point.
+            let middle = p.arc.point(0.5);
+            let half = 0.5 * p.arc.arc.params.length;
+            if spheres
+                .iter()
+                .all(|(c, r)| (middle - c).norm() - r - half >= limit)
+            {
+                continue;
+            }
+        }
         if let Some(c) = closest_to_arcs_within(std::slice::from_ref(&p.arc), obstacle, limit) {
             if c.distance < limit {
                 limit = c.distance;
