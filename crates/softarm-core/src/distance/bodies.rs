@@ -97,10 +97,11 @@ pub fn closest_piece_within(
             // its middle point.
             let middle = p.arc.point(0.5);
             let half = 0.5 * p.arc.arc.params.length;
-            if spheres
-                .iter()
-                .all(|(c, r)| (middle - c).norm() - r - half >= limit)
-            {
+            // Squared, to spare a square root per interval: |m − c| ≥ r + L/2 + limit.
+            if spheres.iter().all(|(c, r)| {
+                let reach = r + half + limit;
+                (middle - c).norm_squared() >= reach * reach
+            }) {
                 continue;
             }
         }
