@@ -104,7 +104,8 @@ def test_bad_mode(arm: softarm.SoftArm) -> None:
 
 
 def test_step_types_and_array_likes(arm: softarm.SoftArm) -> None:
-    res = Resolver(arm)
+    # No lag bound: the model's own pose as `current` then gives the open-loop step.
+    res = Resolver(arm, gains=Gains(lag_periods=0.0))
     target = arm.forward(GOAL)
     r = res.step(list(Q), target.tolist())
     assert isinstance(r, softarm.StepResult)

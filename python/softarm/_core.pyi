@@ -120,6 +120,13 @@ class Gains:
     "smooth" (gamma * e^2 / (e^2 + d^2), the default). ``axis_mask`` selects the controlled
     orientation axes (x, y, z) of the base frame; the paper controls x and z.
     ``max_step`` (m) caps the task part of one increment (the joint-limit part at half).
+    ``lag_periods`` is the actuator lag (first-order time constant, sensor filter included,
+    in control periods) a closed-loop step must tolerate: with a measured pose and no
+    ``plant_q``, every alpha is capped at tanh(1 / (4 lag_periods)) (docs/control.md);
+    default 20. ``repulsion_gain`` (k_r), ``influence_distance`` (rho_0, m) and
+    ``body_radius`` (m) set the obstacle repulsion of planning paper eq. (9): a push of
+    k_r (1/g - 1/rho_0) / g^2 m per step on the closest arm point, g = distance -
+    body_radius. Every field is bounded (see ``Gains.validate`` in the Rust docs).
     """
 
     def __new__(
@@ -143,7 +150,19 @@ class Gains:
         singular_threshold: float = ...,
         limit_margin: float = ...,
         max_step: float = ...,
+        lag_periods: float = ...,
+        repulsion_gain: float = ...,
+        influence_distance: float = ...,
+        body_radius: float = ...,
     ) -> Gains: ...
+    @staticmethod
+    def for_lag(tau_s: float, period_s: float) -> Gains:
+        """The defaults with ``lag_periods = tau_s / period_s`` (tau_s in [0, 100] s, the
+        actuators' and the sensor filter's time constants summed)."""
+    @classmethod
+    def from_dict(cls, d: dict[str, object]) -> Gains:
+        """Gains from fields as ``as_dict`` returns them; missing ones keep the defaults."""
+    def __reduce__(self) -> tuple[object, tuple[dict[str, object]]]: ...
     @staticmethod
     def paper() -> Gains:
         """The paper's printed gains, eq. (23)-(25), read in the units above."""
@@ -189,6 +208,14 @@ class Gains:
     def limit_margin(self) -> float: ...
     @property
     def max_step(self) -> float: ...
+    @property
+    def lag_periods(self) -> float: ...
+    @property
+    def repulsion_gain(self) -> float: ...
+    @property
+    def influence_distance(self) -> float: ...
+    @property
+    def body_radius(self) -> float: ...
     def __eq__(self, value: object, /) -> bool: ...
     def __ne__(self, value: object, /) -> bool: ...
     __hash__: None  # type: ignore[assignment]
@@ -217,6 +244,10 @@ class StepResult:
     @property
     def orientation_error(self) -> float:
         """Masked ||e_zeta|| (rad) at the input state; 0 for a point target."""
+    @property
+    def clearance(self) -> float:
+        """Smallest surface gap (m) of the model arm at q to the obstacles within the
+        influence distance; inf when none is."""
 
 @final
 class Solution:
@@ -235,6 +266,10 @@ class Solution:
     @property
     def orientation_error(self) -> float:
         """Masked ||e_zeta|| at q (rad)."""
+    @property
+    def termination(self) -> str:
+        """Why the iteration stopped: "converged", "stuck" (a step left q unchanged, e.g.
+        the straight rest pose in position mode) or "step_limit"."""
 
 @final
 class Resolver:
@@ -255,11 +290,22 @@ class Resolver:
     @property
     def arm(self) -> SoftArm: ...
     def step(
-        self, q: _ArrayLike, target: _ArrayLike, current: _ArrayLike | None = None
+        self,
+        q: _ArrayLike,
+        target: _ArrayLike,
+        current: _ArrayLike | None = None,
+        *,
+        obstacles: object | None = None,
+        plant_q: _ArrayLike | None = None,
     ) -> StepResult:
         """One step from ``q`` towards ``target`` ((4, 4) pose, or (3,) point in
-        "position"/"conventional" mode); ``current`` is the measured pose (closed loop)
-        or None (the model's forward kinematics)."""
+        "position"/"conventional" mode); ``current`` is the measured pose (closed loop,
+        alpha capped by ``gains.lag_periods``) or None (the model's forward kinematics).
+        ``obstacles``: what ``closest`` takes (curves, segments, clouds, meshes, points), one
+        or a sequence; each repels the arm's body (arcs, plates, gripper) by eq. (9) in the
+        null space of every task. ``plant_q``: a :class:`LagModel`'s prediction of the
+        elongations reached; the measured error is then corrected by the motion still in
+        flight and alpha is not capped."""
     def solve(
         self,
         q0: _ArrayLike,
@@ -267,10 +313,26 @@ class Resolver:
         max_steps: int = 1000,
         position_tolerance: float = 0.0001,
         orientation_tolerance: float = ...,
+        *,
+        obstacles: object | None = None,
     ) -> Solution:
         """Steps on the model until the controlled errors are within tolerance (m, rad;
         default 0.1 mm and 0.1 deg) or ``max_steps``; an unreachable target returns
         ``converged=False`` with the best error. Releases the GIL."""
+
+@final
+class LagModel:
+    """First-order lag of the actuators, y <- y + (1 - exp(-T/tau)) (u - y): the predictor
+    (``plant_q``) of the lag-aware closed loop (docs/control.md)."""
+
+    def __new__(cls, tau_s: float, period_s: float, q0: _ArrayLike) -> LagModel: ...
+    @property
+    def q(self) -> _F64:
+        """Predicted elongations now (n,)."""
+    def advance(self, command: _ArrayLike) -> _F64:
+        """One period with ``command`` held; the predicted elongations after it."""
+    def reset(self, q: _ArrayLike) -> None:
+        """Settles the model at ``q``."""
 
 # --- distance queries and planning (planning paper eq. 9-18) -------------------------
 

@@ -2,7 +2,9 @@
 //! Jacobian included, ≤ 1 µs for the three-section arm).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use softarm_core::{Gains, Kinematics, Mode, Resolver, SoftArm, Target};
+use softarm_core::distance::{Obstacle, PolynomialCurve};
+use softarm_core::resolver::StepInput;
+use softarm_core::{Gains, Kinematics, Mode, Resolver, SoftArm, Target, Vec3};
 use std::hint::black_box;
 
 fn bench_steps(c: &mut Criterion) {
@@ -56,6 +58,51 @@ fn bench_steps(c: &mut Criterion) {
     c.bench_function("resolver/hybrid_step_allocating", |b| {
         b.iter(|| res.step(black_box(&mid), black_box(&near), None))
     });
+    bench_obstacles(c, &arm, &mid, &near);
+}
+
+/// Hybrid steps with 6 curved canes (vertical parabolas, planning paper eq. 10): all
+/// beyond the influence distance (the usual case, culled by bounding spheres), and one
+/// of them within it (one exact closest pair, its point Jacobian and pseudo-inverse).
+fn bench_obstacles(c: &mut Criterion, arm: &SoftArm, mid: &[f64; 9], near: &Target) {
+    let cane = |x: f64, y: f64| {
+        let coeffs = [
+            Vec3::new(x, y, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.03, 0.01, 0.0),
+        ];
+        match PolynomialCurve::new(&coeffs, (0.0, 0.6)) {
+            Ok(c) => Obstacle::Curve(c),
+            Err(e) => panic!("{e}"),
+        }
+    };
+    let far: Vec<Obstacle> = (0..6)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::PI / 3.0;
+            cane(0.25 * a.cos(), 0.25 * a.sin())
+        })
+        .collect();
+    let Ok((p, _)) = arm.point(mid, 1, 0.5) else {
+        panic!("point")
+    };
+    let mut one_near = far.clone();
+    one_near[0] = cane(p.x + 0.06, p.y);
+    let Ok(res) = Resolver::new(arm.clone(), Mode::Hybrid, Gains::blackberry()) else {
+        panic!("gains")
+    };
+    let mut ws = res.workspace();
+    let mut out = [0.0; 9];
+    for (name, obstacles) in [("far", &far), ("one_near", &one_near)] {
+        let input = StepInput {
+            obstacles,
+            ..StepInput::default()
+        };
+        c.bench_function(&format!("resolver/hybrid_step_6_curves_{name}"), |b| {
+            b.iter(|| {
+                res.step_input_into(&mut ws, black_box(mid), black_box(near), &input, &mut out)
+            })
+        });
+    }
 }
 
 criterion_group!(benches, bench_steps);

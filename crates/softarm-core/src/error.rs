@@ -51,6 +51,16 @@ pub enum Error {
         /// Why it is rejected.
         reason: String,
     },
+    /// A named choice (a mode, a schedule) is not one of the accepted names.
+    #[error("{arg} = {value:?}: {reason}")]
+    Choice {
+        /// Name of the argument.
+        arg: String,
+        /// The rejected name.
+        value: String,
+        /// What is accepted.
+        reason: String,
+    },
     /// A pose is malformed (non-finite, rotation not orthonormal, bad last row).
     #[error("{arg}: {reason}")]
     Pose {

@@ -394,7 +394,8 @@ fn every_error_path_is_typed_and_named() {
         | Error::NonFinite { arg, .. }
         | Error::Pose { arg, .. }
         | Error::Parameter { arg, .. }
-        | Error::OutOfRange { arg, .. } => arg,
+        | Error::OutOfRange { arg, .. }
+        | Error::Choice { arg, .. } => arg,
     };
     let e = res.step(&[0.0; 8], &good, None).unwrap_err();
     assert!(matches!(e, Error::Shape { .. }) && arg(e) == "q");

@@ -19,7 +19,7 @@ pub fn to_py(err: Error) -> PyErr {
         Error::Shape { .. } => ShapeError::new_err(msg),
         Error::NonFinite { .. } => NonFiniteError::new_err(msg),
         Error::OutOfRange { .. } => OutOfRangeError::new_err(msg),
-        Error::Parameter { .. } => ParameterError::new_err(msg),
+        Error::Parameter { .. } | Error::Choice { .. } => ParameterError::new_err(msg),
         Error::Pose { .. } => PoseError::new_err(msg),
     }
 }

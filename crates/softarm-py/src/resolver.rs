@@ -5,15 +5,17 @@ use nalgebra::{Matrix4, Vector3};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use softarm_core::distance::Obstacle;
 use softarm_core::resolver::{self as core, Mode, Schedule, SolveOptions, Target};
 use softarm_core::SoftArm as CoreArm;
 
 use crate::convert::{array, as_array, shape_str};
-use crate::errors::{IntoPyResult, ParameterError, ShapeError};
+use crate::distance::obstacle_from;
+use crate::errors::{InputError, IntoPyResult, ParameterError, ShapeError};
 use crate::kinematics::SoftArm;
 
 /// Every field name of `Gains`, in declaration order.
-const FIELDS: [&str; 18] = [
+const FIELDS: [&str; 22] = [
     "conventional_alpha",
     "position_alpha",
     "position_gamma",
@@ -32,6 +34,10 @@ const FIELDS: [&str; 18] = [
     "singular_threshold",
     "limit_margin",
     "max_step",
+    "lag_periods",
+    "repulsion_gain",
+    "influence_distance",
+    "body_radius",
 ];
 
 fn float_field<'a>(g: &'a mut core::Gains, name: &str) -> Option<&'a mut f64> {
@@ -52,6 +58,10 @@ fn float_field<'a>(g: &'a mut core::Gains, name: &str) -> Option<&'a mut f64> {
         "singular_threshold" => &mut g.singular_threshold,
         "limit_margin" => &mut g.limit_margin,
         "max_step" => &mut g.max_step,
+        "lag_periods" => &mut g.lag_periods,
+        "repulsion_gain" => &mut g.repulsion_gain,
+        "influence_distance" => &mut g.influence_distance,
+        "body_radius" => &mut g.body_radius,
         _ => return None,
     })
 }
@@ -178,6 +188,52 @@ impl Gains {
         self.inner.max_step
     }
 
+    #[getter]
+    fn lag_periods(&self) -> f64 {
+        self.inner.lag_periods
+    }
+
+    #[getter]
+    fn repulsion_gain(&self) -> f64 {
+        self.inner.repulsion_gain
+    }
+
+    #[getter]
+    fn influence_distance(&self) -> f64 {
+        self.inner.influence_distance
+    }
+
+    #[getter]
+    fn body_radius(&self) -> f64 {
+        self.inner.body_radius
+    }
+
+    /// The default gains for actuators lagging `tau_s` (s, sensor filter included)
+    /// behind commands sent every `period_s` (s): the closed-loop α cap at that lag.
+    #[staticmethod]
+    fn for_lag(tau_s: f64, period_s: f64) -> PyResult<Self> {
+        Ok(Gains {
+            inner: core::Gains::for_lag(tau_s, period_s).py()?,
+        })
+    }
+
+    /// Gains from a dict of fields (as `as_dict` returns); missing fields keep the
+    /// defaults.
+    #[classmethod]
+    fn from_dict(_cls: &Bound<'_, pyo3::types::PyType>, d: &Bound<'_, PyDict>) -> PyResult<Self> {
+        Ok(Gains {
+            inner: apply(core::Gains::blackberry(), Some(d))?,
+        })
+    }
+
+    /// Pickling and `copy.deepcopy`: rebuilt from `as_dict` through `from_dict`.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+        let from_dict = slf.get_type().getattr("from_dict")?;
+        Ok((from_dict, (slf.get().as_dict(slf.py())?,)))
+    }
+
     #[new]
     #[pyo3(signature = (**kwargs))]
     fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
@@ -289,6 +345,12 @@ impl StepResult {
     fn orientation_error(&self) -> f64 {
         self.info.orientation_error
     }
+    /// Smallest surface gap (m) to the obstacles within the influence distance; inf
+    /// when none is.
+    #[getter]
+    fn clearance(&self) -> f64 {
+        self.info.clearance
+    }
     fn __repr__(&self) -> String {
         format!(
             "StepResult(saturated={}, position_error={:.3e}, orientation_error={:.3e})",
@@ -330,13 +392,21 @@ impl Solution {
     fn orientation_error(&self) -> f64 {
         self.inner.orientation_error
     }
+    /// Why the iteration stopped: "converged", "stuck" (a step left q unchanged: the
+    /// resolver cannot leave it) or "step_limit".
+    #[getter]
+    fn termination(&self) -> &'static str {
+        self.inner.termination.name()
+    }
     fn __repr__(&self) -> String {
         format!(
-            "Solution(converged={}, steps={}, position_error={:.3e}, orientation_error={:.3e})",
+            "Solution(converged={}, steps={}, position_error={:.3e}, orientation_error={:.3e}, \
+             termination={:?})",
             self.inner.converged,
             self.inner.steps,
             self.inner.position_error,
-            self.inner.orientation_error
+            self.inner.orientation_error,
+            self.inner.termination.name()
         )
     }
 }
@@ -361,6 +431,46 @@ fn pose(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Matrix4<f64>> {
     let (flat, _) = array(obj, arg, &[Some(4), Some(4)])?;
     Ok(Matrix4::from_row_slice(&flat))
 }
+
+/// Reads `obstacles=`: None, or an iterable of obstacles (curves, segments, clouds,
+/// meshes, points (3,)). A lone obstacle object is accepted too.
+fn obstacle_list(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Obstacle>> {
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(Vec::new());
+    };
+    if let Ok(one) = obstacle_from(obj, "obstacles") {
+        // A single obstacle object; a bare (3,) array reads as one point.
+        let is_seq_of_points = obj
+            .getattr("ndim")
+            .and_then(|d| d.extract::<usize>())
+            .is_ok_and(|d| d > 1);
+        if !is_seq_of_points {
+            return Ok(vec![one]);
+        }
+    }
+    let iter = obj.try_iter().map_err(|_| {
+        InputError::new_err(format!(
+            "obstacles: expected a sequence of obstacles, got {}",
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })?;
+    let mut out = Vec::new();
+    for (i, item) in iter.enumerate() {
+        if i >= MAX_OBSTACLES {
+            return Err(crate::errors::OutOfRangeError::new_err(format!(
+                "obstacles: more than {MAX_OBSTACLES} obstacles"
+            )));
+        }
+        out.push(obstacle_from(&item?, &format!("obstacles[{i}]"))?);
+    }
+    Ok(out)
+}
+
+/// Most obstacles one step takes (each costs an exact distance query per step).
+const MAX_OBSTACLES: usize = 10_000;
 
 /// Gain-scheduled task-priority resolver for a `SoftArm`.
 #[pyclass(module = "softarm._core", frozen)]
@@ -402,19 +512,36 @@ impl Resolver {
         }
     }
 
-    /// One step from `q` towards `target`; `current` is the measured pose or None.
-    #[pyo3(signature = (q, target, current = None))]
+    /// One step from `q` towards `target`; `current` is the measured pose or None;
+    /// `obstacles` repel the arm (eq. 9, below every task); `plant_q` is a lag model's
+    /// prediction of the elongations reached (Smith predictor).
+    #[pyo3(signature = (q, target, current = None, *, obstacles = None, plant_q = None))]
     fn step(
         &self,
         q: &Bound<'_, PyAny>,
         target: &Bound<'_, PyAny>,
         current: Option<&Bound<'_, PyAny>>,
+        obstacles: Option<&Bound<'_, PyAny>>,
+        plant_q: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<StepResult> {
         let n = softarm_core::chain::SectionModel::n_dofs(self.inner.arm());
         let q = crate::convert::vector(q, "q", n)?;
         let t = self::target(target)?;
-        let current = current.map(|c| pose(c, "current")).transpose()?;
-        let s = self.inner.step(&q, &t, current.as_ref()).py()?;
+        let current = current
+            .filter(|c| !c.is_none())
+            .map(|c| pose(c, "current"))
+            .transpose()?;
+        let plant_q = plant_q
+            .filter(|p| !p.is_none())
+            .map(|p| crate::convert::vector(p, "plant_q", n))
+            .transpose()?;
+        let obstacles = obstacle_list(obstacles)?;
+        let input = core::StepInput {
+            current: current.as_ref(),
+            plant_q: plant_q.as_deref(),
+            obstacles: &obstacles,
+        };
+        let s = self.inner.step_with(&q, &t, &input).py()?;
         Ok(StepResult {
             q: s.q,
             unclamped: s.unclamped,
@@ -424,7 +551,8 @@ impl Resolver {
 
     /// Iterates steps on the model to tolerance. Releases the GIL.
     #[pyo3(signature = (q0, target, max_steps = 1000, position_tolerance = 1e-4,
-                        orientation_tolerance = 0.1f64.to_radians()))]
+                        orientation_tolerance = 0.1f64.to_radians(), *, obstacles = None))]
+    #[allow(clippy::too_many_arguments)]
     fn solve(
         &self,
         py: Python<'_>,
@@ -433,7 +561,9 @@ impl Resolver {
         max_steps: i64,
         position_tolerance: f64,
         orientation_tolerance: f64,
+        obstacles: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Solution> {
+        let obstacles = obstacle_list(obstacles)?;
         let n = softarm_core::chain::SectionModel::n_dofs(self.inner.arm());
         let q0 = crate::convert::vector(q0, "q0", n)?;
         let t = self::target(target)?;
@@ -448,12 +578,65 @@ impl Resolver {
             orientation_tolerance,
         };
         let res = &self.inner;
-        let sol = py.detach(|| res.solve(&q0, &t, &opts)).py()?;
+        let sol = py
+            .detach(|| res.solve_with(&q0, &t, &opts, &obstacles))
+            .py()?;
         Ok(Solution { inner: sol })
     }
 
     fn __repr__(&self) -> String {
         format!("Resolver(mode={:?})", self.inner.mode().name())
+    }
+}
+
+/// A first-order lag model of the actuators (the predictor of the lag-aware loop).
+#[pyclass(module = "softarm._core")]
+pub struct LagModel {
+    inner: core::LagModel,
+}
+
+#[pymethods]
+impl LagModel {
+    #[new]
+    fn new(tau_s: f64, period_s: f64, q0: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (q0, _) = array(q0, "q0", &[None])?;
+        if q0.is_empty() || q0.len() > 1024 {
+            return Err(ShapeError::new_err(format!(
+                "q0: expected 1 to 1024 elongations, got {}",
+                q0.len()
+            )));
+        }
+        Ok(LagModel {
+            inner: core::LagModel::new(tau_s, period_s, &q0).py()?,
+        })
+    }
+    /// Predicted elongations now (n,).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.state())
+    }
+    /// One period with `command` held; returns the predicted elongations after it.
+    fn advance<'py>(
+        &mut self,
+        py: Python<'py>,
+        command: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.inner.state().len();
+        let c = crate::convert::vector(command, "command", n)?;
+        Ok(PyArray1::from_slice(py, self.inner.advance(&c).py()?))
+    }
+    /// Settles the model at `q`.
+    fn reset(&mut self, q: &Bound<'_, PyAny>) -> PyResult<()> {
+        let n = self.inner.state().len();
+        let q = crate::convert::vector(q, "q", n)?;
+        self.inner.reset(&q).py()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "LagModel(tau_s={}, period_s={})",
+            self.inner.tau_s(),
+            self.inner.period_s()
+        )
     }
 }
 
@@ -463,5 +646,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Resolver>()?;
     m.add_class::<StepResult>()?;
     m.add_class::<Solution>()?;
+    m.add_class::<LagModel>()?;
     Ok(())
 }

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from softarm._core import Resolver
+from softarm._core import Gains, Resolver
 from softarm.sim.arm import SimulatedArm
 from softarm.sim.pressure import to_psi
 from softarm.units import METRES_PER_PSI
@@ -18,6 +18,14 @@ F64 = npt.NDArray[np.float64]
 
 #: Control period (s): one resolver step per tracker sample.
 CONTROL_PERIOD = 0.05
+
+
+def declared_gains(plant: SimulatedArm, period: float = CONTROL_PERIOD) -> Gains:
+    """The resolver's default gains with the plant's lag declared (regulators + the
+    tracker's low-pass filter): the closed-loop gain cap of ``Gains.for_lag``
+    (docs/control.md) at that lag rather than the defaults' 20 periods."""
+    cfg = plant.config
+    return Gains.for_lag(cfg.pressure_tau + 1.0 / cfg.cutoff, period)
 
 
 def orientation_error(judge: Resolver, q: F64, target: F64, pose: F64) -> float:

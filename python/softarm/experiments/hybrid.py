@@ -11,7 +11,12 @@ from typing import Any
 import numpy as np
 
 from softarm._core import Gains, Resolver
-from softarm.experiments.common import bush_pressures, closed_loop, start_configuration
+from softarm.experiments.common import (
+    bush_pressures,
+    closed_loop,
+    declared_gains,
+    start_configuration,
+)
 from softarm.experiments.output import mean_std, plot_comparison, write_csv, write_json
 from softarm.sim.arm import SimulatedArm
 
@@ -24,7 +29,7 @@ def run(
     plant = SimulatedArm(seed=seed)
     rng = np.random.default_rng(seed + 3)
     count, duration = (3, 20.0) if quick else (7, 40.0)
-    gains = gains if gains is not None else Gains.default_for(plant.model)
+    gains = gains if gains is not None else declared_gains(plant)
     controllers = {
         "with limits": (Resolver(plant.model, "hybrid", gains), True),
         "without limits": (Resolver(plant.model, "hybrid", gains.replace(hybrid_gamma=0.0)), True),

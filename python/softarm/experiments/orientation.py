@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from softarm._core import Gains, Resolver
-from softarm.experiments.common import closed_loop, start_configuration
+from softarm.experiments.common import closed_loop, declared_gains, start_configuration
 from softarm.experiments.output import (
     mean_std,
     plot_comparison,
@@ -42,7 +42,7 @@ def run(
     plant = SimulatedArm(seed=seed)
     rng = np.random.default_rng(seed + 2)
     count, duration = (5, 20.0) if quick else (15, 30.0)
-    gains = gains if gains is not None else Gains.default_for(plant.model)
+    gains = gains if gains is not None else declared_gains(plant)
     proposed = Resolver(plant.model, "orientation", gains)
     conventional = Resolver(plant.model, "orientation", gains.replace(orientation_gamma=0.0))
     home = plant.true_arm.forward(np.zeros(plant.n))

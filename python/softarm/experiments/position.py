@@ -10,7 +10,12 @@ from typing import Any
 import numpy as np
 
 from softarm._core import Gains, Resolver
-from softarm.experiments.common import bush_pressures, closed_loop, start_configuration
+from softarm.experiments.common import (
+    bush_pressures,
+    closed_loop,
+    declared_gains,
+    start_configuration,
+)
 from softarm.experiments.output import (
     mean_std,
     plot_comparison,
@@ -30,7 +35,7 @@ def run(
     plant = SimulatedArm(seed=seed)
     rng = np.random.default_rng(seed + 1)
     count, duration = (8, 20.0) if quick else (35, 30.0)
-    gains = gains if gains is not None else Gains.default_for(plant.model)
+    gains = gains if gains is not None else declared_gains(plant)
     proposed = Resolver(plant.model, "position", gains)
     conventional = Resolver(plant.model, "conventional", gains)
     rows = []

@@ -13,7 +13,12 @@ from typing import Any
 import numpy as np
 
 from softarm._core import Gains, Resolver
-from softarm.experiments.common import bush_pressures, closed_loop, start_configuration
+from softarm.experiments.common import (
+    bush_pressures,
+    closed_loop,
+    declared_gains,
+    start_configuration,
+)
 from softarm.experiments.output import write_csv, write_json
 from softarm.sim.arm import SimulatedArm
 
@@ -39,7 +44,7 @@ def run(
         for p in bush_pressures(plant, rng, count):
             cases.append((plant, p, start_configuration(rng, plant.n)))
     model = cases[0][0].model
-    base = gains if gains is not None else Gains.default_for(model)
+    base = gains if gains is not None else declared_gains(cases[0][0])
     for mode in ("position", "hybrid"):
         for schedule in ("step", "smooth"):
             res = Resolver(model, mode, base.replace(schedule=schedule))

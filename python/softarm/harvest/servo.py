@@ -94,10 +94,12 @@ class Servo:
         """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose.
 
         With a ``planner`` the pose (and the approach axis, inside the allowed cone) is
-        first solved on the model and reached open loop; the loop then closes on the
-        cameras (eq. 22) to remove the model's error.
+        first solved on the model; the plan's waypoints are then followed in closed loop
+        (:meth:`follow`, the canes repelling inside the resolver) and the loop closes on
+        the berry (eq. 22) to remove the model's error.
         """
         c = self.cfg
+        start = self.clock.now()
         if planner is not None:
             seen = self._observe()
             while seen.pose is None or seen.fix is None:
@@ -110,7 +112,7 @@ class Servo:
             self._waypoints = list(waypoints)
             self.log.event("plan", t=seen.t, q=waypoints, axis=self.axis, berry=seen.fix.position)
             for q_way in waypoints:
-                q = self.ramp(q, q_way, observe=True)
+                q = self.follow(q, q_way, start + c.placement_timeout)
         return self._servo(
             q, c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout, None
         )
@@ -145,6 +147,51 @@ class Servo:
         for q_way in reversed(self._waypoints):
             q = self.ramp(q, q_way, start + c.home_timeout)
         return self.ramp(q, home, start + c.home_timeout)
+
+    def follow(self, q: FloatArray, q_way: FloatArray, deadline: float) -> FloatArray:
+        """Closed loop on the eye-to-hand camera to the pose the model puts at the planned
+        elongations ``q_way``, until the end effector is within ``placement_tolerance`` of
+        it: the resolver corrects the model's error as it goes and the known canes repel
+        the arm inside it (planning paper eq. 9), where an open-loop ramp would carry the
+        true arm, a few cm off the model, into a cane. A controller without a model
+        (``model_pose``) falls back to :meth:`ramp`."""
+        model_pose = getattr(self.controller, "model_pose", None)
+        if model_pose is None:
+            return self.ramp(q, q_way, deadline, observe=True)
+        c = self.cfg
+        goal = model_pose(q_way)
+        best, best_t = np.inf, self.clock.now()
+        while True:
+            seen = self._observe(need_fix=False)
+            if seen.pose is None:
+                self._log_step(seen, q, None, None, False)
+                self._hold(q)
+                continue
+            err = float(np.linalg.norm(seen.pose[:3, 3] - goal[:3, 3]))
+            if err <= c.placement_tolerance:
+                return q
+            if err < best - c.stall_progress:
+                best, best_t = err, seen.t
+            elif seen.t - best_t > c.stall_time:
+                # The true arm cannot reach the model's pose of this waypoint (a limit, a
+                # cane's repulsion): it is only a waypoint, the loop on the berry follows.
+                self.log.event("waypoint_stalled", t=seen.t, error=err)
+                return q
+            if seen.t > deadline:
+                raise Fault(
+                    FaultReason.TIMEOUT,
+                    f"{self.state.value}: waypoint not reached, error {err:.4f} m",
+                )
+            q_next, saturated = self.controller.step(q, goal, seen.pose)
+            q_next = np.asarray(q_next, dtype=np.float64)
+            if not np.all(np.isfinite(q_next)):
+                raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
+            self._log_step(
+                seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
+            )
+            self.actuator.send(q_next)
+            q = q_next
+            self.clock.sleep(c.period)
 
     def ramp(
         self, q: FloatArray, goal: FloatArray, deadline: float = np.inf, observe: bool = False

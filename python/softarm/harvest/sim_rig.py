@@ -14,12 +14,11 @@ from pathlib import Path
 import numpy as np
 
 import softarm
-from softarm._core import Resolver
+from softarm._core import Gains, Resolver
 from softarm.calibration.result import Calibration
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator
-from softarm.harvest.avoidance import CaneRepulsion
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
@@ -47,8 +46,9 @@ class SimRigOptions:
 
     ``scale`` shrinks both images (and focal lengths) for speed; ``hidden`` occludes the
     selected berry from both cameras at the times it returns True (a leaf);
-    ``avoid_canes`` adds the canes' repulsion (planning paper eq. 9) in the resolver's
-    null space; ``joint_limit_gain`` overrides the closed-loop resolver's γ of eq. (20).
+    ``avoid_canes`` passes the canes to the resolver as obstacles (planning paper eq. 9,
+    below position and orientation); ``joint_limit_gain`` overrides the closed-loop
+    resolver's γ of eq. (20).
     """
 
     n_berries: int = 5
@@ -189,13 +189,15 @@ def build_sim_rig(
     )  # fmt: skip
     gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
     if controller is None:
-        resolver = (
-            Resolver(model, mode="hybrid")
-            if o.joint_limit_gain is None
-            else planning_resolver(model, o.joint_limit_gain)
-        )
-        avoid = CaneRepulsion(model, canes) if o.avoid_canes else None
-        controller = ResolverController(resolver, avoid)
+        # The plant's lag, measured by `softarm identify` when given, else declared by the
+        # plant description (its regulators' time constant, as a datasheet states it): the
+        # closed-loop gain of the resolver at its bound for that lag (docs/control.md).
+        lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
+        gains = Gains.for_lag(lag, cfg.period)
+        if o.joint_limit_gain is not None:
+            gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
+        resolver = Resolver(model, mode="hybrid", gains=gains)
+        controller = ResolverController(resolver, canes if o.avoid_canes else ())
     machine = HarvestMachine(
         clock,
         vision,

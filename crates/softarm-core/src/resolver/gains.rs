@@ -47,16 +47,16 @@ impl Schedule {
     /// Parses `"step"` or `"smooth"`.
     ///
     /// # Errors
-    /// [`Error::Parameter`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn parse(name: &str) -> Result<Self> {
         match name {
             "step" => Ok(Schedule::Step),
             "smooth" => Ok(Schedule::Smooth),
-            _ => Err(Error::parameter(
-                "schedule",
-                f64::NAN,
-                format!("unknown schedule {name:?}; expected \"step\" or \"smooth\""),
-            )),
+            _ => Err(Error::Choice {
+                arg: "schedule".to_owned(),
+                value: name.to_owned(),
+                reason: "unknown schedule; expected \"step\" or \"smooth\"".to_owned(),
+            }),
         }
     }
 
@@ -113,6 +113,43 @@ pub struct Gains {
     /// shortened along its direction. The joint-limit part is capped at half of it.
     /// `f64::INFINITY` disables both caps.
     pub max_step: f64,
+    /// First-order lag of the actuators, sensor filter included, in control periods
+    /// (`τ / T`), that a closed-loop step (one given a measured pose) must tolerate. Each
+    /// mode's α is then capped at [`lag_alpha`]`(lag_periods)`, the largest gain for
+    /// which an integrator behind that lag does not overshoot (see `docs/control.md`).
+    /// 0 = no lag: no cap. Steps on the model (no measurement, and `solve`) are not capped.
+    pub lag_periods: f64,
+    /// `k_r` of the repulsion law (planning paper eq. 9): the closest arm point of an
+    /// obstacle is pushed away by `k_r (1/g − 1/ρ₀) / g²` metres per step, with `g` the
+    /// surface gap (clamped at 1 mm) and ρ₀ = `influence_distance` (m⁴ per step).
+    pub repulsion_gain: f64,
+    /// ρ₀ of eq. (9): surface gap (m) below which an obstacle repels.
+    pub influence_distance: f64,
+    /// Distance (m) from the arm's backbone to the surfaces that must not touch, the
+    /// obstacle's own radius included: the surface gap is the exact backbone distance
+    /// minus this.
+    pub body_radius: f64,
+}
+
+/// Lag the default gains tolerate in closed loop (control periods): 20, i.e. 1 s at the
+/// 50 ms period of the harvest, the slow end of pneumatic regulators behind long hoses.
+pub const DEFAULT_LAG_PERIODS: f64 = 20.0;
+
+/// The largest integrator gain α that keeps the loop `u ← u + α e` around a first-order
+/// lag of `lag_periods` control periods free of overshoot: `tanh(1 / (4 N))`.
+///
+/// Derivation (docs/control.md): with `a = exp(−1/N)` the closed loop has the
+/// characteristic polynomial `z² − (1 + a − α(1 − a)) z + a`; it is stable for
+/// `α < 2(1 + a)/(1 − a)`, but its poles are real (no overshoot, hence no limit cycle
+/// through play hysteresis) only for `α ≤ (1 − √a)/(1 + √a) = tanh(1/(4N))`, where both
+/// poles sit at `√a`, the fastest decay the lag allows. `N = 0` gives 1.
+#[inline]
+pub fn lag_alpha(lag_periods: f64) -> f64 {
+    if lag_periods <= 0.0 {
+        1.0
+    } else {
+        (0.25 / lag_periods).tanh()
+    }
 }
 
 impl Gains {
@@ -141,6 +178,10 @@ impl Gains {
             singular_threshold: 0.05,
             limit_margin: 0.01,
             max_step: 0.005,
+            lag_periods: 0.0,
+            repulsion_gain: 1.5e-9,
+            influence_distance: 0.03,
+            body_radius: 0.04,
         }
     }
 
@@ -166,70 +207,185 @@ impl Gains {
             singular_threshold: 0.05,
             limit_margin: 0.01,
             max_step: 0.004,
+            lag_periods: DEFAULT_LAG_PERIODS,
+            // 1 mm per step at a 1 cm gap, 0 at 3 cm (ρ₀).
+            repulsion_gain: 1.5e-9,
+            influence_distance: 0.03,
+            // Largest section radius (28 mm) + actuator (8 mm) + a cane (5 mm).
+            body_radius: 0.041,
         }
     }
 
-    /// Checks every field.
+    /// [`Gains::blackberry`] for a plant whose actuators (sensor filter included) lag
+    /// with time constant `tau_s` behind commands sent every `period_s` seconds: the
+    /// closed-loop α cap of [`lag_alpha`] at `tau_s / period_s` periods instead of the
+    /// default's 20.
     ///
     /// # Errors
-    /// [`Error::Parameter`] naming the first invalid field: α not in (0, 2], a γ task
-    /// weight negative or non-finite, a joint-limit weight positive or non-finite, a
-    /// switch distance negative, damping or threshold negative, margin not in [0, 0.5),
-    /// `max_step` not positive.
-    pub fn validate(&self) -> Result<()> {
-        for (name, v) in [
-            ("conventional_alpha", self.conventional_alpha),
-            ("position_alpha", self.position_alpha),
-            ("orientation_alpha", self.orientation_alpha),
-            ("hybrid_alpha", self.hybrid_alpha),
-        ] {
-            if !(v > 0.0 && v <= 2.0) {
-                return Err(Error::parameter(name, v, "must lie in (0, 2]"));
-            }
+    /// [`Error::Parameter`] for a `tau_s` not in [0, 100] s or a `period_s` not in
+    /// (0, 10] s.
+    pub fn for_lag(tau_s: f64, period_s: f64) -> Result<Self> {
+        if !(0.0..=100.0).contains(&tau_s) {
+            return Err(Error::parameter("tau_s", tau_s, "must lie in [0, 100] s"));
         }
-        for (name, v) in [
-            ("hybrid_position", self.hybrid_position),
-            ("hybrid_orientation", self.hybrid_orientation),
-            ("position_switch", self.position_switch),
-            ("orientation_switch", self.orientation_switch),
-            ("hybrid_switch", self.hybrid_switch),
-            ("damping", self.damping),
-            ("singular_threshold", self.singular_threshold),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::parameter(name, v, "must be finite and >= 0"));
-            }
-        }
-        for (name, v) in [
-            ("position_gamma", self.position_gamma),
-            ("orientation_gamma", self.orientation_gamma),
-            ("hybrid_gamma", self.hybrid_gamma),
-        ] {
-            if !(v.is_finite() && v <= 0.0) {
-                return Err(Error::parameter(
-                    name,
-                    v,
-                    "must be finite and <= 0 (a negative weight descends H)",
-                ));
-            }
-        }
-        if !(self.limit_margin >= 0.0 && self.limit_margin < 0.5) {
+        if !(period_s > 0.0 && period_s <= 10.0) {
             return Err(Error::parameter(
+                "period_s",
+                period_s,
+                "must lie in (0, 10] s",
+            ));
+        }
+        let g = Gains {
+            lag_periods: tau_s / period_s,
+            ..Gains::blackberry()
+        };
+        g.validate()?;
+        Ok(g)
+    }
+
+    /// The α of `mode`'s step, capped at [`lag_alpha`] when the step closes the loop
+    /// through the plant (`closed_loop`) and no predictor accounts for the lag.
+    pub fn effective_alpha(&self, alpha: f64, closed_loop: bool) -> f64 {
+        if closed_loop {
+            alpha.min(lag_alpha(self.lag_periods))
+        } else {
+            alpha
+        }
+    }
+
+    /// Checks every field against a physically meaningful range (so that no step can
+    /// overflow into a non-finite command).
+    ///
+    /// # Errors
+    /// [`Error::Parameter`] naming the first invalid field: an α not in (0, 2]; a task
+    /// weight (γ₄, γ₆) not in [0, 10]; a joint-limit weight (γ₂, γ₃, γ₅) not in [−1, 0] m²;
+    /// a position switch distance not in [0, 10] m or the orientation one not in [0, π];
+    /// damping or threshold not in [0, 1]; `limit_margin` not in [1e-6, 0.45]; `max_step`
+    /// not in (0, 1] m or infinite; `lag_periods` not in [0, 10 000]; `repulsion_gain` not in
+    /// [0, 1e-3]; `influence_distance` or `body_radius` not in [0, 1] m.
+    pub fn validate(&self) -> Result<()> {
+        let pi = std::f64::consts::PI;
+        let ranges: [(&str, f64, f64, f64, &str); 20] = [
+            (
+                "conventional_alpha",
+                self.conventional_alpha,
+                0.0,
+                2.0,
+                "(0, 2]",
+            ),
+            ("position_alpha", self.position_alpha, 0.0, 2.0, "(0, 2]"),
+            (
+                "orientation_alpha",
+                self.orientation_alpha,
+                0.0,
+                2.0,
+                "(0, 2]",
+            ),
+            ("hybrid_alpha", self.hybrid_alpha, 0.0, 2.0, "(0, 2]"),
+            (
+                "hybrid_position",
+                self.hybrid_position,
+                0.0,
+                10.0,
+                "[0, 10]",
+            ),
+            (
+                "hybrid_orientation",
+                self.hybrid_orientation,
+                0.0,
+                10.0,
+                "[0, 10]",
+            ),
+            (
+                "position_gamma",
+                self.position_gamma,
+                -1.0,
+                0.0,
+                "[-1, 0] m² (a negative weight descends H)",
+            ),
+            (
+                "orientation_gamma",
+                self.orientation_gamma,
+                -1.0,
+                0.0,
+                "[-1, 0] m² (a negative weight descends H)",
+            ),
+            (
+                "hybrid_gamma",
+                self.hybrid_gamma,
+                -1.0,
+                0.0,
+                "[-1, 0] m² (a negative weight descends H)",
+            ),
+            (
+                "position_switch",
+                self.position_switch,
+                0.0,
+                10.0,
+                "[0, 10] m",
+            ),
+            ("hybrid_switch", self.hybrid_switch, 0.0, 10.0, "[0, 10] m"),
+            (
+                "orientation_switch",
+                self.orientation_switch,
+                0.0,
+                pi,
+                "[0, π] rad",
+            ),
+            ("damping", self.damping, 0.0, 1.0, "[0, 1]"),
+            (
+                "singular_threshold",
+                self.singular_threshold,
+                0.0,
+                1.0,
+                "[0, 1]",
+            ),
+            // Below ~1e-6 of the range, ∇H at the band's edge (∝ 1/margin²) is no longer a
+            // meaningful number; 0 would make it infinite.
+            (
                 "limit_margin",
                 self.limit_margin,
-                "must lie in [0, 0.5)",
-            ));
-        }
-        if self.limit_margin == 0.0 {
-            // ∇H is infinite at a limit; a zero margin would let it blow up.
-            return Err(Error::parameter(
-                "limit_margin",
+                1e-6,
+                0.45,
+                "[1e-6, 0.45]",
+            ),
+            (
+                "lag_periods",
+                self.lag_periods,
                 0.0,
-                "must be > 0 (∇H is infinite at a limit)",
-            ));
-        }
-        if self.max_step.is_nan() || self.max_step <= 0.0 {
-            return Err(Error::parameter("max_step", self.max_step, "must be > 0"));
+                1e4,
+                "[0, 10000] control periods",
+            ),
+            ("max_step", self.max_step, 0.0, 1.0, "(0, 1] m or inf"),
+            (
+                "repulsion_gain",
+                self.repulsion_gain,
+                0.0,
+                1e-3,
+                "[0, 1e-3] m⁴",
+            ),
+            (
+                "influence_distance",
+                self.influence_distance,
+                0.0,
+                1.0,
+                "[0, 1] m",
+            ),
+            ("body_radius", self.body_radius, 0.0, 1.0, "[0, 1] m"),
+        ];
+        for (name, v, lo, hi, text) in ranges {
+            // α and max_step exclude their lower bound; max_step also accepts +inf (no cap).
+            let open_low = name.ends_with("_alpha") || name == "max_step";
+            let ok = if name == "max_step" && v == f64::INFINITY {
+                true
+            } else if open_low {
+                v > lo && v <= hi
+            } else {
+                v >= lo && v <= hi
+            };
+            if !ok {
+                return Err(Error::parameter(name, v, format!("must lie in {text}")));
+            }
         }
         Ok(())
     }

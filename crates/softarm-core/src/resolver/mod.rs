@@ -25,16 +25,19 @@
 //! assert!(sol.converged && sol.position_error < 1e-4);
 //! ```
 
+pub mod avoid;
 pub mod gains;
 pub mod joint_limits;
+pub mod lag;
 pub mod orientation;
 pub mod pinv;
 mod solve;
 mod step;
 
-pub use gains::{Gains, Schedule};
-pub use solve::{Solution, SolveOptions};
-pub use step::{StepInfo, Workspace};
+pub use gains::{lag_alpha, Gains, Schedule};
+pub use lag::LagModel;
+pub use solve::{Solution, SolveOptions, SolveTermination};
+pub use step::{StepInfo, StepInput, Workspace};
 
 use crate::error::{Error, Result};
 use crate::kinematics::Kinematics;
@@ -57,21 +60,20 @@ impl Mode {
     /// Parses `"conventional" | "position" | "orientation" | "hybrid"`.
     ///
     /// # Errors
-    /// [`Error::Parameter`] naming `mode` for any other string.
+    /// [`Error::Choice`] naming `mode` and the string for any other one.
     pub fn parse(name: &str) -> Result<Self> {
         match name {
             "conventional" => Ok(Mode::Conventional),
             "position" => Ok(Mode::Position),
             "orientation" => Ok(Mode::Orientation),
             "hybrid" => Ok(Mode::Hybrid),
-            _ => Err(Error::parameter(
-                "mode",
-                f64::NAN,
-                format!(
-                    "unknown mode {name:?}; expected \"conventional\", \"position\", \
-                     \"orientation\" or \"hybrid\""
-                ),
-            )),
+            _ => Err(Error::Choice {
+                arg: "mode".to_owned(),
+                value: name.to_owned(),
+                reason: "unknown mode; expected \"conventional\", \"position\", \
+                         \"orientation\" or \"hybrid\""
+                    .to_owned(),
+            }),
         }
     }
 

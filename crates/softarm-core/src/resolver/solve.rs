@@ -1,6 +1,8 @@
 //! Iterating steps to tolerance with the model alone.
 
+use super::step::StepInput;
 use super::{Mode, Resolver, Target};
+use crate::distance::Obstacle;
 use crate::error::{Error, Result};
 use crate::kinematics::Kinematics;
 
@@ -26,6 +28,31 @@ impl Default for SolveOptions {
     }
 }
 
+/// Why [`Resolver::solve`] stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolveTermination {
+    /// Every controlled error is within its tolerance.
+    Converged,
+    /// A step left the configuration unchanged: the resolver cannot leave it (a singular
+    /// configuration, such as the straight rest pose in position mode, where the
+    /// position Jacobian loses the rank the error needs, or every coordinate that would
+    /// help held at a limit). More steps would change nothing.
+    Stuck,
+    /// `max_steps` steps were taken without reaching the tolerances.
+    StepLimit,
+}
+
+impl SolveTermination {
+    /// Lower-case name: "converged", "stuck", "step_limit".
+    pub fn name(&self) -> &'static str {
+        match self {
+            SolveTermination::Converged => "converged",
+            SolveTermination::Stuck => "stuck",
+            SolveTermination::StepLimit => "step_limit",
+        }
+    }
+}
+
 /// The result of [`Resolver::solve`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solution {
@@ -39,6 +66,8 @@ pub struct Solution {
     pub position_error: f64,
     /// Masked ‖e_ζ‖ at `q` (rad); 0 for a point target.
     pub orientation_error: f64,
+    /// Why the iteration stopped.
+    pub termination: SolveTermination,
 }
 
 impl<K: Kinematics> Resolver<K> {
@@ -51,6 +80,21 @@ impl<K: Kinematics> Resolver<K> {
     /// As [`Resolver::step_into`]; [`Error::Parameter`] for a tolerance that is not
     /// positive and finite.
     pub fn solve(&self, q0: &[f64], target: &Target, opts: &SolveOptions) -> Result<Solution> {
+        self.solve_with(q0, target, opts, &[])
+    }
+
+    /// [`Resolver::solve`] with `obstacles` repelling the model arm at every step
+    /// (planning paper eq. 9, below every task; see [`super::avoid`]).
+    ///
+    /// # Errors
+    /// As [`Resolver::solve`].
+    pub fn solve_with(
+        &self,
+        q0: &[f64],
+        target: &Target,
+        opts: &SolveOptions,
+        obstacles: &[Obstacle],
+    ) -> Result<Solution> {
         for (name, v) in [
             ("position_tolerance", opts.position_tolerance),
             ("orientation_tolerance", opts.orientation_tolerance),
@@ -84,8 +128,13 @@ impl<K: Kinematics> Resolver<K> {
         let mut next = vec![0.0; q.len()];
         let mut best: Option<Solution> = None;
         let mut best_score = f64::INFINITY;
+        let input = StepInput {
+            obstacles,
+            ..StepInput::default()
+        };
+        let mut termination = SolveTermination::StepLimit;
         for k in 0..=opts.max_steps {
-            let info = self.step_into(&mut ws, &q, target, None, &mut next)?;
+            let info = self.step_input_into(&mut ws, &q, target, &input, &mut next)?;
             let s = score(info.position_error, info.orientation_error);
             if s < best_score || best.is_none() {
                 best_score = s;
@@ -95,14 +144,27 @@ impl<K: Kinematics> Resolver<K> {
                     steps: k,
                     position_error: info.position_error,
                     orientation_error: info.orientation_error,
+                    termination,
                 });
             }
-            if s <= 1.0 || !s.is_finite() {
+            if s <= 1.0 {
+                termination = SolveTermination::Converged;
+                break;
+            }
+            if next == q {
+                termination = SolveTermination::Stuck;
                 break;
             }
             std::mem::swap(&mut q, &mut next);
         }
-        best.ok_or_else(|| Error::parameter("max_steps", 0.0, "no step was taken"))
+        let mut sol =
+            best.ok_or_else(|| Error::parameter("max_steps", 0.0, "no step was taken"))?;
+        sol.termination = if sol.converged {
+            SolveTermination::Converged
+        } else {
+            termination
+        };
+        Ok(sol)
     }
 
     fn arm_clamp(&self, q: &mut [f64]) {
