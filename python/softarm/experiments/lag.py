@@ -88,6 +88,7 @@ def run_one(
     res = controller(name, plant.model, tau_total, period)
     lo, hi = plant.model.lower, plant.model.upper
     lag = LagModel(tau_total, period, q0) if name == "predictor" else None
+    judge = Resolver(plant.model, mode="hybrid")  # reads the core's masked orientation error
     q = np.asarray(q0, dtype=np.float64).copy()
     measured = plant.reset(q)
     ep, eo = [], []
@@ -102,7 +103,7 @@ def run_one(
             lag.advance(q)
         true = plant.true_pose()
         ep.append(float(np.linalg.norm(target[:3, 3] - true[:3, 3])))
-        eo.append(orientation_error(target, true))
+        eo.append(orientation_error(judge, q, target, true))
     e_p, e_o = np.asarray(ep), np.asarray(eo)
     bad = np.nonzero((e_p > POSITION_TOL) | (e_o > ANGLE_TOL))[0]
     window = round(2.0 / period)

@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import Resolver, SoftArm
+from softarm.geometry import cone_axes
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.targets import approach_pose
@@ -34,21 +35,6 @@ def planning_resolver(model: SoftArm, joint_limit_gain: float = -1e-3) -> Resolv
     sit mid-range, where the true arm (a few % off the model) can still reach them."""
     gains = Resolver(model, mode="hybrid").gains.replace(hybrid_gamma=joint_limit_gain)
     return Resolver(model, mode="hybrid", gains=gains)
-
-
-def cone_axes(axis: FloatArray, cone_deg: float, rings: int = 2, per_ring: int = 8) -> FloatArray:
-    """(1 + rings * per_ring, 3) unit axes: ``axis``, then rings at growing angles up to
-    ``cone_deg`` around it."""
-    a = axis / np.linalg.norm(axis)
-    u = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 0.0, 1.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(a, u)
-    out = [a]
-    for k in range(1, rings + 1):
-        t = np.radians(cone_deg) * k / rings
-        for phi in np.linspace(0, 2 * np.pi, per_ring, endpoint=False):
-            out.append(np.cos(t) * a + np.sin(t) * (np.cos(phi) * u + np.sin(phi) * v))
-    return np.array(out)
 
 
 class ModelIK:
