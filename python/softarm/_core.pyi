@@ -122,7 +122,8 @@ class Gains:
     ``max_step`` (m) caps the task part of one increment (the joint-limit part at half).
     ``lag_periods`` is the actuator lag (first-order time constant, sensor filter included,
     in control periods) a closed-loop step must tolerate: with a measured pose and no
-    ``plant_q``, every alpha is capped at tanh(1 / (4 lag_periods)) (docs/control.md);
+    ``plant_q``, the largest task gain (alpha, or hybrid_alpha * max(hybrid_position,
+    hybrid_orientation)) is capped at tanh(1 / (4 lag_periods)) (docs/control.md);
     default 20. ``repulsion_gain`` (k_r), ``influence_distance`` (rho_0, m) and
     ``body_radius`` (m) set the obstacle repulsion of planning paper eq. (9): a push of
     k_r (1/g - 1/rho_0) / g^2 m per step on the closest arm point, g = distance -

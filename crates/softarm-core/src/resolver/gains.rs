@@ -114,9 +114,11 @@ pub struct Gains {
     /// `f64::INFINITY` disables both caps.
     pub max_step: f64,
     /// First-order lag of the actuators, sensor filter included, in control periods
-    /// (`τ / T`), that a closed-loop step (one given a measured pose) must tolerate. Each
-    /// mode's α is then capped at [`lag_alpha`]`(lag_periods)`, the largest gain for
-    /// which an integrator behind that lag does not overshoot (see `docs/control.md`).
+    /// (`τ / T`), that a closed-loop step (one given a measured pose and no lag
+    /// prediction) must tolerate. The mode's largest task gain (α, or α₄ max(γ₆, γ₄) in
+    /// hybrid mode) is then capped at [`lag_alpha`]`(lag_periods)`, the largest gain for
+    /// which an integrator behind that lag does not overshoot (see `docs/control.md`);
+    /// the other weights keep their ratios.
     /// 0 = no lag: no cap. Steps on the model (no measurement, and `solve`) are not capped.
     pub lag_periods: f64,
     /// `k_r` of the repulsion law (planning paper eq. 9): the closest arm point of an
