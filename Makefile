@@ -8,7 +8,7 @@ export PATH := $(abspath $(VENV))/bin:$(PATH)
 # Non-interactive plotting everywhere (CI, headless machines).
 export MPLBACKEND ?= Agg
 
-.PHONY: help venv dev install test test-rust test-python demo lint fmt bench clean
+.PHONY: help venv dev dev-all install test test-rust test-python demo lint fmt bench clean
 
 help:
 	@echo "make demo   - simulated harvest with plots (no hardware, no test tools)"
@@ -35,10 +35,16 @@ install: venv
 test-rust:
 	cargo test --release -p softarm-core
 
-test-python: dev
+# The optional extras whose tests run in CI: Ray sweeps, the Cosserat rod, the rerun view.
+TEST_EXTRAS := test,sweep,cosserat,viz
+
+dev-all: venv
+	$(VENV)/bin/maturin develop --release --extras $(TEST_EXTRAS) -q
+
+test-python: dev-all
 	$(PY) -m pytest -q
 
-test: dev test-rust
+test: dev-all test-rust
 	$(PY) -m pytest -q
 
 demo: install
