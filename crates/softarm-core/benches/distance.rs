@@ -1,4 +1,4 @@
-//! criterion benches for the distance queries (DESIGN.md target: arc ↔ polynomial curve,
+//! criterion benches for the distance queries (docs/architecture.md target: arc ↔ polynomial curve,
 //! exact, ≤ 1 µs per pair). Baselines: brute force over a point cloud.
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -1,4 +1,4 @@
-//! criterion benches for the kinematics (DESIGN.md targets: forward ≤ 150 ns,
+//! criterion benches for the kinematics (docs/architecture.md targets: forward ≤ 150 ns,
 //! forward + Jacobian ≤ 300 ns, for the three-section arm).
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -1,4 +1,4 @@
-//! criterion benches for whole plans of the planning paper's simulations (DESIGN.md
+//! criterion benches for whole plans of the planning paper's simulations (docs/architecture.md
 //! target: simulation 3 ≤ 1 ms; the paper: 0.74 s in MATLAB). The proposed method and the
 //! point-set baselines (1, 10, 50, 100 points per curve; 10 arm points per segment,
 //! brute force) run in the same process, so they are compared on equal terms.

@@ -1,4 +1,4 @@
-//! criterion benches for one resolver step (DESIGN.md target: one hybrid step of eq. (20),
+//! criterion benches for one resolver step (docs/architecture.md target: one hybrid step of eq. (20),
 //! Jacobian included, ≤ 1 µs for the three-section arm).
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -6,6 +6,7 @@ use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use softarm_core::distance::Obstacle;
+use softarm_core::error::MAX_ITERATIONS;
 use softarm_core::resolver::{self as core, Mode, Schedule, SolveOptions, Target};
 use softarm_core::SoftArm as CoreArm;
 
@@ -481,9 +482,25 @@ pub struct Resolver {
 #[pymethods]
 impl Resolver {
     #[new]
-    #[pyo3(signature = (arm, mode = "hybrid", gains = None))]
-    fn new(arm: PyRef<'_, SoftArm>, mode: &str, gains: Option<PyRef<'_, Gains>>) -> PyResult<Self> {
-        let mode = Mode::parse(mode).py()?;
+    #[pyo3(signature = (arm, mode = None, gains = None))]
+    fn new(
+        arm: PyRef<'_, SoftArm>,
+        mode: Option<&Bound<'_, PyAny>>,
+        gains: Option<PyRef<'_, Gains>>,
+    ) -> PyResult<Self> {
+        // None is the default mode; anything but a string is a typed error naming `mode`.
+        let mode: String = match mode.filter(|m| !m.is_none()) {
+            None => "hybrid".to_owned(),
+            Some(m) => m.extract().map_err(|_| {
+                InputError::new_err(format!(
+                    "mode: expected a string, got {}",
+                    m.get_type()
+                        .name()
+                        .map_or_else(|_| "?".to_owned(), |n| n.to_string())
+                ))
+            })?,
+        };
+        let mode = Mode::parse(&mode).py()?;
         let gains = gains.map_or_else(core::Gains::blackberry, |g| g.inner);
         Ok(Resolver {
             inner: core::Resolver::new(arm.inner.clone(), mode, gains).py()?,
@@ -550,28 +567,38 @@ impl Resolver {
     }
 
     /// Iterates steps on the model to tolerance. Releases the GIL.
-    #[pyo3(signature = (q0, target, max_steps = 1000, position_tolerance = 1e-4,
-                        orientation_tolerance = 0.1f64.to_radians(), *, obstacles = None))]
+    #[pyo3(signature = (q0, target, max_steps = None, position_tolerance = None,
+                        orientation_tolerance = None, *, obstacles = None))]
     #[allow(clippy::too_many_arguments)]
     fn solve(
         &self,
         py: Python<'_>,
         q0: &Bound<'_, PyAny>,
         target: &Bound<'_, PyAny>,
-        max_steps: i64,
-        position_tolerance: f64,
-        orientation_tolerance: f64,
+        max_steps: Option<&Bound<'_, PyAny>>,
+        position_tolerance: Option<&Bound<'_, PyAny>>,
+        orientation_tolerance: Option<&Bound<'_, PyAny>>,
         obstacles: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Solution> {
+        // Counts and tolerances go through the bindings' one converter: a typed error
+        // naming the argument for a float count, a huge int or a string; None = default.
+        let defaults = SolveOptions::default();
+        let max_steps = match max_steps.filter(|v| !v.is_none()) {
+            Some(v) => crate::convert::count(v, "max_steps", 0, MAX_ITERATIONS)?,
+            None => defaults.max_steps,
+        };
+        let position_tolerance = match position_tolerance.filter(|v| !v.is_none()) {
+            Some(v) => crate::convert::real(v, "position_tolerance")?,
+            None => defaults.position_tolerance,
+        };
+        let orientation_tolerance = match orientation_tolerance.filter(|v| !v.is_none()) {
+            Some(v) => crate::convert::real(v, "orientation_tolerance")?,
+            None => defaults.orientation_tolerance,
+        };
         let obstacles = obstacle_list(obstacles)?;
         let n = softarm_core::chain::SectionModel::n_dofs(self.inner.arm());
         let q0 = crate::convert::vector(q0, "q0", n)?;
         let t = self::target(target)?;
-        let max_steps = usize::try_from(max_steps).map_err(|_| {
-            crate::errors::OutOfRangeError::new_err(format!(
-                "max_steps = {max_steps} is out of range [0, inf]"
-            ))
-        })?;
         let opts = SolveOptions {
             max_steps,
             position_tolerance,

@@ -149,17 +149,27 @@ class Servo:
         return self.ramp(q, home, start + c.home_timeout)
 
     def follow(self, q: FloatArray, q_way: FloatArray, deadline: float) -> FloatArray:
-        """Closed loop on the eye-to-hand camera to the pose the model puts at the planned
-        elongations ``q_way``, until the end effector is within ``placement_tolerance`` of
-        it: the resolver corrects the model's error as it goes and the known canes repel
-        the arm inside it (planning paper eq. 9), where an open-loop ramp would carry the
-        true arm, a few cm off the model, into a cane. A controller without a model
-        (``model_pose``) falls back to :meth:`ramp`."""
+        """Follow the planned segment ``q`` → ``q_way`` in closed loop on the eye-to-hand
+        camera until the end effector is within ``placement_tolerance`` of the model's pose
+        at ``q_way``.
+
+        Each period the plan's elongations advance by ``home_speed`` (the feedforward of the
+        planned q) and the resolver's step, closed on the measured pose towards the model's
+        pose at the plan's current point, adds the correction: the model's error is taken
+        out as the arm goes and the known canes repel it inside the step (planning paper
+        eq. 9), where an open-loop ramp would carry the true arm, a few cm off the model,
+        into a cane. The resolver alone is local: closed on a waypoint 20-30 cm away it
+        saturates on the joint limits, which is why the plan's q leads. A controller
+        without a model (``model_pose``) falls back to :meth:`ramp`."""
         model_pose = getattr(self.controller, "model_pose", None)
-        if model_pose is None:
+        arm = getattr(self.controller, "arm", None)
+        if model_pose is None or arm is None:
             return self.ramp(q, q_way, deadline, observe=True)
         c = self.cfg
-        goal = model_pose(q_way)
+        lower, upper = np.asarray(arm.lower), np.asarray(arm.upper)
+        step = c.home_speed * c.period
+        nominal = np.asarray(q, dtype=np.float64).copy()  # the plan's point now
+        goal_final = model_pose(q_way)
         best, best_t = np.inf, self.clock.now()
         while True:
             seen = self._observe(need_fix=False)
@@ -167,12 +177,13 @@ class Servo:
                 self._log_step(seen, q, None, None, False)
                 self._hold(q)
                 continue
-            err = float(np.linalg.norm(seen.pose[:3, 3] - goal[:3, 3]))
-            if err <= c.placement_tolerance:
+            on_plan_end = bool(np.all(nominal == q_way))
+            err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
+            if on_plan_end and err <= c.placement_tolerance:
                 return q
             if err < best - c.stall_progress:
                 best, best_t = err, seen.t
-            elif seen.t - best_t > c.stall_time:
+            elif on_plan_end and seen.t - best_t > c.stall_time:
                 # The true arm cannot reach the model's pose of this waypoint (a limit, a
                 # cane's repulsion): it is only a waypoint, the loop on the berry follows.
                 self.log.event("waypoint_stalled", t=seen.t, error=err)
@@ -182,8 +193,13 @@ class Servo:
                     FaultReason.TIMEOUT,
                     f"{self.state.value}: waypoint not reached, error {err:.4f} m",
                 )
-            q_next, saturated = self.controller.step(q, goal, seen.pose)
-            q_next = np.asarray(q_next, dtype=np.float64)
+            goal = model_pose(nominal)
+            q_fb, saturated = self.controller.step(q, goal, seen.pose)
+            advance = np.clip(q_way - nominal, -step, step)
+            nominal = nominal + advance
+            # Feedforward of the plan's motion on top of the closed-loop correction, kept
+            # inside the limits the resolver's own command respects.
+            q_next = np.clip(np.asarray(q_fb, dtype=np.float64) + advance, lower, upper)
             if not np.all(np.isfinite(q_next)):
                 raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
             self._log_step(

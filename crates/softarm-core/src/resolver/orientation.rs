@@ -1,5 +1,5 @@
-//! Pose validation and the orientation error of DESIGN.md: the rotation vector of
-//! `R_target · R_currentᵀ`, in the base frame (the `e_ζ` of eq. 8), with an axis mask.
+//! Pose validation and the orientation error of docs/architecture.md (conventions): the
+//! rotation vector of `R_target · R_currentᵀ`, in the base frame (the `e_ζ` of eq. 8), with an axis mask.
 
 use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
 
