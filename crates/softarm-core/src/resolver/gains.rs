@@ -227,16 +227,7 @@ impl Gains {
     /// [`Error::Parameter`] for a `tau_s` not in [0, 100] s or a `period_s` not in
     /// (0, 10] s.
     pub fn for_lag(tau_s: f64, period_s: f64) -> Result<Self> {
-        if !(0.0..=100.0).contains(&tau_s) {
-            return Err(Error::parameter("tau_s", tau_s, "must lie in [0, 100] s"));
-        }
-        if !(period_s > 0.0 && period_s <= 10.0) {
-            return Err(Error::parameter(
-                "period_s",
-                period_s,
-                "must lie in (0, 10] s",
-            ));
-        }
+        super::lag::check_lag(tau_s, period_s)?;
         let g = Gains {
             lag_periods: tau_s / period_s,
             ..Gains::blackberry()

@@ -28,16 +28,7 @@ impl LagModel {
     /// [`Error::Parameter`] for `tau_s` not in [0, 100] or `period_s` not in (0, 10];
     /// [`Error::NonFinite`] for a non-finite `q0`.
     pub fn new(tau_s: f64, period_s: f64, q0: &[f64]) -> Result<Self> {
-        if !(0.0..=100.0).contains(&tau_s) {
-            return Err(Error::parameter("tau_s", tau_s, "must lie in [0, 100] s"));
-        }
-        if !(period_s > 0.0 && period_s <= 10.0) {
-            return Err(Error::parameter(
-                "period_s",
-                period_s,
-                "must lie in (0, 10] s",
-            ));
-        }
+        check_lag(tau_s, period_s)?;
         check_finite("q0", q0)?;
         let gain = if tau_s == 0.0 {
             1.0
@@ -90,6 +81,25 @@ impl LagModel {
         self.state.copy_from_slice(q);
         Ok(())
     }
+}
+
+/// Checks a lag `tau_s` in [0, 100] s and a control period `period_s` in (0, 10] s: the
+/// one validation of the lag that [`LagModel::new`] and `Gains::for_lag` share.
+///
+/// # Errors
+/// [`Error::Parameter`] naming the argument that is out of its range.
+pub(crate) fn check_lag(tau_s: f64, period_s: f64) -> Result<()> {
+    if !(0.0..=100.0).contains(&tau_s) {
+        return Err(Error::parameter("tau_s", tau_s, "must lie in [0, 100] s"));
+    }
+    if !(period_s > 0.0 && period_s <= 10.0) {
+        return Err(Error::parameter(
+            "period_s",
+            period_s,
+            "must lie in (0, 10] s",
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
