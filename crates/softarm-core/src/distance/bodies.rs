@@ -125,7 +125,8 @@ pub fn closest_piece_within(
 /// `obstacle`. Never farther than [`super::closest`], which sees the arcs only.
 ///
 /// # Errors
-/// [`crate::Error::Shape`] / [`crate::Error::NonFinite`] for a bad `q`.
+/// [`crate::Error::Shape`] / [`crate::Error::NonFinite`] for a bad `q`;
+/// [`crate::Error::Parameter`] for a model without sections.
 pub fn closest_body<K: Kinematics + ?Sized>(
     model: &K,
     q: &[f64],
@@ -147,7 +148,9 @@ pub fn closest_body<K: Kinematics + ?Sized>(
             });
         }
     }
-    Ok(best.expect("an arm has at least one section"))
+    // Every model has at least one section (its constructors refuse none); an empty one
+    // is still an error here rather than a panic.
+    best.ok_or_else(|| crate::Error::parameter("model", 0.0, "has no sections"))
 }
 
 #[cfg(test)]
