@@ -8,13 +8,14 @@ export PATH := $(abspath $(VENV))/bin:$(PATH)
 # Non-interactive plotting everywhere (CI, headless machines).
 export MPLBACKEND ?= Agg
 
-.PHONY: help venv dev dev-all install test test-rust test-python demo lint fmt bench clean
+.PHONY: help venv dev dev-all install docs test test-rust test-python demo lint fmt bench clean
 
 help:
 	@echo "make demo   - simulated harvest with plots (no hardware, no test tools)"
 	@echo "make test   - set up .venv, build, run cargo test and pytest"
 	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
 	@echo "make bench  - criterion and pytest-benchmark"
+	@echo "make docs   - regenerate the generated docs (docs/planning.md and its figures)"
 
 $(VENV)/.stamp: pyproject.toml
 	python3 -m venv $(VENV)
@@ -46,6 +47,11 @@ test-python: dev-all
 
 test: dev-all test-rust
 	$(PY) -m pytest -q
+
+# The generated docs: the planning paper's tables and figures, from the code that measures
+# them (tests/test_docs_current.py checks that their deterministic columns are current).
+docs: dev
+	$(PY) -m softarm.planning.report --out docs/planning.md
 
 demo: install
 	$(VENV)/bin/softarm demo
