@@ -100,3 +100,19 @@ def test_planner_and_plan_round_trip() -> None:
             assert getattr(copied, name) == getattr(plan, name)
     sampled = _core.PotentialFieldPlanner(ARM, arm_samples=7)
     assert pickle.loads(pickle.dumps(sampled)).options["arm_samples"] == 7
+
+
+def test_resolver_pickles_and_steps_identically() -> None:
+    import pickle
+
+    import numpy as np
+
+    import softarm
+
+    arm = softarm.SoftArm.blackberry()
+    res = softarm.Resolver(arm, "position", softarm.Gains(position_alpha=0.2))
+    back = pickle.loads(pickle.dumps(res))
+    q = np.full(arm.n_actuators, 0.015)
+    target = arm.forward(np.full(arm.n_actuators, 0.01))[:3, 3]
+    assert back.mode == "position" and back.gains == res.gains
+    np.testing.assert_array_equal(back.step(q, target).q, res.step(q, target).q)

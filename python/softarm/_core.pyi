@@ -282,8 +282,10 @@ class Resolver:
     """
 
     def __new__(
-        cls, arm: SoftArm, mode: str = "hybrid", gains: Gains | None = None
-    ) -> Resolver: ...
+        cls, arm: SoftArm, mode: str | None = None, gains: Gains | None = None
+    ) -> Resolver:
+        """``mode`` None means "hybrid"; ``gains`` None means ``Gains()``."""
+    def __reduce__(self) -> tuple[type[Resolver], tuple[SoftArm, str, Gains]]: ...
     @property
     def mode(self) -> str: ...
     @property
@@ -311,15 +313,16 @@ class Resolver:
         self,
         q0: _ArrayLike,
         target: _ArrayLike,
-        max_steps: int = 1000,
-        position_tolerance: float = 0.0001,
-        orientation_tolerance: float = ...,
+        max_steps: int | None = None,
+        position_tolerance: float | None = None,
+        orientation_tolerance: float | None = None,
         *,
         obstacles: object | None = None,
     ) -> Solution:
         """Steps on the model until the controlled errors are within tolerance (m, rad;
-        default 0.1 mm and 0.1 deg) or ``max_steps``; an unreachable target returns
-        ``converged=False`` with the best error. Releases the GIL."""
+        None means the defaults: 0.1 mm and 0.1 deg) or ``max_steps`` (None: 1000); an
+        unreachable target returns ``converged=False`` with the best error. Releases the
+        GIL."""
 
 @final
 class LagModel:

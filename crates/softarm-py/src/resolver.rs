@@ -4,7 +4,7 @@
 use nalgebra::{Matrix4, Vector3};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyDict, PyTuple, PyType};
 use softarm_core::distance::Obstacle;
 use softarm_core::error::MAX_ITERATIONS;
 use softarm_core::resolver::{self as core, Mode, Schedule, SolveOptions, Target};
@@ -613,6 +613,25 @@ impl Resolver {
 
     fn __repr__(&self) -> String {
         format!("Resolver(mode={:?})", self.inner.mode().name())
+    }
+
+    /// Pickles as `Resolver(arm, mode, gains)`: the resolver holds no other state.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (Bound<'py, PyType>, (SoftArm, &'static str, Gains)) {
+        let r = slf.get();
+        (
+            slf.get_type(),
+            (
+                SoftArm {
+                    inner: r.inner.arm().clone(),
+                },
+                r.inner.mode().name(),
+                Gains {
+                    inner: *r.inner.gains(),
+                },
+            ),
+        )
     }
 }
 
