@@ -281,9 +281,7 @@ class Resolver:
     "hybrid" (eq. 20). ``gains=None`` uses ``Gains.default_for(arm)``.
     """
 
-    def __new__(
-        cls, arm: SoftArm, mode: str | None = None, gains: Gains | None = None
-    ) -> Resolver:
+    def __new__(cls, arm: SoftArm, mode: str | None = None, gains: Gains | None = None) -> Resolver:
         """``mode`` None means "hybrid"; ``gains`` None means ``Gains()``."""
     def __reduce__(self) -> tuple[type[Resolver], tuple[SoftArm, str, Gains]]: ...
     @property
