@@ -35,7 +35,7 @@ from softarm.harvest.vision_loop import CameraVision
 from softarm.identification.result import IdentifiedPlant
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
-from softarm.sim.pressure import MAX_PSI
+from softarm.units import MAX_PSI
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
 
@@ -180,7 +180,7 @@ def build_sim_rig(
         watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
     clock = SimClock([plant.advance, watch.sample])
     bank = SafePressureBank(
-        SimulatedPressureBank(plant, plant.arm.n_actuators), 70.0, 100.0, 0.5, clock.now,
+        SimulatedPressureBank(plant, plant.arm.n_actuators), MAX_PSI, 100.0, 0.5, clock.now,
         watchdog_thread=False,
     )  # fmt: skip
     vision = sim_vision(
