@@ -1,11 +1,23 @@
-"""The pressure actuator of the harvest loop: elongations (m) → psi → safety layer."""
+"""The pressure actuator of the harvest loop: elongations (m) → psi → safety layer.
+
+It owns what the arm was actually sent: the safety layer clamps and rate-limits every
+command, so the q a controller asked for is not always the q the regulators got.
+:attr:`SafeActuator.sent` is the latter (the state the resolver linearises at), and with
+a known lag :attr:`SafeActuator.predicted` is where the actuators are now, a
+:class:`softarm.LagModel` fed with every command sent (ramps and holds included), for
+the lag-aware closed loop (docs/control.md, section 2).
+"""
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
 
-from softarm.errors import NonFiniteError
+from softarm._core import LagModel
+from softarm.errors import NonFiniteError, ParameterError
+from softarm.hardware.play_inverse import PlayInverse
 from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.safety import SafePressureBank
 
@@ -18,19 +30,120 @@ class SafeActuator:
     """Sends elongations through ``bank`` (a :class:`SafePressureBank`, which clamps,
     rate-limits and watches every command) using ``pressure_map`` (the paper's 1/2100 m
     per psi, section IV-A). Implements :class:`~softarm.harvest.interfaces.PressureActuator`.
+
+    Args:
+        bank: the safety layer.
+        pressure_map: elongation ↔ psi (``to_psi``/``to_elongation``).
+        play_psi: the actuators' play band (psi per channel, e.g. identified): commands
+            go through a :class:`~softarm.hardware.play_inverse.PlayInverse`. None: none.
+        lag: ``(tau_s, period_s)`` of the actuators: :attr:`predicted` follows the sent
+            commands through that lag. None: no prediction.
+        sensor_lag_s: the time constant (s) of the pose measurement's own first-order
+            filter, in series after the actuators' lag: :attr:`predicted` is then the
+            elongations the *measured* pose reflects (0: no filter).
+        now: the clock (s) the commands are stamped with, for the prediction to count
+            the periods between two commands (a grasp sends nothing for a while).
     """
 
-    def __init__(self, bank: SafePressureBank, pressure_map: ElongationMap | None = None) -> None:
+    def __init__(
+        self,
+        bank: SafePressureBank,
+        pressure_map: ElongationMap | None = None,
+        *,
+        play_psi: npt.ArrayLike | None = None,
+        lag: tuple[float, float] | None = None,
+        now: Callable[[], float] | None = None,
+        sensor_lag_s: float = 0.0,
+    ) -> None:
         self.bank = bank
         self.pressure_map = pressure_map or ElongationMap(max_psi=bank.max_pressure)
+        self.play = None if play_psi is None else PlayInverse(play_psi)
+        n = bank.channels
+        if self.play is not None and self.play.width.shape != (n,):
+            raise ParameterError(f"play_psi: expected {n} channels, got {self.play.width.size}")
+        if lag is not None and now is None:
+            raise ParameterError("lag: needs the clock `now` to count periods")
+        self._now = now
+        self._lag = lag
+        self._sent = np.zeros(n)
+        # The regulators' lag, then the pose filter's: one first-order model each.
+        self._stages = (
+            []
+            if lag is None
+            else [LagModel(tau, lag[1], self._sent) for tau in (lag[0], sensor_lag_s) if tau > 0]
+        )
+        self._stamp = None if now is None else now()
+        # What the regulators were told, boost included (the lag model's input).
+        self._drive = np.zeros(n)
+        import os
 
-    def send(self, q: FloatArray) -> None:
-        """Command elongations ``q`` (m). A NaN raises before anything is sent."""
+        frac, kmax = float(os.environ.get("LEAD", "0")), float(os.environ.get("LEADMAX", "5"))
+        a = 0.0 if lag is None or lag[0] <= 0 else float(np.exp(-lag[1] / lag[0]))
+        self._lead = min(kmax, frac * a / (1.0 - a)) if a > 0 else 0.0
+
+    @property
+    def sent(self) -> FloatArray:
+        """The elongations (m) the regulators were last sent, after the safety layer's
+        clamp and rate limit and without the play compensation (a copy)."""
+        return self._sent.copy()
+
+    @property
+    def predicted(self) -> FloatArray | None:
+        """The elongations (m) the measured pose reflects now by the lag model (the
+        actuators' lag, then the pose filter's), or None without a lag."""
+        if self._lag is None:
+            return None
+        self._catch_up()
+        return np.asarray(self._stages[-1].q) if self._stages else self._sent.copy()
+
+    def send(self, q: FloatArray) -> FloatArray:
+        """Command elongations ``q`` (m); returns :attr:`sent`. A NaN raises before
+        anything is sent."""
         q = np.asarray(q, dtype=np.float64)
         if not np.all(np.isfinite(q)):
             raise NonFiniteError(f"q must be finite, got {q.tolist()!r}")
-        self.bank.set_pressures(self.pressure_map.to_psi(q))
+        self._catch_up()
+        wanted = self.pressure_map.to_psi(q)
+        boost = np.zeros_like(wanted)
+        if self._lead > 0 and self._stages:
+            boost = self._lead * (wanted - self.pressure_map.to_psi(self._stages[0].q))
+        command = wanted + boost
+        if self.play is not None:
+            command = self.play.command(wanted) + boost
+        self.bank.set_pressures(np.clip(command, 0.0, self.bank.max_pressure))
+        drive = self.bank.last_sent
+        if self.play is not None:
+            drive = drive - self.play.offset
+        self._drive = self.pressure_map.to_elongation(drive)
+        # The target the regulators are driven towards: the wanted pressure while the
+        # boost pushes past it, what the safety layer let through when it held the
+        # command short of it.
+        target = np.where(
+            boost > 0,
+            np.minimum(wanted, drive),
+            np.where(boost < 0, np.maximum(wanted, drive), drive),
+        )
+        self._sent = self.pressure_map.to_elongation(target)
+        return self.sent
 
     def vent(self, reason: str) -> None:
         """Vent every channel; the safety layer logs ``reason``."""
+        self._catch_up()
         self.bank.vent(reason)
+        self._sent = np.zeros_like(self._sent)
+        self._drive = np.zeros_like(self._drive)
+        if self.play is not None:
+            self.play.reset()
+
+    def _catch_up(self) -> None:
+        """Advance the lag model over the whole periods since the last command, with the
+        command held (the regulators held it)."""
+        if not self._stages or self._now is None or self._lag is None:
+            return
+        now = self._now()
+        periods = int(np.floor((now - self._stamp) / self._lag[1] + 1e-9))
+        for _ in range(min(periods, 10_000)):
+            u = self._drive
+            for stage in self._stages:
+                u = stage.advance(u)
+        self._stamp += periods * self._lag[1]

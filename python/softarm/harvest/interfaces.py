@@ -127,8 +127,10 @@ class PlacementPlanner(Protocol):
 class PressureActuator(Protocol):
     """Elongations (m) to pressures (psi) through the safety layer."""
 
-    def send(self, q: FloatArray) -> None:
-        """Command elongations ``q`` (m); raises HardwareError/SafetyError on a fault."""
+    def send(self, q: FloatArray) -> FloatArray:
+        """Command elongations ``q`` (m); returns the elongations actually sent (the
+        safety layer clamps and rate-limits), the state the controller goes on from.
+        Raises HardwareError/SafetyError on a fault."""
         ...
 
     def vent(self, reason: str) -> None:

@@ -205,8 +205,8 @@ class Servo:
             self._log_step(
                 seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
             )
-            self.actuator.send(q_next)
-            q = q_next
+            # Go on from what was sent: the safety layer may have clamped or rate-limited it.
+            q = self.actuator.send(q_next)
             self.clock.sleep(c.period)
 
     def ramp(
@@ -306,8 +306,8 @@ class Servo:
                     f"pointing {np.degrees(ang):.1f} deg",
                 )
             self._log_step(seen, q_next, goal, (err, ang), saturated)
-            self.actuator.send(q_next)
-            q = q_next
+            # Go on from what was sent: the safety layer may have clamped or rate-limited it.
+            q = self.actuator.send(q_next)
             self.clock.sleep(c.period)
 
     def _observe(self, need_fix: bool = True) -> _Seen:

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+import os
 
 import numpy as np
 
@@ -68,6 +69,11 @@ class SimRigOptions:
     #: A fitted model (``softarm calibrate``, ``--model model.toml``): the controller's arm
     #: and the actuators' gains; None: the nominal blackberry arm.
     calibration: Calibration | None = None
+    #: How the loop handles the plant's lag and play (docs/control.md): "predictor" (a
+    #: lag model of the sent commands, the gain bounded by the pose filter's lag alone,
+    #: and the play inverted at the regulators) or "bound" (the gain bounded by the
+    #: whole lag, no model of it).
+    lag_control: str = "predictor"
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -188,22 +194,46 @@ def build_sim_rig(
         seed=o.seed, hidden=o.hidden,
     )  # fmt: skip
     gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    # The plant's lag and play, measured by `softarm identify` when given, else declared by
+    # the plant description (its regulators' time constant and hysteresis, as a datasheet
+    # states them).
+    if o.identified is None:
+        lag, play = o.plant.pressure_tau, np.full(model.n_actuators, o.plant.hysteresis_psi)
+    else:
+        lag, play = o.identified.lag_s, np.asarray(o.identified.hysteresis_psi)
+    if o.lag_control not in ("predictor", "bound"):
+        raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
+    predict = o.lag_control == "predictor"
+    actuator = SafeActuator(
+        bank,
+        None if o.calibration is None else o.calibration.pressure_map(),
+        play_psi=play if predict and os.environ.get("PLAY", "1") == "1" else None,
+        lag=(lag, cfg.period) if predict else None,
+        now=clock.now,
+        # The tracker's first-order pose filter (10 rad/s): part of what the loop sees.
+        sensor_lag_s=0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff,
+    )
     if controller is None:
-        # The plant's lag, measured by `softarm identify` when given, else declared by the
-        # plant description (its regulators' time constant, as a datasheet states it): the
-        # closed-loop gain of the resolver at its bound for that lag (docs/control.md).
-        lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
-        gains = Gains.for_lag(lag, cfg.period)
+        if predict:
+            # The lag model takes out the regulators' lag; what it does not model, the
+            # pose filter's, bounds the gain (docs/control.md, section 2).
+            filter_lag = 0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff
+            alpha = float(os.environ.get("ALPHA", "0.3"))
+            gains = Gains().replace(hybrid_alpha=alpha)
+        else:
+            gains = Gains.for_lag(lag, cfg.period)
         if o.joint_limit_gain is not None:
             gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
         resolver = Resolver(model, mode="hybrid", gains=gains)
-        controller = ResolverController(resolver, canes if o.avoid_canes else ())
+        controller = ResolverController(
+            resolver, canes if o.avoid_canes else (), (lambda: actuator.predicted) if predict else None
+        )
     machine = HarvestMachine(
         clock,
         vision,
         vision,
         controller,
-        SafeActuator(bank, None if o.calibration is None else o.calibration.pressure_map()),
+        actuator,
         gripper,
         gripper,
         n_actuators=model.n_actuators,
