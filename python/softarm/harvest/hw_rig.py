@@ -114,7 +114,7 @@ def build_hardware_rig(
         )  # fmt: skip
         gripper = ArduinoGripper(link)
         machine = HarvestMachine(
-            MonotonicClock(), vision, vision, ResolverController(resolver),
+            MonotonicClock(), vision, ResolverController(resolver),
             SafeActuator(bank, ElongationMap(ch.p_max, ch.metres_per_psi)), gripper,
             ArduinoRipenessSensor(link), arm.n_actuators, cfg, log,
             planner=ModelIK(planning_resolver(arm), cfg),

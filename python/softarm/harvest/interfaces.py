@@ -23,19 +23,19 @@ from softarm.hardware.protocols import Gripper, RipenessSensor
 
 __all__ = [
     "BerryFix",
-    "BerryLocator",
     "BerryTarget",
     "CameraName",
     "Clock",
     "Controller",
-    "EndEffectorTracker",
     "Gripper",
     "GripperDevice",
     "GroundTruth",
+    "Observation",
     "PlacementPlanner",
     "PressureActuator",
     "RipenessProbe",
     "RipenessSensor",
+    "Vision",
 ]
 
 FloatArray = npt.NDArray[np.float64]
@@ -77,25 +77,30 @@ class Clock(Protocol):
         ...
 
 
-class EndEffectorTracker(Protocol):
-    """Eye-to-hand tracking of the end-effector marker cube (eq. 22)."""
+@dataclass(frozen=True)
+class Observation:
+    """What the cameras give at time ``t``: ``T_base_ee`` (4, 4) from the marker cube
+    (eq. 22), None when the cube is not seen, and the berry ``fix``, None when there is
+    none (not seen and no fix held)."""
 
-    def track(self, time: float) -> FloatArray | None:
-        """``T_base_ee`` (4, 4) at ``time``, or None when the cube is not seen."""
-        ...
+    t: float
+    pose: FloatArray | None
+    fix: BerryFix | None
 
 
-class BerryLocator(Protocol):
-    """The berry position from both cameras: eye-to-hand far away, eye-in-hand (eq. 21)
-    within the 6 cm hand-over distance, the most recent fix held while the berry is
-    hidden, up to an age limit (section III-D, fig. 4)."""
+class Vision(Protocol):
+    """Both cameras: eye-to-hand tracking of the end-effector cube (eq. 22), and the berry
+    from eye-to-hand far away, eye-in-hand (eq. 21) within the 6 cm hand-over distance,
+    the most recent fix held while the berry is hidden, up to an age limit (section
+    III-D, fig. 4). How long the harvest tolerates a lost marker is not the vision's
+    business (:class:`softarm.harvest.observe.BerryWatch` owns that)."""
 
     def select(self, berry: BerryTarget) -> None:
         """Track ``berry`` from now on, forgetting any held fix."""
         ...
 
-    def locate(self, time: float, T_base_ee: FloatArray | None) -> BerryFix | None:
-        """The berry at ``time`` given the tracked end-effector pose, or None."""
+    def observe(self, time: float) -> Observation:
+        """The end-effector pose and the berry at ``time``."""
         ...
 
 

@@ -201,7 +201,6 @@ def build_sim_rig(
     machine = HarvestMachine(
         clock,
         vision,
-        vision,
         controller,
         SafeActuator(bank, None if o.calibration is None else o.calibration.pressure_map()),
         gripper,

@@ -4,9 +4,9 @@ The eye-to-hand camera C1 gives the end-effector pose from the marker cube (eq. 
 first berry position; the eye-in-hand camera C2 gives the berry close up, carried to the
 base frame through the tracked end-effector pose (eq. 21). :class:`CameraFusion` picks
 the source: C1 until the grasp point is within 6 cm of the berry, C2 after, the most
-recent fix while the berry is hidden (section III-D, fig. 4). Implements both
-:class:`~softarm.harvest.interfaces.EndEffectorTracker` and
-:class:`~softarm.harvest.interfaces.BerryLocator`.
+recent fix while the berry is hidden (section III-D, fig. 4). Implements
+:class:`~softarm.harvest.interfaces.Vision`: one :meth:`CameraVision.observe` per control
+step reads both cameras.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import VisionError
-from softarm.harvest.interfaces import BerryFix, BerryTarget, FloatArray
+from softarm.harvest.interfaces import BerryFix, BerryTarget, FloatArray, Observation
 from softarm.vision import BaseRegistration, CameraFusion, CameraModel, MarkerCube, MarkerDetector
 from softarm.vision.detector import Detection, square_marker_poses
 from softarm.vision.poses import invert
@@ -95,7 +95,6 @@ class CameraVision:
         )
         self.selected = BerryTarget(-1)
         self._cube_prev: FloatArray | None = None
-        self._c1: tuple[FloatArray | None, FloatArray | None] = (None, None)
         self.max_jump, self.max_rejects = max_jump, max_rejects
         self._last_ee: FloatArray | None = None
         self._rejects = 0
@@ -105,21 +104,40 @@ class CameraVision:
         self.selected = berry
         self.fusion.reset()
 
+    def observe(self, time: float) -> Observation:
+        """Both cameras at ``time``: ``T_base_ee`` from the cube in C1 (eq. 22), and the
+        berry from the fusion of C1 and C2 (eq. 21), or the held fix."""
+        T_c1_ee, berry_c1 = self._view_c1(time)
+        img = self.frame2(time)
+        berry_c2 = None
+        if img is not None:
+            berry_c2 = self._tag_position(self.detector.detect(img, self.model2), self.model2)
+        est = self.fusion.update(time, T_c1_ee, berry_c1, berry_c2)
+        fix = None
+        if est.target is not None and est.source != "none":
+            fix = BerryFix(est.target, est.source, est.target_age)
+        pose = None if T_c1_ee is None else self.T_base_c1 @ T_c1_ee
+        return Observation(time, pose, fix)
+
     def track(self, time: float) -> FloatArray | None:
-        """C1: ``T_base_ee`` from the cube (eq. 22); the berry in C1 is kept for :meth:`locate`."""
+        """C1 alone: ``T_base_ee`` from the cube (eq. 22), or None; for the callers that
+        need no berry (calibration, identification)."""
+        T_c1_ee, _ = self._view_c1(time)
+        return None if T_c1_ee is None else self.T_base_c1 @ T_c1_ee
+
+    def _view_c1(self, time: float) -> tuple[FloatArray | None, FloatArray | None]:
+        """C1's frame at ``time``: ``T_c1_ee`` (None when the cube is not seen or the pose
+        is an outlier) and the selected berry's tag position in C1 (None if not seen)."""
         dets = self.detector.detect(_frame(self.frame1, time), self.model1)
         est = self.cube.estimate(dets, self.model1, self._cube_prev)
         berry_c1 = self._tag_position(dets, self.model1)
         if est is None:
-            self._c1 = (None, berry_c1)
-            return None
+            return None, berry_c1
         T_c1_ee = est.T_camera_cube @ invert(self.T_ee_cube)
         if self._outlier(T_c1_ee):
-            self._c1 = (None, berry_c1)
-            return None
+            return None, berry_c1
         self._cube_prev = est.T_camera_cube
-        self._c1 = (T_c1_ee, berry_c1)
-        return self.T_base_c1 @ T_c1_ee
+        return T_c1_ee, berry_c1
 
     def _outlier(self, T_c1_ee: FloatArray) -> bool:
         last = self._last_ee
@@ -130,18 +148,6 @@ class CameraVision:
         self._rejects = 0
         self._last_ee = T_c1_ee
         return False
-
-    def locate(self, time: float, T_base_ee: FloatArray | None) -> BerryFix | None:
-        """C2 and the fusion: the berry in the base frame (eq. 21), or the held fix."""
-        T_c1_ee, berry_c1 = self._c1
-        img = self.frame2(time)
-        berry_c2 = None
-        if img is not None:
-            berry_c2 = self._tag_position(self.detector.detect(img, self.model2), self.model2)
-        est = self.fusion.update(time, T_c1_ee, berry_c1, berry_c2)
-        if est.target is None or est.source == "none":
-            return None
-        return BerryFix(est.target, est.source, est.target_age)
 
     def _tag_position(self, dets: list[Detection], model: CameraModel) -> FloatArray | None:
         for d in dets:
