@@ -42,7 +42,9 @@ def test_round_trip(tmp_path: Path) -> None:
     base = default_config()
     config = Config(
         arm=base.arm,
-        gains=GainsConfig({"alpha": 0.5, "schedule": "smooth", "axes": [True, True, False]}),
+        gains=GainsConfig(
+            {"hybrid_alpha": 0.5, "schedule": "smooth", "axis_mask": [True, True, False]}
+        ),
         calibration=CalibrationConfig(
             c1=CameraConfig(0, ((700.0, 0, 640.0), (0, 700.0, 360.0), (0, 0, 1.0)), (0.1, -0.2)),
             c2=CameraConfig("/dev/video2", file="c2 intrinsics.npz"),
@@ -93,6 +95,10 @@ CASES = [
     ("[arm]\nsections = []\n", "arm.sections must be a non-empty array"),
     (edit("[gains]", "[gains]\nalpha = {x = 1}"), "gains.alpha must be a finite number, bool"),
     (edit("[gains]", "[gains]\nalpha = nan"), "gains.alpha must be a finite number"),
+    (edit("[gains]", "[gains]\nalpha = 0.5"), "unknown key 'gains.alpha' (a softarm.Gains"),
+    (edit("[gains]", "[gains]\nhybrid_gamma = 'x'"), "gains.hybrid_gamma is refused by"),
+    (edit("[gains]", "[gains]\nschedule = 'nope'"), "gains.schedule is refused by softarm.Gains"),
+    (edit("[gains]", "[gains]\nhybrid_alpha = 9.0"), "gains.hybrid_alpha is refused by"),
     (edit("[calibration]  #", "[calibration]\n" + POSE_BAD_ROW + "#"), "last row"),
     (edit("[calibration]  #", "[calibration]\n" + POSE_SKEW + "#"), "orthonormal"),
     (edit("[calibration]  #", "[calibration]\n" + POSE_MIRROR + "#"), "determinant"),

@@ -19,6 +19,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from softarm._core import Gains
 from softarm.errors import ConfigError
 from softarm.hardware.limits import (
     BAUD,
@@ -73,7 +74,8 @@ class ArmConfig:
 
 @dataclass(frozen=True)
 class GainsConfig:
-    """Free-form resolver gain keywords (passed to ``softarm.Gains(**values)``)."""
+    """Resolver gain keywords (passed to ``softarm.Gains(**values)``); :func:`load_config`
+    checks each against ``softarm.Gains`` and names the bad one (``gains.<key>``)."""
 
     values: dict[str, Any] = field(default_factory=dict)
 
@@ -328,14 +330,7 @@ def _build(root: _Table) -> Config:
     )
     arm_t.done()
 
-    gains_t = root.table("gains")
-    for name, value in gains_t.data.items():
-        items = value if isinstance(value, list) else [value]
-        if not all(isinstance(x, int | float | str) for x in items) or (
-            any(isinstance(x, float) and not math.isfinite(x) for x in items)
-        ):
-            raise gains_t.error(name, "must be a finite number, bool, string or a list of them")
-    gains = GainsConfig(dict(gains_t.data))
+    gains = GainsConfig(_gains(root.table("gains")))
 
     cal_t = root.table("calibration")
     c1_t, c2_t = cal_t.table("c1"), cal_t.table("c2")
@@ -416,6 +411,37 @@ def _build(root: _Table) -> Config:
     plant_model = _plant_model(root.table("plant_model"), len(channels.names))
     root.done()
     return Config(arm, gains, calibration, channels, serial, plant_model)
+
+
+#: Every keyword of ``softarm.Gains`` (its fields, as ``Gains.as_dict`` lists them).
+GAIN_KEYS: tuple[str, ...] = tuple(Gains().as_dict())
+
+
+def _gains(t: _Table) -> dict[str, Any]:
+    """``[gains]``: each key a ``softarm.Gains`` keyword whose value the resolver takes,
+    checked here so that the error names ``gains.<key>`` (not only when a rig is built)."""
+    for name, value in t.data.items():
+        t.used.add(name)
+        items = value if isinstance(value, list) else [value]
+        if not all(isinstance(x, int | float | str) for x in items) or (
+            any(isinstance(x, float) and not math.isfinite(x) for x in items)
+        ):
+            raise t.error(name, "must be a finite number, bool, string or a list of them")
+        if name not in GAIN_KEYS:
+            raise ConfigError(
+                f"{t.source}: unknown key {t.key(name)!r} (a softarm.Gains keyword: "
+                f"{', '.join(GAIN_KEYS)})"
+            )
+        try:
+            Gains(**{name: value})
+        except (ValueError, TypeError) as exc:
+            raise t.error(name, f"is refused by softarm.Gains ({exc})") from None
+    try:  # the keys together (a constraint between two gains)
+        Gains(**t.data)
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(f"{t.source}: {t.path}: {exc}") from None
+    t.done()
+    return dict(t.data)
 
 
 def _plant_model(t: _Table, n_channels: int) -> PlantModelConfig | None:
