@@ -35,11 +35,6 @@ from softarm.vision.poses import invert
 
 __all__ = ["HardwareRig", "MonotonicClock", "build_hardware_rig"]
 
-#: The marker cube in the end-effector frame: 5 cm behind the gripper frame, as built.
-#: Not in the TOML config yet (see docs/harvest.md).
-T_EE_CUBE = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.05], [0, 0, 0, 1]])
-BERRY_TAG = 0.012  # the paper's 12 mm berry tag (section III-D)
-
 
 class MonotonicClock:
     """Wall-clock time; ``sleep`` waits for the next control period boundary."""
@@ -80,13 +75,14 @@ def _camera_model(cam: CameraConfig, name: str) -> CameraModel:
 def build_hardware_rig(
     config: Config, harvest: HarvestConfig | None = None, log: HarvestLog | None = None
 ) -> HardwareRig:
-    """Open every device of ``config`` and wire the machine.
+    """Open every device of ``config`` and wire the machine, tuned by ``harvest`` (default:
+    the config's ``[harvest]``).
 
     Raises:
         HardwareUnavailableError: a device (or its driver) is absent.
         ConfigError: the calibration needed by the vision loop is missing.
     """
-    cfg = harvest or HarvestConfig()
+    cfg = harvest or config.harvest
     cal, ch = config.calibration, config.channels
     if cal.T_C1_base is None or cal.T_C2_EE is None:
         raise ConfigError("calibration.T_C1_base and calibration.T_C2_EE must be set to harvest")
@@ -109,8 +105,8 @@ def build_hardware_rig(
         stack.callback(cam2.close)
         vision = CameraVision(
             lambda t: cam1.read(), lambda t: cam2.read(), model1, model2,
-            invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)), T_EE_CUBE,
-            MarkerCube.standard(), BERRY_TAG, cfg.grasp_offset,
+            invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)),
+            np.array(cal.T_EE_cube), MarkerCube.standard(), cal.berry_tag, cfg.grasp_offset,
         )  # fmt: skip
         gripper = ArduinoGripper(link)
         machine = HarvestMachine(

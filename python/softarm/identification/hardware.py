@@ -23,7 +23,7 @@ from softarm.hardware.camera import OpenCVCamera
 from softarm.hardware.daq import NidaqPressureBank
 from softarm.hardware.pressure_map import VoltageMap
 from softarm.hardware.safety import SafePressureBank
-from softarm.harvest.hw_rig import BERRY_TAG, T_EE_CUBE, MonotonicClock, _camera_model
+from softarm.harvest.hw_rig import MonotonicClock, _camera_model
 from softarm.harvest.vision_loop import CameraVision
 from softarm.vision import MarkerCube
 from softarm.vision.poses import invert
@@ -69,8 +69,8 @@ class HardwareIdentificationRig:
             stack.callback(cam.close)
             self.vision = CameraVision(
                 lambda t: cam.read(), lambda t: None, model1, model1,
-                invert(np.array(cal.T_C1_base)), np.eye(4), T_EE_CUBE,
-                MarkerCube.standard(), BERRY_TAG, 0.0,
+                invert(np.array(cal.T_C1_base)), np.eye(4), np.array(cal.T_EE_cube),
+                MarkerCube.standard(), cal.berry_tag, 0.0,
             )  # fmt: skip
             self._devices = stack.pop_all()
 
