@@ -33,6 +33,7 @@ from softarm.hardware.limits import (
     Limit,
 )
 from softarm.harvest_config import HarvestConfig
+from softarm.identified_plant import IdentifiedPlant
 from softarm.units import MAX_PSI, METRES_PER_PSI, PA_PER_PSI
 
 __all__ = [
@@ -505,8 +506,6 @@ def _plant_model(t: _Table, n_channels: int) -> PlantModelConfig | None:
             others = sorted(set(t.data) - {"file"})
             raise ConfigError(f"{t.source}: {t.key(others[0])}: give either file or the lists")
         return PlantModelConfig(file=file)
-    from softarm.identification.result import IdentifiedPlant
-
     plant = IdentifiedPlant.from_mapping(t.data, where=f"{t.source}: {t.path}")
     if plant.n_channels != n_channels:
         raise ConfigError(

@@ -9,17 +9,19 @@ The devices have one vocabulary, :mod:`softarm.hardware.protocols` (``PressureBa
 ``RipenessSensor`` from there. ``GripperDevice`` and ``RipenessProbe`` are their old names
 here, kept as aliases so that existing imports keep working. What is defined here is what
 the harvest loop adds on top of the devices: the estimates, the controller, the clock.
+The vision's vocabulary (``BerryTarget``, ``BerryFix``, ``Observation``) is defined in
+:mod:`softarm.vision.observation` and re-exported here.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal, Protocol
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from softarm.hardware.protocols import Gripper, RipenessSensor
+from softarm.vision.observation import BerryFix, BerryTarget, CameraName, Observation
 
 __all__ = [
     "BerryFix",
@@ -39,29 +41,6 @@ __all__ = [
 ]
 
 FloatArray = npt.NDArray[np.float64]
-#: Which camera the berry position came from; ``held`` = the most recent one, kept while
-#: the berry is hidden (section III-D). (A name, not a device: the device protocol is
-#: :class:`softarm.hardware.protocols.Camera`.)
-CameraName = Literal["eye_to_hand", "eye_in_hand", "held"]
-
-
-@dataclass(frozen=True)
-class BerryTarget:
-    """A berry to harvest: the id of the ArUco tag that marks it (section IV-E) and an
-    optional label for the logs."""
-
-    tag_id: int
-    label: str = ""
-
-
-@dataclass(frozen=True)
-class BerryFix:
-    """A berry position ``position`` (3,) in the base frame, the ``camera`` it came from
-    and its ``age`` (s since it was measured; 0 for a fresh measurement)."""
-
-    position: FloatArray
-    camera: CameraName
-    age: float = 0.0
 
 
 class Clock(Protocol):
@@ -75,17 +54,6 @@ class Clock(Protocol):
     def sleep(self, dt: float) -> None:
         """Let ``dt`` seconds pass."""
         ...
-
-
-@dataclass(frozen=True)
-class Observation:
-    """What the cameras give at time ``t``: ``T_base_ee`` (4, 4) from the marker cube
-    (eq. 22), None when the cube is not seen, and the berry ``fix``, None when there is
-    none (not seen and no fix held)."""
-
-    t: float
-    pose: FloatArray | None
-    fix: BerryFix | None
 
 
 class Vision(Protocol):
