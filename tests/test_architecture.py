@@ -106,6 +106,68 @@ def test_the_layer_check_can_fail() -> None:
     ]
 
 
+#: The layers of docs/architecture.md, bottom up, and what each may not import: nothing
+#: above it. ``softarm.viz``'s drawing geometry (``viz.arm``, ``viz.gripper``) sits below
+#: the harvest and the planning that plot with it; its rerun views of a harvest above.
+_TOP = ("softarm.commands", "softarm.cli", "softarm.sweep", "softarm.experiments")
+_HARVEST_UP = (*_TOP, "softarm.harvest", "softarm.planning", "softarm.viz")
+_FIT_UP = (*_HARVEST_UP, "softarm.calibration", "softarm.identification")
+_SIM_UP = (*_FIT_UP, "softarm.sim")
+LAYERS: dict[str, tuple[str, ...]] = {
+    "units.py": ("softarm.",),
+    "so3.py": ("softarm.",),
+    "geometry.py": ("softarm.",),
+    "checks.py": ("softarm.",),
+    "errors.py": ("softarm.",),
+    "hardware": (*_SIM_UP, "softarm.vision", "softarm.config"),
+    "config.py": (*_SIM_UP, "softarm.vision"),
+    "harvest_config.py": (*_SIM_UP, "softarm.vision", "softarm.config"),
+    "identified_plant.py": (*_SIM_UP, "softarm.vision"),
+    "vision": _SIM_UP,
+    "sim": _FIT_UP,
+    "calibration": _HARVEST_UP,
+    "identification": _HARVEST_UP,
+    "viz/arm.py": _HARVEST_UP,
+    "viz/gripper.py": _HARVEST_UP,
+    "harvest": (*_TOP, "softarm.planning", "softarm.viz.records", "softarm.viz.replay",
+                "softarm.viz.sim_view", "softarm.viz.layout", "softarm.viz.scene"),
+}  # fmt: skip
+#: What a leaf module may import of softarm.
+LEAF_MAY = ("softarm.errors", "softarm._core")
+
+
+def _layer_violations(rel: str, source: str) -> list[str]:
+    """The imports of module ``rel`` (path under softarm/) that its layer forbids."""
+    forbidden = next((v for k, v in LAYERS.items() if rel == k or rel.startswith(k + "/")), ())
+    return [
+        n
+        for n in _imports(ast.parse(source))
+        if any(n == f or n.startswith(f if f.endswith(".") else f + ".") for f in forbidden)
+        and not any(n == m or n.startswith(m + ".") for m in LEAF_MAY)
+    ]
+
+
+@pytest.mark.parametrize("path", _modules(PACKAGE), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_every_layer_imports_nothing_above_it(path: Path) -> None:
+    rel = path.relative_to(PACKAGE).as_posix()
+    bad = _layer_violations(rel, path.read_text())
+    assert bad == [], f"{rel} imports {bad} (see the layers of docs/architecture.md)"
+
+
+def test_the_layer_table_can_fail() -> None:
+    up = "from softarm.harvest.interfaces import Observation\nimport softarm.cli\n"
+    assert _layer_violations("vision/two_cameras.py", up) == [
+        "softarm.harvest.interfaces",
+        "softarm.harvest.interfaces.Observation",
+        "softarm.cli",
+    ]
+    assert _layer_violations("config.py", "from softarm.identification.result import X\n")
+    assert _layer_violations("units.py", "from softarm.so3 import exp\n")
+    assert not _layer_violations("units.py", "from softarm.errors import InputError\n")
+    assert _layer_violations("harvest/plots.py", "from softarm.viz.replay import replay\n")
+    assert not _layer_violations("harvest/plots.py", "from softarm.viz.arm import arm_line\n")
+
+
 def test_moved_helpers_are_the_same_objects_or_give_the_same_results() -> None:
     import numpy as np
 

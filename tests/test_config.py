@@ -14,6 +14,7 @@ from softarm.config import (
     CameraConfig,
     Config,
     GainsConfig,
+    HarvestConfig,
     SerialConfig,
     default_config,
     load_config,
@@ -42,7 +43,9 @@ def test_round_trip(tmp_path: Path) -> None:
     base = default_config()
     config = Config(
         arm=base.arm,
-        gains=GainsConfig({"alpha": 0.5, "schedule": "smooth", "axes": [True, True, False]}),
+        gains=GainsConfig(
+            {"hybrid_alpha": 0.5, "schedule": "smooth", "axis_mask": [True, True, False]}
+        ),
         calibration=CalibrationConfig(
             c1=CameraConfig(0, ((700.0, 0, 640.0), (0, 700.0, 360.0), (0, 0, 1.0)), (0.1, -0.2)),
             c2=CameraConfig("/dev/video2", file="c2 intrinsics.npz"),
@@ -93,6 +96,10 @@ CASES = [
     ("[arm]\nsections = []\n", "arm.sections must be a non-empty array"),
     (edit("[gains]", "[gains]\nalpha = {x = 1}"), "gains.alpha must be a finite number, bool"),
     (edit("[gains]", "[gains]\nalpha = nan"), "gains.alpha must be a finite number"),
+    (edit("[gains]", "[gains]\nalpha = 0.5"), "unknown key 'gains.alpha' (a softarm.Gains"),
+    (edit("[gains]", "[gains]\nhybrid_gamma = 'x'"), "gains.hybrid_gamma is refused by"),
+    (edit("[gains]", "[gains]\nschedule = 'nope'"), "gains.schedule is refused by softarm.Gains"),
+    (edit("[gains]", "[gains]\nhybrid_alpha = 9.0"), "gains.hybrid_alpha is refused by"),
     (edit("[calibration]  #", "[calibration]\n" + POSE_BAD_ROW + "#"), "last row"),
     (edit("[calibration]  #", "[calibration]\n" + POSE_SKEW + "#"), "orthonormal"),
     (edit("[calibration]  #", "[calibration]\n" + POSE_MIRROR + "#"), "determinant"),
@@ -133,3 +140,71 @@ def test_validation_errors_name_the_key(text: str, message: str) -> None:
 def test_error_message_carries_the_value() -> None:
     with pytest.raises(ConfigError, match=r"test\.toml: arm\.sections\[1\]\.radius .* got -0\.022"):
         parse_config(edit("radius = 0.022", "radius = -0.022"), source="test.toml")
+
+
+HARVEST_OK = """[harvest]
+period = 0.1
+approach = [0, 0, 1]
+settle_steps = 5
+marker_timeout = 2
+#"""
+
+
+def test_harvest_tuning_and_marker_geometry_from_the_file(tmp_path: Path) -> None:
+    text = edit("[calibration]  #", "[calibration]\nberry_tag = 0.03\n#").replace(
+        "T_EE_cube = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.05], [0, 0, 0, 1]]",
+        "T_EE_cube = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.07], [0, 0, 0, 1]]",
+    )
+    text = re.sub(r"\nberry_tag = 0\.012[^\n]*", "", text).replace("[harvest]  #", HARVEST_OK)
+    c = parse_config(text, source="test.toml")
+    assert c.harvest == HarvestConfig(
+        period=0.1, approach=(0.0, 0.0, 1.0), settle_steps=5, marker_timeout=2.0
+    )
+    assert c.harvest.fine_timeout == HarvestConfig().fine_timeout  # the rest: defaults
+    assert c.calibration.berry_tag == 0.03
+    assert c.calibration.T_EE_cube[2][3] == -0.07
+    save_config(c, tmp_path / "c.toml")
+    assert load_config(tmp_path / "c.toml") == c
+
+
+def test_shipped_defaults_are_the_harvest_defaults() -> None:
+    c = default_config()
+    assert c.harvest == HarvestConfig()
+    assert c.calibration.berry_tag == 0.012  # the paper's 12 mm tag
+    assert c.calibration.T_EE_cube[2][3] == -0.05  # the cube 5 cm behind the gripper frame
+
+
+HARVEST_BAD = [
+    ("periodd = 0.1", "unknown key 'harvest.periodd'"),
+    ("period = -0.1", "harvest.period must be finite and > 0, got -0.1"),
+    ("period = 'fast'", "harvest.period must be a finite number, got 'fast'"),
+    ("period = true", "harvest.period must be a finite number"),
+    ("settle_steps = 2.5", "harvest.settle_steps must be an integer >= 1"),
+    ("approach = [1, 1, 0]", "harvest.approach must be a unit vector"),
+    ("approach = [0, 1]", "harvest.approach must be a unit vector"),
+    ("approach_cone_deg = 90", "harvest.approach_cone_deg must be in [0, 90)"),
+    ("grasp_offset = -0.01", "harvest.grasp_offset must be finite and >= 0"),
+    ("fine_budget = nan", "harvest.fine_budget must be a finite number"),
+]
+
+
+@pytest.mark.parametrize(("line", "message"), HARVEST_BAD)
+def test_harvest_errors_name_the_key(line: str, message: str) -> None:
+    with pytest.raises(ConfigError, match=re.escape(message)):
+        parse_config(edit("[harvest]  #", f"[harvest]\n{line}\n#"), source="test.toml")
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ("berry_tag = 0", "calibration.berry_tag must be > 0"),
+        ("berry_tag = '12 mm'", "calibration.berry_tag must be a finite number"),
+        ("T_EE_cube = [[1, 0], [0, 1]]", "calibration.T_EE_cube must be a 4x4"),
+        ("T_EE_cube = [[2,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]", "T_EE_cube must have an ortho"),
+    ],
+)
+def test_marker_geometry_errors_name_the_key(line: str, message: str) -> None:
+    text = re.sub(r"\n(T_EE_cube|berry_tag) = [^\n]*", "", DEFAULT)
+    text = text.replace("[calibration]  #", f"[calibration]\n{line}\n#")
+    with pytest.raises(ConfigError, match=re.escape(message)):
+        parse_config(text, source="test.toml")

@@ -1,5 +1,6 @@
 """Configuration of a softarm installation in one TOML file: geometry, gains, camera
-calibration, pressure channels and the serial port.
+calibration and marker geometry, pressure channels, the serial port and the harvest's
+tuning.
 
 ``load_config(path)`` parses and validates (every error is a
 :class:`~softarm.errors.ConfigError` naming the key path, e.g. ``arm.sections[1].radius``);
@@ -14,12 +15,13 @@ from __future__ import annotations
 import json
 import math
 import tomllib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from softarm.errors import ConfigError
+from softarm._core import Gains
+from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.limits import (
     BAUD,
     FULL_SCALE_PSI,
@@ -30,6 +32,8 @@ from softarm.hardware.limits import (
     WATCHDOG_TIMEOUT_S,
     Limit,
 )
+from softarm.harvest_config import HarvestConfig
+from softarm.identified_plant import IdentifiedPlant
 from softarm.units import MAX_PSI, METRES_PER_PSI, PA_PER_PSI
 
 __all__ = [
@@ -39,6 +43,7 @@ __all__ = [
     "ChannelsConfig",
     "Config",
     "GainsConfig",
+    "HarvestConfig",
     "PlantModelConfig",
     "SectionConfig",
     "SerialConfig",
@@ -73,7 +78,8 @@ class ArmConfig:
 
 @dataclass(frozen=True)
 class GainsConfig:
-    """Free-form resolver gain keywords (passed to ``softarm.Gains(**values)``)."""
+    """Resolver gain keywords (passed to ``softarm.Gains(**values)``); :func:`load_config`
+    checks each against ``softarm.Gains`` and names the bad one (``gains.<key>``)."""
 
     values: dict[str, Any] = field(default_factory=dict)
 
@@ -91,13 +97,19 @@ class CameraConfig:
 
 @dataclass(frozen=True)
 class CalibrationConfig:
-    """Cameras and extrinsics: ``T_C1_base`` (base in the eye-to-hand camera C1) and
-    ``T_C2_EE`` (end effector in the eye-in-hand camera C2), 4×4, or ``None`` if unknown."""
+    """Cameras, extrinsics and marker geometry: ``T_C1_base`` (base in the eye-to-hand
+    camera C1) and ``T_C2_EE`` (end effector in the eye-in-hand camera C2), 4×4, or
+    ``None`` if unknown; ``T_EE_cube``, the marker cube in the end-effector frame (eq. 22;
+    as built: 5 cm behind the gripper frame), and ``berry_tag``, the side (m) of the
+    berry ArUco tags (the paper's 12 mm, section III-D)."""
 
     c1: CameraConfig = field(default_factory=CameraConfig)
     c2: CameraConfig = field(default_factory=lambda: CameraConfig(source=1))
     T_C1_base: Matrix | None = None
     T_C2_EE: Matrix | None = None
+    T_EE_cube: Matrix = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, -0.05),
+                         (0.0, 0.0, 0.0, 1.0))  # fmt: skip
+    berry_tag: float = 0.012
 
 
 @dataclass(frozen=True)
@@ -148,6 +160,8 @@ class Config:
     channels: ChannelsConfig = field(default_factory=ChannelsConfig)
     serial: SerialConfig = field(default_factory=SerialConfig)
     plant_model: PlantModelConfig | None = None
+    #: ``[harvest]``: the state machine's tuning (:class:`softarm.harvest.HarvestConfig`).
+    harvest: HarvestConfig = field(default_factory=HarvestConfig)
 
 
 def load_config(path: str | Path) -> Config:
@@ -328,19 +342,18 @@ def _build(root: _Table) -> Config:
     )
     arm_t.done()
 
-    gains_t = root.table("gains")
-    for name, value in gains_t.data.items():
-        items = value if isinstance(value, list) else [value]
-        if not all(isinstance(x, int | float | str) for x in items) or (
-            any(isinstance(x, float) and not math.isfinite(x) for x in items)
-        ):
-            raise gains_t.error(name, "must be a finite number, bool, string or a list of them")
-    gains = GainsConfig(dict(gains_t.data))
+    gains = GainsConfig(_gains(root.table("gains")))
 
     cal_t = root.table("calibration")
     c1_t, c2_t = cal_t.table("c1"), cal_t.table("c2")
+    d0 = CalibrationConfig()
     calibration = CalibrationConfig(
-        _camera(c1_t, 0), _camera(c2_t, 1), _pose(cal_t, "T_C1_base"), _pose(cal_t, "T_C2_EE")
+        _camera(c1_t, 0),
+        _camera(c2_t, 1),
+        _pose(cal_t, "T_C1_base"),
+        _pose(cal_t, "T_C2_EE"),
+        _pose(cal_t, "T_EE_cube") or d0.T_EE_cube,
+        cal_t.number("berry_tag", d0.berry_tag, positive=True),
     )
     cal_t.done()
 
@@ -414,8 +427,70 @@ def _build(root: _Table) -> Config:
     )
     se.done()
     plant_model = _plant_model(root.table("plant_model"), len(channels.names))
+    harvest = _harvest(root.table("harvest"))
     root.done()
-    return Config(arm, gains, calibration, channels, serial, plant_model)
+    return Config(arm, gains, calibration, channels, serial, plant_model, harvest)
+
+
+def _harvest(t: _Table) -> HarvestConfig:
+    """``[harvest]``: fields of :class:`HarvestConfig`, each checked on its own so that
+    the error names ``harvest.<key>``; the keys not given keep their defaults."""
+    defaults = HarvestConfig()
+    names = {f.name for f in fields(HarvestConfig)}
+    values: dict[str, Any] = {}
+    for name, value in t.data.items():
+        if name not in names:
+            raise ConfigError(
+                f"{t.source}: unknown key {t.key(name)!r} (a softarm.harvest.HarvestConfig "
+                f"field: {', '.join(sorted(names))})"
+            )
+        t.used.add(name)
+        if isinstance(value, list):  # approach: TOML has arrays, the dataclass a tuple
+            value = tuple(float(x) if isinstance(x, int) and not isinstance(x, bool) else x
+                          for x in value)  # fmt: skip
+        is_number = isinstance(value, int | float) and not isinstance(value, bool)
+        if isinstance(getattr(defaults, name), float) and is_number:
+            value = float(value)
+        try:
+            HarvestConfig(**{name: value})
+        except ParameterError as exc:
+            message = str(exc)
+            message = message[len(name) :].lstrip() if message.startswith(name) else message
+            raise ConfigError(f"{t.source}: {t.key(name)} {message}") from None
+        values[name] = value
+    t.done()
+    return HarvestConfig(**values)
+
+
+#: Every keyword of ``softarm.Gains`` (its fields, as ``Gains.as_dict`` lists them).
+GAIN_KEYS: tuple[str, ...] = tuple(Gains().as_dict())
+
+
+def _gains(t: _Table) -> dict[str, Any]:
+    """``[gains]``: each key a ``softarm.Gains`` keyword whose value the resolver takes,
+    checked here so that the error names ``gains.<key>`` (not only when a rig is built)."""
+    for name, value in t.data.items():
+        t.used.add(name)
+        items = value if isinstance(value, list) else [value]
+        if not all(isinstance(x, int | float | str) for x in items) or (
+            any(isinstance(x, float) and not math.isfinite(x) for x in items)
+        ):
+            raise t.error(name, "must be a finite number, bool, string or a list of them")
+        if name not in GAIN_KEYS:
+            raise ConfigError(
+                f"{t.source}: unknown key {t.key(name)!r} (a softarm.Gains keyword: "
+                f"{', '.join(GAIN_KEYS)})"
+            )
+        try:
+            Gains(**{name: value})
+        except (ValueError, TypeError) as exc:
+            raise t.error(name, f"is refused by softarm.Gains ({exc})") from None
+    try:  # the keys together (a constraint between two gains)
+        Gains(**t.data)
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(f"{t.source}: {t.path}: {exc}") from None
+    t.done()
+    return dict(t.data)
 
 
 def _plant_model(t: _Table, n_channels: int) -> PlantModelConfig | None:
@@ -431,8 +506,6 @@ def _plant_model(t: _Table, n_channels: int) -> PlantModelConfig | None:
             others = sorted(set(t.data) - {"file"})
             raise ConfigError(f"{t.source}: {t.key(others[0])}: give either file or the lists")
         return PlantModelConfig(file=file)
-    from softarm.identification.result import IdentifiedPlant
-
     plant = IdentifiedPlant.from_mapping(t.data, where=f"{t.source}: {t.path}")
     if plant.n_channels != n_channels:
         raise ConfigError(
@@ -475,11 +548,13 @@ def dump_config(config: Config) -> str:
         out += ["[[arm.sections]]", *_lines(asdict(s)), ""]
     out += ["[gains]", *_lines(config.gains.values), ""]
     cal = config.calibration
-    out += ["[calibration]", *_lines({"T_C1_base": cal.T_C1_base, "T_C2_EE": cal.T_C2_EE}), ""]
+    poses = {"T_C1_base": cal.T_C1_base, "T_C2_EE": cal.T_C2_EE, "T_EE_cube": cal.T_EE_cube}
+    out += ["[calibration]", *_lines({**poses, "berry_tag": cal.berry_tag}), ""]
     for name, cam in (("c1", cal.c1), ("c2", cal.c2)):
         out += [f"[calibration.{name}]", *_lines(asdict(cam)), ""]
     out += ["[channels]", *_lines(asdict(config.channels)), ""]
-    out += ["[serial]", *_lines(asdict(config.serial))]
+    out += ["[serial]", *_lines(asdict(config.serial)), ""]
+    out += ["[harvest]", *_lines(asdict(config.harvest))]
     if config.plant_model is not None:
         out += ["", "[plant_model]", *_lines(asdict(config.plant_model))]
     return "\n".join(out) + "\n"

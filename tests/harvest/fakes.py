@@ -16,6 +16,7 @@ from softarm.harvest import (
     HarvestConfig,
     HarvestLog,
     HarvestMachine,
+    Observation,
     SafeActuator,
 )
 from softarm.harvest.states import HarvestState
@@ -107,6 +108,22 @@ class FakeLocator:
 
 
 @dataclass
+class FakeVision:
+    """Both fakes as one :class:`~softarm.harvest.interfaces.Vision`: the pose, then the
+    berry given that pose."""
+
+    tracker: FakeTracker
+    locator: FakeLocator
+
+    def select(self, berry: BerryTarget) -> None:
+        self.locator.select(berry)
+
+    def observe(self, time: float) -> Observation:
+        pose = self.tracker.track(time)
+        return Observation(time, pose, self.locator.locate(time, pose))
+
+
+@dataclass
 class FakeController:
     """Proportional step in q towards the target position, clipped to the limits."""
 
@@ -192,8 +209,7 @@ def make_rig(log: HarvestLog | None = None, config: HarvestConfig | None = None)
     ripeness = FakeRipeness({}, locator)
     machine = HarvestMachine(
         clock,
-        tracker,
-        locator,
+        FakeVision(tracker, locator),
         FakeController(),
         SafeActuator(bank),
         gripper,

@@ -116,7 +116,7 @@ def _hardware(args: argparse.Namespace, progress: Progress) -> Calibration | Non
             excitation_set(nominal, args.poses, seed=args.seed),
             m.actuator.send,
             m.clock.sleep,
-            lambda: m.servo.tracker.track(m.clock.now()),
+            lambda: m.vision.track(m.clock.now()),  # type: ignore[attr-defined]
             on_pose=progress,
         )
     finally:

@@ -26,6 +26,10 @@ CALIBRATION = """\
 #    calibration (eq. 21).
 # T_C1_base = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
 # T_C2_EE = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+# The marker cube in the end-effector frame (eq. 22; rotation block and translation in m),
+# and the side (m) of the berry tags: measure your build (these are the defaults).
+T_EE_cube = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.05], [0, 0, 0, 1]]
+berry_tag = 0.012
 
 [calibration.c1]  # eye-to-hand camera (a ZED2 in the paper)
 source = 0  # OpenCV device index, or a video file or stream URL
@@ -45,7 +49,8 @@ source = 1
 HEADER = """\
 # softarm hardware configuration, written by `softarm config init`.
 # 1. Fill in [calibration] below (the poses and both cameras' intrinsics).
-# 2. Check the channel names, the serial port and the pressure limits for your rig.
+# 2. Check the channel names, the serial port and the pressure limits for your rig, and
+#    the marker cube's mount and berry tag size in [calibration]; tune in [harvest].
 # 3. `softarm config check THIS_FILE`, then `softarm harvest --config THIS_FILE`.
 # The arm geometry is the blackberry arm of the redundancy paper, as shipped:
 """

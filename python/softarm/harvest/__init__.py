@@ -5,15 +5,15 @@ from softarm.harvest.actuator import SafeActuator
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryFix,
-    BerryLocator,
     BerryTarget,
     Clock,
     Controller,
-    EndEffectorTracker,
     GripperDevice,
     GroundTruth,
+    Observation,
     PressureActuator,
     RipenessProbe,
+    Vision,
 )
 from softarm.harvest.log import HarvestLog, read_log
 from softarm.harvest.machine import HarvestMachine
@@ -23,12 +23,10 @@ from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
 __all__ = [
     "FAULTS_THAT_STOP",
     "BerryFix",
-    "BerryLocator",
     "BerryResult",
     "BerryTarget",
     "Clock",
     "Controller",
-    "EndEffectorTracker",
     "FaultReason",
     "GripperDevice",
     "GroundTruth",
@@ -37,8 +35,10 @@ __all__ = [
     "HarvestMachine",
     "HarvestReport",
     "HarvestState",
+    "Observation",
     "PressureActuator",
     "RipenessProbe",
     "SafeActuator",
+    "Vision",
     "read_log",
 ]

@@ -8,18 +8,18 @@ everything opened so far is vented and closed again and
 
 from __future__ import annotations
 
-import time
 from contextlib import ExitStack
 from dataclasses import dataclass
 
 import numpy as np
 
 from softarm._core import Gains, Resolver, Section, SoftArm
-from softarm.config import CameraConfig, Config
+from softarm.config import Config
 from softarm.errors import ConfigError
 from softarm.hardware.arduino import ArduinoLink
 from softarm.hardware.arduino_devices import ArduinoGripper, ArduinoRipenessSensor
 from softarm.hardware.camera import OpenCVCamera
+from softarm.hardware.clock import MonotonicClock
 from softarm.hardware.daq import NidaqPressureBank
 from softarm.hardware.pressure_map import ElongationMap, VoltageMap
 from softarm.hardware.safety import SafePressureBank
@@ -30,31 +30,11 @@ from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.vision_loop import CameraVision
-from softarm.vision import CameraModel, MarkerCube
+from softarm.vision import MarkerCube
+from softarm.vision.camera_model import camera_from_config
 from softarm.vision.poses import invert
 
 __all__ = ["HardwareRig", "MonotonicClock", "build_hardware_rig"]
-
-#: The marker cube in the end-effector frame: 5 cm behind the gripper frame, as built.
-#: Not in the TOML config yet (see docs/harvest.md).
-T_EE_CUBE = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.05], [0, 0, 0, 1]])
-BERRY_TAG = 0.012  # the paper's 12 mm berry tag (section III-D)
-
-
-class MonotonicClock:
-    """Wall-clock time; ``sleep`` waits for the next control period boundary."""
-
-    def __init__(self) -> None:
-        self._next = time.monotonic()
-
-    def now(self) -> float:
-        """Seconds since an arbitrary origin."""
-        return time.monotonic()
-
-    def sleep(self, dt: float) -> None:
-        """Wait until ``dt`` after the previous deadline (no drift when a step is slow)."""
-        self._next = max(self._next + dt, time.monotonic())
-        time.sleep(max(0.0, self._next - time.monotonic()))
 
 
 @dataclass
@@ -69,28 +49,21 @@ class HardwareRig:
         self.devices.close()
 
 
-def _camera_model(cam: CameraConfig, name: str) -> CameraModel:
-    if cam.file is not None:
-        return CameraModel.load(cam.file)
-    if cam.matrix is None:
-        raise ConfigError(f"calibration.{name}: no intrinsics (matrix or file) in the config")
-    return CameraModel(np.array(cam.matrix), np.array(cam.distortion or [0.0] * 5))
-
-
 def build_hardware_rig(
     config: Config, harvest: HarvestConfig | None = None, log: HarvestLog | None = None
 ) -> HardwareRig:
-    """Open every device of ``config`` and wire the machine.
+    """Open every device of ``config`` and wire the machine, tuned by ``harvest`` (default:
+    the config's ``[harvest]``).
 
     Raises:
         HardwareUnavailableError: a device (or its driver) is absent.
         ConfigError: the calibration needed by the vision loop is missing.
     """
-    cfg = harvest or HarvestConfig()
+    cfg = harvest or config.harvest
     cal, ch = config.calibration, config.channels
     if cal.T_C1_base is None or cal.T_C2_EE is None:
         raise ConfigError("calibration.T_C1_base and calibration.T_C2_EE must be set to harvest")
-    model1, model2 = _camera_model(cal.c1, "c1"), _camera_model(cal.c2, "c2")
+    model1, model2 = camera_from_config(cal.c1, "c1"), camera_from_config(cal.c2, "c2")
     arm = SoftArm([Section(**vars(s)) for s in config.arm.sections])
     gains = Gains(**config.gains.values) if config.gains.values else None
     resolver = Resolver(arm, mode="hybrid", gains=gains)
@@ -109,12 +82,12 @@ def build_hardware_rig(
         stack.callback(cam2.close)
         vision = CameraVision(
             lambda t: cam1.read(), lambda t: cam2.read(), model1, model2,
-            invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)), T_EE_CUBE,
-            MarkerCube.standard(), BERRY_TAG, cfg.grasp_offset,
+            invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)),
+            np.array(cal.T_EE_cube), MarkerCube.standard(), cal.berry_tag, cfg.grasp_offset,
         )  # fmt: skip
         gripper = ArduinoGripper(link)
         machine = HarvestMachine(
-            MonotonicClock(), vision, vision, ResolverController(resolver),
+            MonotonicClock(), vision, ResolverController(resolver),
             SafeActuator(bank, ElongationMap(ch.p_max, ch.metres_per_psi)), gripper,
             ArduinoRipenessSensor(link), arm.n_actuators, cfg, log,
             planner=ModelIK(planning_resolver(arm), cfg),

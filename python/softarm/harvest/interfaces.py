@@ -9,59 +9,38 @@ The devices have one vocabulary, :mod:`softarm.hardware.protocols` (``PressureBa
 ``RipenessSensor`` from there. ``GripperDevice`` and ``RipenessProbe`` are their old names
 here, kept as aliases so that existing imports keep working. What is defined here is what
 the harvest loop adds on top of the devices: the estimates, the controller, the clock.
+The vision's vocabulary (``BerryTarget``, ``BerryFix``, ``Observation``) is defined in
+:mod:`softarm.vision.observation` and re-exported here.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal, Protocol
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from softarm.hardware.protocols import Gripper, RipenessSensor
+from softarm.vision.observation import BerryFix, BerryTarget, CameraName, Observation
 
 __all__ = [
     "BerryFix",
-    "BerryLocator",
     "BerryTarget",
     "CameraName",
     "Clock",
     "Controller",
-    "EndEffectorTracker",
     "Gripper",
     "GripperDevice",
     "GroundTruth",
+    "Observation",
     "PlacementPlanner",
     "PressureActuator",
     "RipenessProbe",
     "RipenessSensor",
+    "Vision",
 ]
 
 FloatArray = npt.NDArray[np.float64]
-#: Which camera the berry position came from; ``held`` = the most recent one, kept while
-#: the berry is hidden (section III-D). (A name, not a device: the device protocol is
-#: :class:`softarm.hardware.protocols.Camera`.)
-CameraName = Literal["eye_to_hand", "eye_in_hand", "held"]
-
-
-@dataclass(frozen=True)
-class BerryTarget:
-    """A berry to harvest: the id of the ArUco tag that marks it (section IV-E) and an
-    optional label for the logs."""
-
-    tag_id: int
-    label: str = ""
-
-
-@dataclass(frozen=True)
-class BerryFix:
-    """A berry position ``position`` (3,) in the base frame, the ``camera`` it came from
-    and its ``age`` (s since it was measured; 0 for a fresh measurement)."""
-
-    position: FloatArray
-    camera: CameraName
-    age: float = 0.0
 
 
 class Clock(Protocol):
@@ -77,25 +56,19 @@ class Clock(Protocol):
         ...
 
 
-class EndEffectorTracker(Protocol):
-    """Eye-to-hand tracking of the end-effector marker cube (eq. 22)."""
-
-    def track(self, time: float) -> FloatArray | None:
-        """``T_base_ee`` (4, 4) at ``time``, or None when the cube is not seen."""
-        ...
-
-
-class BerryLocator(Protocol):
-    """The berry position from both cameras: eye-to-hand far away, eye-in-hand (eq. 21)
-    within the 6 cm hand-over distance, the most recent fix held while the berry is
-    hidden, up to an age limit (section III-D, fig. 4)."""
+class Vision(Protocol):
+    """Both cameras: eye-to-hand tracking of the end-effector cube (eq. 22), and the berry
+    from eye-to-hand far away, eye-in-hand (eq. 21) within the 6 cm hand-over distance,
+    the most recent fix held while the berry is hidden, up to an age limit (section
+    III-D, fig. 4). How long the harvest tolerates a lost marker is not the vision's
+    business (:class:`softarm.harvest.observe.BerryWatch` owns that)."""
 
     def select(self, berry: BerryTarget) -> None:
         """Track ``berry`` from now on, forgetting any held fix."""
         ...
 
-    def locate(self, time: float, T_base_ee: FloatArray | None) -> BerryFix | None:
-        """The berry at ``time`` given the tracked end-effector pose, or None."""
+    def observe(self, time: float) -> Observation:
+        """The end-effector pose and the berry at ``time``."""
         ...
 
 

@@ -28,21 +28,22 @@ import numpy as np
 from softarm.errors import HardwareError, NonFiniteError, SafetyError, VisionError
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
-    BerryLocator,
     BerryTarget,
     Clock,
     Controller,
-    EndEffectorTracker,
     FloatArray,
     Gripper,
     GroundTruth,
     PlacementPlanner,
     PressureActuator,
     RipenessSensor,
+    Vision,
 )
 from softarm.harvest.log import HarvestLog
+from softarm.harvest.observe import BerryWatch
+from softarm.harvest.outcome import Fault
 from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.servo import Fault, Servo
+from softarm.harvest.servo import Servo
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
 
 __all__ = ["HarvestMachine"]
@@ -53,8 +54,15 @@ S = HarvestState
 class HarvestMachine:
     """Harvests berries one at a time with the devices given (see module docstring).
 
+    The machine alone owns the harvest state, the current berry's approach axis and
+    :class:`~softarm.harvest.report.BerryResult`: the stages (:class:`~softarm.harvest.
+    servo.Servo`) are told what they need and return a
+    :class:`~softarm.harvest.outcome.StageOutcome`; what they observed along the way (also
+    up to a fault) is in the berry's :class:`~softarm.harvest.observe.BerryWatch`, which
+    the machine records into the result when the berry ends.
+
     Args:
-        clock, tracker, locator, controller, actuator, gripper, ripeness: the
+        clock, vision, controller, actuator, gripper, ripeness: the
             :mod:`softarm.harvest.interfaces` the machine runs on.
         n_actuators: length of q.
         config: tuning; defaults follow the paper.
@@ -67,8 +75,7 @@ class HarvestMachine:
     def __init__(
         self,
         clock: Clock,
-        tracker: EndEffectorTracker,
-        locator: BerryLocator,
+        vision: Vision,
         controller: Controller,
         actuator: PressureActuator,
         gripper: Gripper,
@@ -80,7 +87,7 @@ class HarvestMachine:
         planner: PlacementPlanner | None = None,
     ) -> None:
         self.clock = clock
-        self.locator = locator
+        self.vision = vision
         self.actuator = actuator
         self.gripper = gripper
         self.ripeness = ripeness
@@ -94,8 +101,10 @@ class HarvestMachine:
         #: The ready pose between berries: straight, every actuator at ``home_elongation``,
         #: away from the lower limits where the resolver's steps would be clipped.
         self.home: FloatArray = np.full(n_actuators, self.config.home_elongation)
-        self.servo = Servo(clock, tracker, locator, controller, actuator, self.config, self.log)
+        self.servo = Servo(clock, controller, actuator, self.config, self.log)
         self.planner = planner
+        #: The approach axis of the current berry (a placement planner may tilt it).
+        self.axis: FloatArray = self.config.approach_axis
 
     def run(self, berries: Sequence[BerryTarget]) -> HarvestReport:
         """Harvest ``berries`` in order; stop early after a fault in FAULTS_THAT_STOP."""
@@ -119,24 +128,30 @@ class HarvestMachine:
         """
         result = BerryResult(berry.tag_id)
         start = self.clock.now()
-        self.servo.begin(berry, result)
+        watch = BerryWatch(self.vision, self.clock, berry, self.log, self.config.marker_timeout)
+        self.axis = self.config.approach_axis
+        waypoints: tuple[FloatArray, ...] = ()
+        servo = self.servo
         self._transition(S.IDLE, berry, "new berry")
         try:
-            self.locator.select(berry)
-            self.q = self.servo.ramp(self.q, self.home)
-            self.servo.wait_visible(self.q)
+            self.vision.select(berry)
+            self.q = servo.ramp(watch, self.state, self.q, self.home)
+            servo.wait_visible(watch, self.state, self.q)
             self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
-            self.q = self.servo.place(self.q, self.planner)
+            placed = servo.place(watch, self.state, self.q, self.axis, self.planner)
+            self.q, self.axis, waypoints = placed.q, placed.axis, placed.waypoints
             self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
-            self.q = self.servo.fine(self.q)
+            self.q = servo.fine(watch, self.state, self.q, self.axis).q
             self._record_grasp_errors(berry, result)
             if not grasp:
                 self._transition(S.DONE, berry, "positioned; no grasp requested")
-                return self._finish(result, start)
+                return self._finish(result, watch, start)
             self._transition(S.GRASP, berry, "berry within the grasp workspace")
             self._grasp(result)
             self._transition(S.RETURN_HOME, berry, "grasp finished")
-            self.q = self.servo.go_home(self.q, self.home)
+            self.q = servo.go_home(
+                watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
+            )
             if result.harvested:
                 self.gripper.open()  # drop the berry at the rest pose
             self._transition(S.DONE, berry, "harvested" if result.harvested else "skipped")
@@ -155,9 +170,18 @@ class HarvestMachine:
             self._vent(f"unexpected {exc!r}")
             self.log.event("crash", berry=berry.tag_id, error=repr(exc))
             raise
-        return self._finish(result, start)
+        return self._finish(result, watch, start)
 
-    def _finish(self, result: BerryResult, start: float) -> BerryResult:
+    def _finish(self, result: BerryResult, watch: BerryWatch, start: float) -> BerryResult:
+        """Record what the stages observed, the final state and the time into ``result``."""
+        if watch.last_fix is not None:
+            result.target = [float(v) for v in watch.last_fix]
+        if watch.grasp_errors is not None:
+            position, pointing = watch.grasp_errors
+            result.position_error_mm = 1e3 * position
+            result.orientation_error_deg = float(np.degrees(pointing))
+        result.steps = watch.steps
+        result.cameras = dict(watch.cameras)
         result.final_state = self.state
         result.duration_s = self.clock.now() - start
         self.log.event("berry_result", **result.to_dict())
@@ -178,13 +202,12 @@ class HarvestMachine:
     def _record_grasp_errors(self, berry: BerryTarget, result: BerryResult) -> None:
         if self.ground_truth is None:
             return
-        pos, ang = self.ground_truth.grasp_errors(berry, self.servo.axis)
+        pos, ang = self.ground_truth.grasp_errors(berry, self.axis)
         result.true_position_error_mm = 1e3 * pos
         result.true_orientation_error_deg = float(np.degrees(ang))
 
     def _transition(self, new: HarvestState, berry: BerryTarget, reason: str) -> None:
         old, self.state = self.state, new
-        self.servo.state = new
         self.log.event(
             "transition", t=self.clock.now(), berry=berry.tag_id, old=old, new=new, why=reason
         )

@@ -4,7 +4,7 @@ position, go home. Each step reads the cameras, checks them, logs, and commands 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 
@@ -12,131 +12,130 @@ from softarm.errors import NonFiniteError
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryFix,
-    BerryLocator,
-    BerryTarget,
     Clock,
     Controller,
-    EndEffectorTracker,
     FloatArray,
     PlacementPlanner,
     PressureActuator,
 )
 from softarm.harvest.log import HarvestLog
-from softarm.harvest.report import BerryResult
+from softarm.harvest.observe import BerryWatch
+from softarm.harvest.outcome import Ending, Fault, StageOutcome
 from softarm.harvest.states import FaultReason, HarvestState
 from softarm.harvest.targets import grasp_point, pointing_error, tool_pose
 
 __all__ = ["Fault", "Servo"]
 
 
-class Fault(Exception):
-    """Raised inside a stage to enter the safe state for ``reason``."""
-
-    def __init__(self, reason: FaultReason, detail: str) -> None:
-        super().__init__(detail)
-        self.reason = reason
-
-
-@dataclass
-class _Seen:
-    """What one step observed."""
-
-    t: float
-    pose: FloatArray | None
-    fix: BerryFix | None
-
-
 class Servo:
-    """Runs the stages of :class:`~softarm.harvest.machine.HarvestMachine`."""
+    """Runs the stages of :class:`~softarm.harvest.machine.HarvestMachine`.
+
+    It keeps no state of a berry or of the machine: each stage is told the berry's
+    :class:`~softarm.harvest.observe.BerryWatch`, the ``stage`` it runs as (for the step
+    log and the fault messages) and what it works towards, and returns where it ended.
+    """
 
     def __init__(
         self,
         clock: Clock,
-        tracker: EndEffectorTracker,
-        locator: BerryLocator,
         controller: Controller,
         actuator: PressureActuator,
         config: HarvestConfig,
         log: HarvestLog,
     ) -> None:
-        self.clock, self.tracker, self.locator = clock, tracker, locator
-        self.controller, self.actuator, self.cfg, self.log = controller, actuator, config, log
-        self.state = HarvestState.IDLE
-        self._berry = BerryTarget(-1)
-        self._result = BerryResult(-1)
-        self._pose_seen = self._fix_seen = -np.inf
-        self._last_fix: BerryFix | None = None
-        #: The approach axis of the current berry (the planner may tilt it).
-        self.axis = config.approach_axis
-        self._waypoints = []
-
-    def begin(self, berry: BerryTarget, result: BerryResult) -> None:
-        """Start a new berry: forget what was seen."""
-        self._berry, self._result = berry, result
-        self._pose_seen = self._fix_seen = self.clock.now()
-        self._last_fix = None
-        self.axis = self.cfg.approach_axis
-        self._waypoints: list[FloatArray] = []
+        self.clock, self.controller, self.actuator = clock, controller, actuator
+        self.cfg, self.log = config, log
 
     # -- stages ---------------------------------------------------------------------
 
-    def wait_visible(self, q: FloatArray) -> None:
+    def wait_visible(self, watch: BerryWatch, stage: HarvestState, q: FloatArray) -> None:
         """IDLE: hold the arm until both the cube and the berry are seen."""
-        self._pose_seen = self._fix_seen = self.clock.now()
+        watch.restart()
         while True:
-            seen = self._observe()
-            self._log_step(seen, q, None, None, False)
+            seen = watch.observe()
+            watch.log_step(stage, seen, q, None, None, False)
             if seen.pose is not None and seen.fix is not None:
                 return
             self._hold(q)
 
-    def place(self, q: FloatArray, planner: PlacementPlanner | None) -> FloatArray:
-        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose.
+    def place(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        axis: FloatArray,
+        planner: PlacementPlanner | None,
+    ) -> StageOutcome:
+        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose,
+        approaching along ``axis``.
 
         With a ``planner`` the pose (and the approach axis, inside the allowed cone) is
         first solved on the model; the plan's waypoints are then followed in closed loop
         (:meth:`follow`, the canes repelling inside the resolver) and the loop closes on
-        the berry (eq. 22) to remove the model's error.
+        the berry (eq. 22) to remove the model's error. The outcome carries the axis and
+        the waypoints used.
         """
         c = self.cfg
         start = self.clock.now()
+        waypoints: tuple[FloatArray, ...] = ()
         if planner is not None:
-            seen = self._observe()
+            seen = watch.observe()
             while seen.pose is None or seen.fix is None:
                 self._hold(q)
-                seen = self._observe()
+                seen = watch.observe()
             plan = planner.plan(q, seen.fix.position, seen.pose)
             if plan is None:
                 raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
-            waypoints, self.axis = plan
-            self._waypoints = list(waypoints)
-            self.log.event("plan", t=seen.t, q=waypoints, axis=self.axis, berry=seen.fix.position)
-            for q_way in waypoints:
-                q = self.follow(q, q_way, start + c.placement_timeout)
-        return self._servo(
-            q, c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout, None
-        )
+            planned, axis = plan
+            waypoints = tuple(planned)
+            self.log.event("plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position)
+            for q_way in planned:
+                q = self.follow(watch, stage, q, q_way, start + c.placement_timeout)
+        out = self._servo(
+            watch, stage, q, axis, c.grasp_offset + c.standoff, c.placement_tolerance,
+            c.placement_timeout, None, record_errors=True, placed_on_limit=True,
+        )  # fmt: skip
+        return replace(out, waypoints=waypoints)
 
-    def fine(self, q: FloatArray) -> FloatArray:
+    def fine(
+        self, watch: BerryWatch, stage: HarvestState, q: FloatArray, axis: FloatArray
+    ) -> StageOutcome:
         """FINE_POSITIONING: grasp point onto the berry (eye-in-hand, eq. 21)."""
         c = self.cfg
-        return self._servo(q, c.grasp_offset, c.fine_tolerance, c.fine_timeout, c.fine_budget)
+        return self._servo(
+            watch, stage, q, axis, c.grasp_offset, c.fine_tolerance, c.fine_timeout,
+            c.fine_budget, record_errors=True, placed_on_limit=False,
+        )  # fmt: skip
 
-    def go_home(self, q: FloatArray, home: FloatArray) -> FloatArray:
+    def go_home(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        home: FloatArray,
+        axis: FloatArray,
+        waypoints: tuple[FloatArray, ...],
+        berry: FloatArray | None,
+    ) -> FloatArray:
         """RETURN_HOME: back out to the pre-grasp pose (the approach line is free of
-        branches), ramp back through the placement plan's waypoints, then to ``home``."""
+        branches) of the ``berry`` last seen, along ``axis``, ramp back through the
+        placement plan's ``waypoints``, then to ``home``."""
         c = self.cfg
         start = self.clock.now()
-        berry = self._last_fix.position if self._last_fix is not None else None
         try:
             q = self._servo(
+                watch,
+                stage,
                 q,
+                axis,
                 c.grasp_offset + c.standoff,
                 c.placement_tolerance,
                 c.home_timeout / 2,
                 None,
+                record_errors=False,
+                placed_on_limit=False,
                 frozen=berry,
-            )
+            ).q
         except Fault as fault:
             # Backing out is best effort: the berry is already in the fingers, and the
             # ramp home is open loop anyway.
@@ -144,11 +143,18 @@ class Servo:
                 raise
             self.log.event("retreat_incomplete", t=self.clock.now(), detail=str(fault))
         # Leave by the planned way in (checked against the known canes), reversed.
-        for q_way in reversed(self._waypoints):
-            q = self.ramp(q, q_way, start + c.home_timeout)
-        return self.ramp(q, home, start + c.home_timeout)
+        for q_way in reversed(waypoints):
+            q = self.ramp(watch, stage, q, q_way, start + c.home_timeout)
+        return self.ramp(watch, stage, q, home, start + c.home_timeout)
 
-    def follow(self, q: FloatArray, q_way: FloatArray, deadline: float) -> FloatArray:
+    def follow(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        q_way: FloatArray,
+        deadline: float,
+    ) -> FloatArray:
         """Follow the planned segment ``q`` → ``q_way`` in closed loop on the eye-to-hand
         camera until the end effector is within ``placement_tolerance`` of the model's pose
         at ``q_way``.
@@ -164,7 +170,7 @@ class Servo:
         model_pose = getattr(self.controller, "model_pose", None)
         arm = getattr(self.controller, "arm", None)
         if model_pose is None or arm is None:
-            return self.ramp(q, q_way, deadline, observe=True)
+            return self.ramp(watch, stage, q, q_way, deadline, observe=True)
         c = self.cfg
         lower, upper = np.asarray(arm.lower), np.asarray(arm.upper)
         step = c.home_speed * c.period
@@ -172,9 +178,9 @@ class Servo:
         goal_final = model_pose(q_way)
         best, best_t = np.inf, self.clock.now()
         while True:
-            seen = self._observe(need_fix=False)
+            seen = watch.observe(need_fix=False)
             if seen.pose is None:
-                self._log_step(seen, q, None, None, False)
+                watch.log_step(stage, seen, q, None, None, False)
                 self._hold(q)
                 continue
             on_plan_end = bool(np.all(nominal == q_way))
@@ -191,7 +197,7 @@ class Servo:
             if seen.t > deadline:
                 raise Fault(
                     FaultReason.TIMEOUT,
-                    f"{self.state.value}: waypoint not reached, error {err:.4f} m",
+                    f"{stage.value}: waypoint not reached, error {err:.4f} m",
                 )
             goal = model_pose(nominal)
             q_fb, saturated = self.controller.step(q, goal, seen.pose)
@@ -202,26 +208,32 @@ class Servo:
             q_next = np.clip(np.asarray(q_fb, dtype=np.float64) + advance, lower, upper)
             if not np.all(np.isfinite(q_next)):
                 raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
-            self._log_step(
-                seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
+            watch.log_step(
+                stage, seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
             )
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.
             q = self.actuator.send(q_next)
             self.clock.sleep(c.period)
 
     def ramp(
-        self, q: FloatArray, goal: FloatArray, deadline: float = np.inf, observe: bool = False
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        goal: FloatArray,
+        deadline: float = np.inf,
+        observe: bool = False,
     ) -> FloatArray:
         """Move the elongations straight to ``goal`` at ``home_speed``, open loop; with
         ``observe`` the cameras are still read (and checked) at every step."""
         step = self.cfg.home_speed * self.cfg.period
         while np.any(q != goal):
             if self.clock.now() > deadline:
-                raise Fault(FaultReason.TIMEOUT, f"{self.state.value}: ramp not done in time")
+                raise Fault(FaultReason.TIMEOUT, f"{stage.value}: ramp not done in time")
             q = q + np.clip(goal - q, -step, step)
             self.actuator.send(q)
-            seen = self._observe(need_fix=False) if observe else _Seen(self.clock.now(), None, None)
-            self._log_step(seen, q, None, None, False)
+            seen = watch.observe(need_fix=False) if observe else watch.blind()
+            watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
         return q
 
@@ -229,30 +241,37 @@ class Servo:
 
     def _servo(
         self,
+        watch: BerryWatch,
+        stage: HarvestState,
         q: FloatArray,
+        axis: FloatArray,
         distance: float,
         tol: float,
         timeout: float,
         budget: float | None,
+        record_errors: bool,
+        placed_on_limit: bool,
         frozen: FloatArray | None = None,
-    ) -> FloatArray:
+    ) -> StageOutcome:
         """Drive the end effector to ``distance`` short of the berry along the approach
-        axis until the error stays below ``tol``; see :class:`HarvestConfig`. With
+        ``axis`` until the error stays below ``tol``; see :class:`HarvestConfig`. With
         ``frozen`` the berry position is that fixed point, not the cameras' (the berry is
-        in the fingers on the way back)."""
-        c, axis = self.cfg, self.axis
+        in the fingers on the way back). With ``record_errors`` every step keeps its errors
+        at the grasp in ``watch``; with ``placed_on_limit`` a saturated arm within ``tol``
+        hands over (:attr:`Ending.PLACEMENT_LIMIT`) instead of faulting."""
+        c = self.cfg
         start = self.clock.now()
-        self._fix_seen = max(self._fix_seen, start)  # the open-loop ramp needed no berry
+        watch.excuse_berry(start)  # the open-loop ramp needed no berry
         inside = 0
         best, best_t, saturated_since = np.inf, start, None
         angle_tol = np.radians(c.angle_tolerance_deg)
         while True:
-            seen = self._observe(need_fix=frozen is None)
+            seen = watch.observe(need_fix=frozen is None)
             if frozen is not None:
-                seen.fix = BerryFix(frozen, "held", seen.t - start)
+                seen = replace(seen, fix=BerryFix(frozen, "held", seen.t - start))
             elapsed = seen.t - start
             if seen.pose is None or seen.fix is None:
-                self._log_step(seen, q, None, None, False)
+                watch.log_step(stage, seen, q, None, None, False)
                 self._hold(q)
                 continue
             # The grasp point, not the end-effector origin, is servoed onto its goal
@@ -262,23 +281,25 @@ class Servo:
             goal = tool_pose(seen.pose, point, axis, c.grasp_offset)
             err = float(np.linalg.norm(grasp_point(seen.pose, c.grasp_offset) - point))
             ang = pointing_error(seen.pose, axis)
-            if self.state is not HarvestState.RETURN_HOME:  # the errors at the grasp
-                self._result.position_error_mm = 1e3 * float(
-                    np.linalg.norm(grasp_point(seen.pose, c.grasp_offset) - seen.fix.position)
+            if record_errors:  # the errors at the grasp
+                watch.record_grasp_errors(
+                    float(
+                        np.linalg.norm(grasp_point(seen.pose, c.grasp_offset) - seen.fix.position)
+                    ),
+                    ang,
                 )
-                self._result.orientation_error_deg = float(np.degrees(ang))
             inside = inside + 1 if err <= tol and ang <= angle_tol else 0
             if inside >= c.settle_steps:
-                self._log_step(seen, q, goal, (err, ang), False)
-                return q
+                watch.log_step(stage, seen, q, goal, (err, ang), False)
+                return StageOutcome(q, Ending.SETTLED, axis)
             if budget is not None and elapsed > budget and err <= c.grasp_workspace:
                 self.log.event("fine_budget", t=seen.t, error=err)
-                self._log_step(seen, q, goal, (err, ang), False)
-                return q
+                watch.log_step(stage, seen, q, goal, (err, ang), False)
+                return StageOutcome(q, Ending.BUDGET, axis)
             if elapsed > timeout:
                 raise Fault(
                     FaultReason.TIMEOUT,
-                    f"{self.state.value}: error {err:.4f} m after {elapsed:.1f} s",
+                    f"{stage.value}: error {err:.4f} m after {elapsed:.1f} s",
                 )
             q_next, saturated = self.controller.step(q, goal, seen.pose)
             q_next = np.asarray(q_next, dtype=np.float64)
@@ -294,71 +315,23 @@ class Servo:
                 if budget is not None and err <= c.grasp_workspace:
                     # On a joint limit but inside the gripper's ±1 cm: grasp (III-D).
                     self.log.event("limit_grasp", t=seen.t, error=err)
-                    return q
-                if self.state is HarvestState.INITIAL_PLACEMENT and err <= tol:
+                    return StageOutcome(q, Ending.LIMIT_GRASP, axis)
+                if placed_on_limit and err <= tol:
                     # Placed, but a joint limit holds the pointing: fine positioning, on
                     # the eye-in-hand camera, decides whether the berry can be reached.
                     self.log.event("placement_limit", t=seen.t, error=err, pointing=ang)
-                    return q
+                    return StageOutcome(q, Ending.PLACEMENT_LIMIT, axis)
                 raise Fault(
                     FaultReason.UNREACHABLE,
-                    f"{self.state.value}: saturated at error {err:.4f} m, "
+                    f"{stage.value}: saturated at error {err:.4f} m, "
                     f"pointing {np.degrees(ang):.1f} deg",
                 )
-            self._log_step(seen, q_next, goal, (err, ang), saturated)
+            watch.log_step(stage, seen, q_next, goal, (err, ang), saturated)
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.
             q = self.actuator.send(q_next)
             self.clock.sleep(c.period)
-
-    def _observe(self, need_fix: bool = True) -> _Seen:
-        """Read the tracker and the locator; check for NaN and for markers lost too long
-        (the berry only if ``need_fix``)."""
-        t = self.clock.now()
-        pose = self.tracker.track(t)
-        if pose is not None:
-            pose = np.asarray(pose, dtype=np.float64)
-            if not np.all(np.isfinite(pose)):
-                raise NonFiniteError("end-effector pose from the eye-to-hand camera is not finite")
-            self._pose_seen = t
-        elif t - self._pose_seen > self.cfg.marker_timeout:
-            raise Fault(FaultReason.MARKER_LOST, f"cube not seen for {t - self._pose_seen:.2f} s")
-        fix = self.locator.locate(t, pose)
-        if fix is not None:
-            if not np.all(np.isfinite(fix.position)):
-                raise NonFiniteError(f"berry position from {fix.camera} is not finite")
-            self._fix_seen = t
-            self._last_fix = fix
-            self._result.target = [float(v) for v in fix.position]
-            self._result.cameras[fix.camera] = self._result.cameras.get(fix.camera, 0) + 1
-        elif need_fix and t - self._fix_seen > self.cfg.marker_timeout:
-            raise Fault(FaultReason.MARKER_LOST, f"berry not seen for {t - self._fix_seen:.2f} s")
-        return _Seen(t, pose, fix)
 
     def _hold(self, q: FloatArray) -> None:
         """Keep commanding ``q`` (it also feeds the safety layer's watchdog) and wait."""
         self.actuator.send(q)
         self.clock.sleep(self.cfg.period)
-
-    def _log_step(
-        self,
-        seen: _Seen,
-        q: FloatArray,
-        goal: FloatArray | None,
-        errors: tuple[float, float] | None,
-        saturated: bool,
-    ) -> None:
-        self._result.steps += 1
-        self.log.step(
-            t=seen.t,
-            state=self.state,
-            berry=self._berry.tag_id,
-            q=q,
-            pose=seen.pose,
-            target=None if seen.fix is None else seen.fix.position,
-            camera=None if seen.fix is None else seen.fix.camera,
-            target_age=None if seen.fix is None else seen.fix.age,
-            goal=None if goal is None else goal[:3, 3],
-            position_error=None if errors is None else errors[0],
-            orientation_error=None if errors is None else errors[1],
-            saturated=saturated,
-        )

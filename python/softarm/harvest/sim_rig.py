@@ -231,7 +231,6 @@ def build_sim_rig(
     machine = HarvestMachine(
         clock,
         vision,
-        vision,
         controller,
         actuator,
         gripper,

@@ -20,13 +20,14 @@ from softarm.errors import ConfigError
 from softarm.hardware.arduino import ArduinoLink
 from softarm.hardware.arduino_devices import ArduinoPressureMonitor
 from softarm.hardware.camera import OpenCVCamera
+from softarm.hardware.clock import MonotonicClock
 from softarm.hardware.daq import NidaqPressureBank
 from softarm.hardware.pressure_map import VoltageMap
 from softarm.hardware.safety import SafePressureBank
-from softarm.harvest.hw_rig import BERRY_TAG, T_EE_CUBE, MonotonicClock, _camera_model
-from softarm.harvest.vision_loop import CameraVision
 from softarm.vision import MarkerCube
+from softarm.vision.camera_model import camera_from_config
 from softarm.vision.poses import invert
+from softarm.vision.two_cameras import CameraVision
 
 __all__ = ["HardwareIdentificationRig"]
 
@@ -45,7 +46,7 @@ class HardwareIdentificationRig:
         cal, ch = config.calibration, config.channels
         if cal.T_C1_base is None:
             raise ConfigError("calibration.T_C1_base must be set to track the arm")
-        model1 = _camera_model(cal.c1, "c1")
+        model1 = camera_from_config(cal.c1, "c1")
         self.period = period
         self.pose_cutoff: float | None = None  # C1's cube pose is not low-passed
         self.metres_per_psi = ch.metres_per_psi
@@ -69,8 +70,8 @@ class HardwareIdentificationRig:
             stack.callback(cam.close)
             self.vision = CameraVision(
                 lambda t: cam.read(), lambda t: None, model1, model1,
-                invert(np.array(cal.T_C1_base)), np.eye(4), T_EE_CUBE,
-                MarkerCube.standard(), BERRY_TAG, 0.0,
+                invert(np.array(cal.T_C1_base)), np.eye(4), np.array(cal.T_EE_cube),
+                MarkerCube.standard(), cal.berry_tag, 0.0,
             )  # fmt: skip
             self._devices = stack.pop_all()
 

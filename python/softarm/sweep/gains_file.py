@@ -13,12 +13,10 @@ from pathlib import Path
 from typing import Any
 
 import softarm
+from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError
 
 __all__ = ["GAIN_KEYS", "apply_gains", "gains_from", "load_gains", "write_gains"]
-
-#: Every keyword of ``softarm.Gains`` (its fields, as ``Gains.as_dict`` lists them).
-GAIN_KEYS: tuple[str, ...] = tuple(softarm.Gains().as_dict())
 
 
 def gains_from(values: Mapping[str, Any]) -> softarm.Gains:

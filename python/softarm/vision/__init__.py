@@ -19,11 +19,13 @@ from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.filter import PoseLowPassFilter
 from softarm.vision.fusion import CameraFusion, FusionEstimate
 from softarm.vision.registration import RegistrationResult, register_points
+from softarm.vision.two_cameras import CameraVision, register_c1
 
 __all__ = [
     "BaseRegistration",
     "CameraFusion",
     "CameraModel",
+    "CameraVision",
     "CubePose",
     "CubeTracker",
     "Detection",
@@ -40,6 +42,7 @@ __all__ = [
     "estimate_marker_poses",
     "get_dictionary",
     "marker_object_points",
+    "register_c1",
     "register_points",
     "square_marker_poses",
 ]

@@ -19,7 +19,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
@@ -27,6 +27,9 @@ import numpy.typing as npt
 
 from softarm.errors import ConfigError, ParameterError, ShapeError
 from softarm.vision._checks import FloatArray, as_array
+
+if TYPE_CHECKING:
+    from softarm.config import CameraConfig
 
 FORMAT = "softarm.camera/1"
 _DIST_LENGTHS = (0, 4, 5, 8, 12, 14)
@@ -190,3 +193,17 @@ class CameraModel:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def camera_from_config(cam: CameraConfig, name: str) -> CameraModel:
+    """The intrinsics of camera ``name`` (``c1``, ``c2``) of a configuration: its
+    ``file``, else its inline ``matrix`` and ``distortion``.
+
+    Raises:
+        ConfigError: neither is given.
+    """
+    if cam.file is not None:
+        return CameraModel.load(cam.file)
+    if cam.matrix is None:
+        raise ConfigError(f"calibration.{name}: no intrinsics (matrix or file) in the config")
+    return CameraModel(np.array(cam.matrix), np.array(cam.distortion or [0.0] * 5))

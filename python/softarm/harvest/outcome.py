@@ -1,0 +1,45 @@
+"""How a stage of the harvest ends: a :class:`StageOutcome` when it hands over to the
+next state, a :class:`Fault` when it cannot."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+from softarm.harvest.interfaces import FloatArray
+from softarm.harvest.states import FaultReason
+
+__all__ = ["Ending", "Fault", "StageOutcome"]
+
+
+class Fault(Exception):
+    """Raised inside a stage to enter the safe state for ``reason``."""
+
+    def __init__(self, reason: FaultReason, detail: str) -> None:
+        super().__init__(detail)
+        self.reason = reason
+
+
+class Ending(StrEnum):
+    """Why a closed-loop stage handed over (every way but a fault)."""
+
+    #: Within the tolerances for ``settle_steps`` steps in a row.
+    SETTLED = "settled"
+    #: Fine positioning ran out of its budget inside the grasp workspace (±1 cm).
+    BUDGET = "budget"
+    #: Saturated on a joint limit without progress, but inside the grasp workspace.
+    LIMIT_GRASP = "limit_grasp"
+    #: Placed within the position tolerance; a joint limit holds the pointing.
+    PLACEMENT_LIMIT = "placement_limit"
+
+
+@dataclass(frozen=True)
+class StageOutcome:
+    """What a stage hands to the machine: the commanded elongations ``q`` it ended at,
+    how it ended, the approach ``axis`` it used (a placement planner may tilt it), and the
+    plan's ``waypoints`` (elongations) the arm came in by, for the way out."""
+
+    q: FloatArray
+    ending: Ending
+    axis: FloatArray
+    waypoints: tuple[FloatArray, ...] = field(default=())

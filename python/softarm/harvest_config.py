@@ -1,0 +1,115 @@
+"""Tuning of the harvesting state machine (SI units).
+
+Below :mod:`softarm.harvest` (beside :mod:`softarm.config`, which reads it from the
+``[harvest]`` table of a configuration file); :mod:`softarm.harvest.config` re-exports it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softarm.errors import ParameterError
+
+__all__ = ["HarvestConfig"]
+
+
+@dataclass(frozen=True)
+class HarvestConfig:
+    """Parameters of :class:`~softarm.harvest.machine.HarvestMachine`.
+
+    Attributes:
+        period: control period (s).
+        approach: unit direction along which the gripper faces every berry (the bush
+            lies along +Y of the base frame, section IV-F).
+        approach_cone_deg: a placement planner may tilt the approach axis this far from
+            ``approach`` when the arm cannot face the berry squarely.
+        grasp_offset: how far ahead of the end-effector origin (m), along its z axis, a
+            berry sits when it is between the fingers.
+        standoff: pre-grasp distance (m) short of the grasp pose. Inside the 6 cm at which
+            fig. 4 hands over to the eye-in-hand camera, so placement ends in its view.
+        placement_tolerance: position error (m) that ends initial placement.
+        angle_tolerance_deg: pointing error that ends initial placement.
+        fine_tolerance: grasp-point-to-berry error (m) that ends fine positioning
+            (section IV-E reports 0.75 ± 0.36 mm).
+        grasp_workspace: error (m) the gripper still grasps at (±1 cm, section III-D);
+            used only when fine positioning runs out of time.
+        settle_steps: consecutive steps within tolerance before moving on (noise).
+        marker_timeout: how long (s) the cube or the berry may stay unseen (beyond the
+            locator's own hold of the last target) before MARKER_LOST.
+        placement_timeout, fine_timeout, home_timeout: time budgets (s) of the stages.
+        fine_budget: time (s) after which fine positioning settles for ``grasp_workspace``.
+        stall_time: saturated for this long (s) without ``stall_progress`` (m) of
+            improvement → UNREACHABLE.
+        stall_progress: see ``stall_time``.
+        ripeness_threshold: below it a grasped berry is unripe and released.
+        home_speed: elongation rate (m/s) of the open-loop moves to the ready pose.
+        home_elongation: every actuator's elongation (m) at the ready pose (straight arm).
+    """
+
+    period: float = 0.05
+    approach: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    approach_cone_deg: float = 20.0
+    grasp_offset: float = 0.03
+    standoff: float = 0.05
+    placement_tolerance: float = 0.01
+    angle_tolerance_deg: float = 5.0
+    fine_tolerance: float = 0.001
+    grasp_workspace: float = 0.01
+    settle_steps: int = 3
+    marker_timeout: float = 1.0
+    placement_timeout: float = 30.0
+    fine_timeout: float = 20.0
+    fine_budget: float = 12.0
+    home_timeout: float = 10.0
+    stall_time: float = 3.0
+    stall_progress: float = 0.002
+    ripeness_threshold: float = 0.5
+    home_speed: float = 0.03
+    home_elongation: float = 0.0167
+
+    def __post_init__(self) -> None:
+        for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
+                     "grasp_workspace", "marker_timeout", "placement_timeout", "fine_timeout",
+                     "fine_budget", "home_timeout", "stall_time", "home_speed",
+                     "angle_tolerance_deg"):  # fmt: skip
+            value = _real(self, name)
+            if not value > 0:
+                raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
+        for name in ("grasp_offset", "stall_progress", "home_elongation"):
+            value = _real(self, name)
+            if not value >= 0:
+                raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
+        _real(self, "ripeness_threshold")
+        cone = _real(self, "approach_cone_deg")
+        if not 0 <= cone < 90:
+            raise ParameterError(f"approach_cone_deg must be in [0, 90), got {cone!r}")
+        a = self.approach
+        if not (
+            isinstance(a, tuple | list)
+            and len(a) == 3
+            and all(_is_real(x) and np.isfinite(x) for x in a)
+            and abs(float(np.linalg.norm(a)) - 1.0) <= 1e-9
+        ):
+            raise ParameterError(f"approach must be a unit vector (3 numbers), got {a!r}")
+        n = self.settle_steps
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+            raise ParameterError(f"settle_steps must be an integer >= 1, got {n!r}")
+
+    @property
+    def approach_axis(self) -> np.ndarray:
+        """``approach`` as an array (3,)."""
+        return np.asarray(self.approach, dtype=np.float64)
+
+
+def _is_real(value: object) -> bool:
+    return isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
+
+
+def _real(config: HarvestConfig, name: str) -> float:
+    """The field ``name`` if it is a finite number, else a ParameterError naming it."""
+    value = getattr(config, name)
+    if not (_is_real(value) and np.isfinite(value)):
+        raise ParameterError(f"{name} must be a finite number, got {value!r}")
+    return float(value)

@@ -1,0 +1,169 @@
+"""Perception of the harvest loop from two cameras, simulated or real.
+
+The eye-to-hand camera C1 gives the end-effector pose from the marker cube (eq. 22) and a
+first berry position; the eye-in-hand camera C2 gives the berry close up, carried to the
+base frame through the tracked end-effector pose (eq. 21). :class:`CameraFusion` picks
+the source: C1 until the grasp point is within 6 cm of the berry, C2 after, the most
+recent fix while the berry is hidden (section III-D, fig. 4). Implements
+:class:`~softarm.harvest.interfaces.Vision`: one :meth:`CameraVision.observe` per control
+step reads both cameras. (In the vision layer, so that identification and calibration
+track the cube without the harvest; :mod:`softarm.harvest.vision_loop` re-exports it.)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm.checks import FloatArray
+from softarm.errors import VisionError
+from softarm.vision.base_registration import BaseRegistration
+from softarm.vision.camera_model import CameraModel
+from softarm.vision.cube import MarkerCube
+from softarm.vision.detector import Detection, MarkerDetector, square_marker_poses
+from softarm.vision.fusion import CameraFusion
+from softarm.vision.observation import BerryFix, BerryTarget, Observation
+from softarm.vision.poses import invert
+
+__all__ = ["CameraVision", "register_c1"]
+
+Frame = Callable[[float], npt.NDArray[np.uint8] | None]
+
+
+def register_c1(
+    frame: Frame,
+    model: CameraModel,
+    tag_id: int,
+    tag_length: float,
+    T_base_tag: FloatArray,
+    frames: int = 5,
+    dictionary: str = "DICT_4X4_50",
+) -> FloatArray:
+    """``T_base_c1`` from ``frames`` images of the base tag (section II-C, eq. 22).
+
+    Raises:
+        VisionError: the tag was never seen.
+    """
+    reg = BaseRegistration(model, tag_id, tag_length, T_base_tag, dictionary, frames)
+    for _ in range(frames):
+        reg.update(frame(0.0))
+    if reg.T_base_camera is None:
+        raise VisionError(f"the eye-to-hand camera does not see base tag {tag_id}")
+    return reg.T_base_camera
+
+
+class CameraVision:
+    """Tracks the cube and the selected berry tag in two cameras.
+
+    Args:
+        frame1, frame2: ``(time) -> image or None`` of C1 (eye-to-hand) and C2 (eye-in-hand).
+        model1, model2: their intrinsics.
+        T_base_c1: C1 in the base frame (from :func:`register_c1`).
+        T_ee_c2: C2 in the end-effector frame (hand-eye calibration, eq. 21).
+        T_ee_cube: the marker cube in the end-effector frame.
+        cube: the cube's markers.
+        berry_tag: side (m) of the berry tags.
+        grasp_offset: the grasp point (m) ahead of the end effector; the 6 cm hand-over
+            is measured from it.
+        max_age: how long (s) the most recent berry fix is held while it is hidden.
+        max_jump: a cube pose this far (m) from the previous one is an outlier (a wrong
+            solution of an ambiguous view: the arm cannot move that fast in one frame)
+            and is dropped, unless ``max_rejects`` in a row agree it is real.
+    """
+
+    def __init__(
+        self,
+        frame1: Frame,
+        frame2: Frame,
+        model1: CameraModel,
+        model2: CameraModel,
+        T_base_c1: FloatArray,
+        T_ee_c2: FloatArray,
+        T_ee_cube: FloatArray,
+        cube: MarkerCube,
+        berry_tag: float,
+        grasp_offset: float,
+        max_age: float = 1.0,
+        max_jump: float = 0.03,
+        max_rejects: int = 3,
+    ) -> None:
+        self.frame1, self.frame2 = frame1, frame2
+        self.model1, self.model2 = model1, model2
+        self.T_base_c1, self.T_ee_cube, self.cube = T_base_c1, T_ee_cube, cube
+        self.berry_tag = berry_tag
+        self.detector = MarkerDetector(cube.dictionary)
+        self.fusion = CameraFusion(
+            T_base_c1, T_ee_c2, max_age=max_age, tool_point=(0.0, 0.0, grasp_offset)
+        )
+        self.selected = BerryTarget(-1)
+        self._cube_prev: FloatArray | None = None
+        self.max_jump, self.max_rejects = max_jump, max_rejects
+        self._last_ee: FloatArray | None = None
+        self._rejects = 0
+
+    def select(self, berry: BerryTarget) -> None:
+        """Track ``berry`` from now on (the fusion forgets any held target)."""
+        self.selected = berry
+        self.fusion.reset()
+
+    def observe(self, time: float) -> Observation:
+        """Both cameras at ``time``: ``T_base_ee`` from the cube in C1 (eq. 22), and the
+        berry from the fusion of C1 and C2 (eq. 21), or the held fix."""
+        T_c1_ee, berry_c1 = self._view_c1(time)
+        img = self.frame2(time)
+        berry_c2 = None
+        if img is not None:
+            berry_c2 = self._tag_position(self.detector.detect(img, self.model2), self.model2)
+        est = self.fusion.update(time, T_c1_ee, berry_c1, berry_c2)
+        fix = None
+        if est.target is not None and est.source != "none":
+            fix = BerryFix(est.target, est.source, est.target_age)
+        pose = None if T_c1_ee is None else self.T_base_c1 @ T_c1_ee
+        return Observation(time, pose, fix)
+
+    def track(self, time: float) -> FloatArray | None:
+        """C1 alone: ``T_base_ee`` from the cube (eq. 22), or None; for the callers that
+        need no berry (calibration, identification)."""
+        T_c1_ee, _ = self._view_c1(time)
+        return None if T_c1_ee is None else self.T_base_c1 @ T_c1_ee
+
+    def _view_c1(self, time: float) -> tuple[FloatArray | None, FloatArray | None]:
+        """C1's frame at ``time``: ``T_c1_ee`` (None when the cube is not seen or the pose
+        is an outlier) and the selected berry's tag position in C1 (None if not seen)."""
+        dets = self.detector.detect(_frame(self.frame1, time), self.model1)
+        est = self.cube.estimate(dets, self.model1, self._cube_prev)
+        berry_c1 = self._tag_position(dets, self.model1)
+        if est is None:
+            return None, berry_c1
+        T_c1_ee = est.T_camera_cube @ invert(self.T_ee_cube)
+        if self._outlier(T_c1_ee):
+            return None, berry_c1
+        self._cube_prev = est.T_camera_cube
+        return T_c1_ee, berry_c1
+
+    def _outlier(self, T_c1_ee: FloatArray) -> bool:
+        last = self._last_ee
+        if last is not None and np.linalg.norm(T_c1_ee[:3, 3] - last[:3, 3]) > self.max_jump:
+            self._rejects += 1
+            if self._rejects < self.max_rejects:
+                return True
+        self._rejects = 0
+        self._last_ee = T_c1_ee
+        return False
+
+    def _tag_position(self, dets: list[Detection], model: CameraModel) -> FloatArray | None:
+        for d in dets:
+            if d.marker_id == self.selected.tag_id:
+                sols = square_marker_poses(d.corners, model, self.berry_tag)
+                if sols:
+                    return sols[0].T_camera_marker[:3, 3]
+        return None
+
+
+def _frame(frame: Frame, time: float) -> Any:
+    """A frame, or an empty image (no detections) when the camera dropped one."""
+    img = frame(time)
+    return np.zeros((8, 8), np.uint8) if img is None else img
