@@ -22,7 +22,9 @@ from pathlib import Path
 import numpy as np
 
 
-def one_trial(tau: float, hysteresis: float, seed: int, berries: int) -> dict:
+def one_trial(
+    tau: float, hysteresis: float, seed: int, berries: int, lag_control: str = "predictor"
+) -> dict:
     """Harvest one bush on one plant; returns the report as a dict plus the plant keys."""
     from softarm.harvest import sim_rig
     from softarm.sim.arm import PlantConfig
@@ -31,6 +33,8 @@ def one_trial(tau: float, hysteresis: float, seed: int, berries: int) -> dict:
     fields = {f.name for f in dataclasses.fields(sim_rig.SimRigOptions)}
     if "plant" in fields:
         opts = sim_rig.SimRigOptions(n_berries=berries, seed=seed, plant=plant)
+        if "lag_control" in fields:
+            opts.lag_control = lag_control
     else:  # a build older than the plant option: swap the plant's configuration in
         from softarm.harvest.sim_plant import ArmPlant
         from softarm.sim.arm import SimulatedArm
@@ -45,6 +49,7 @@ def one_trial(tau: float, hysteresis: float, seed: int, berries: int) -> dict:
     report["wall_s"] = time.perf_counter() - start
     report["tau"] = tau
     report["hysteresis_psi"] = hysteresis
+    report["lag_control"] = lag_control
     return report
 
 
@@ -84,11 +89,19 @@ def main() -> None:
     ap.add_argument("--berries", type=int, default=8)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("out/plants"))
+    ap.add_argument(
+        "--lag-control",
+        choices=["predictor", "bound"],
+        default="predictor",
+        help="the loop's handling of the lag (SimRigOptions.lag_control, docs/control.md)",
+    )
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     trials = [(t, h, s) for t in args.tau for h in args.hysteresis for s in args.seeds]
     with ProcessPoolExecutor(args.jobs) as pool:
-        futures = [pool.submit(one_trial, t, h, s, args.berries) for t, h, s in trials]
+        futures = [
+            pool.submit(one_trial, t, h, s, args.berries, args.lag_control) for t, h, s in trials
+        ]
         reports = []
         # Written as each bush finishes, so that a run stopped early keeps what it did.
         for done in as_completed(futures):

@@ -32,7 +32,8 @@ class HarvestConfig:
         placement_tolerance: position error (m) that ends initial placement.
         angle_tolerance_deg: pointing error that ends initial placement.
         fine_tolerance: grasp-point-to-berry error (m) that ends fine positioning
-            (section IV-E reports 0.75 ± 0.36 mm).
+            (section IV-E reports 0.75 ± 0.36 mm; 0.5 mm here, as the measured error
+            stops the loop and the true one lands around it).
         grasp_workspace: error (m) the gripper still grasps at (±1 cm, section III-D);
             used only when fine positioning runs out of time.
         settle_steps: consecutive steps within tolerance before moving on (noise).
@@ -44,7 +45,9 @@ class HarvestConfig:
             improvement → UNREACHABLE.
         stall_progress: see ``stall_time``.
         ripeness_threshold: below it a grasped berry is unripe and released.
-        home_speed: elongation rate (m/s) of the open-loop moves to the ready pose.
+        home_speed: elongation rate (m/s) of the plan's feedforward and the open-loop
+            moves to the ready pose: 0.045 m/s is 94.5 psi/s, inside the safety layer's
+            default 100 psi/s rate limit.
         home_elongation: every actuator's elongation (m) at the ready pose (straight arm).
     """
 
@@ -55,7 +58,7 @@ class HarvestConfig:
     standoff: float = 0.05
     placement_tolerance: float = 0.01
     angle_tolerance_deg: float = 5.0
-    fine_tolerance: float = 0.001
+    fine_tolerance: float = 0.0005
     grasp_workspace: float = 0.01
     settle_steps: int = 3
     marker_timeout: float = 1.0
@@ -66,7 +69,7 @@ class HarvestConfig:
     stall_time: float = 3.0
     stall_progress: float = 0.002
     ripeness_threshold: float = 0.5
-    home_speed: float = 0.03
+    home_speed: float = 0.045
     home_elongation: float = 0.0167
 
     def __post_init__(self) -> None:

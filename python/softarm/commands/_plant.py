@@ -27,8 +27,8 @@ def add_plant_options(p: argparse.ArgumentParser, *, sim_only_flag: bool = True)
     p.add_argument(
         "--identified",
         type=config_file,
-        help="the plant `softarm identify` measured (id.json), checked and passed to the rig "
-        "as SimRigOptions.identified (per-channel lag tau_s, control period)",
+        help="the plant `softarm identify` measured (id.json): the actuators' lag the "
+        "lag-aware loop predicts (on hardware it replaces the config's [plant_model])",
     )
     p.add_argument(
         "--model",

@@ -251,9 +251,16 @@ def _run_hardware(args: argparse.Namespace) -> int:
             f"{args.config}: set {', '.join(missing)} to harvest (see the comments that "
             "`softarm config init` writes)"
         )
+    from softarm.identified_plant import identified_from_config, load_identified
+
+    identified = (
+        load_identified(args.identified)
+        if getattr(args, "identified", None) is not None
+        else identified_from_config(config, args.config)
+    )
     log = HarvestLog(args.log)
     try:
-        rig = build_hardware_rig(config, log=log)
+        rig = build_hardware_rig(config, log=log, identified=identified)
     except HardwareUnavailableError as exc:
         log.close()
         print(

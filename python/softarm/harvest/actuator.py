@@ -17,13 +17,27 @@ import numpy.typing as npt
 
 from softarm._core import LagModel
 from softarm.errors import NonFiniteError, ParameterError
-from softarm.hardware.play_inverse import PlayInverse
 from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.safety import SafePressureBank
 
-__all__ = ["SafeActuator"]
+__all__ = ["SafeActuator", "lead_gain"]
 
 FloatArray = npt.NDArray[np.float64]
+
+
+def lead_gain(tau_s: float, period_s: float, cap: float = 1.5) -> float:
+    """The pre-compensation gain ``k`` for regulators of time constant ``tau_s`` driven
+    every ``period_s``: half the overshoot-free bound ``a/(1 − a)``, ``a = e^{−T/τ}``
+    (docs/control.md, section 6), at most ``cap``. The cap (tuned on seeds 0–3) keeps the
+    boosted commands near the planned path: a larger boost saturates some channels at 0
+    or 70 psi and not others, and the arm leaves the straight line in q between two plan
+    waypoints that the canes were checked against."""
+    if not (np.isfinite(tau_s) and tau_s >= 0 and np.isfinite(period_s) and period_s > 0):
+        raise ParameterError(f"tau_s = {tau_s!r}, period_s = {period_s!r}: need tau >= 0, T > 0")
+    if tau_s == 0:
+        return 0.0
+    a = float(np.exp(-period_s / tau_s))
+    return min(cap, 0.5 * a / (1.0 - a))
 
 
 class SafeActuator:
@@ -34,13 +48,15 @@ class SafeActuator:
     Args:
         bank: the safety layer.
         pressure_map: elongation ↔ psi (``to_psi``/``to_elongation``).
-        play_psi: the actuators' play band (psi per channel, e.g. identified): commands
-            go through a :class:`~softarm.hardware.play_inverse.PlayInverse`. None: none.
         lag: ``(tau_s, period_s)`` of the actuators: :attr:`predicted` follows the sent
             commands through that lag. None: no prediction.
         sensor_lag_s: the time constant (s) of the pose measurement's own first-order
             filter, in series after the actuators' lag: :attr:`predicted` is then the
             elongations the *measured* pose reflects (0: no filter).
+        lead: pre-compensation of the regulators' lag, ``k``: they are told
+            ``q + k (q − ŷ)`` with ``ŷ`` the lag model's pressure, so that a first-order
+            regulator approaches ``q`` ``1 + k`` times faster (``k ≤ a/(1 − a)``,
+            ``a = e^{−T/τ}``, keeps it free of overshoot). 0: none.
         now: the clock (s) the commands are stamped with, for the prediction to count
             the periods between two commands (a grasp sends nothing for a while).
     """
@@ -50,17 +66,14 @@ class SafeActuator:
         bank: SafePressureBank,
         pressure_map: ElongationMap | None = None,
         *,
-        play_psi: npt.ArrayLike | None = None,
         lag: tuple[float, float] | None = None,
         now: Callable[[], float] | None = None,
         sensor_lag_s: float = 0.0,
+        lead: float = 0.0,
     ) -> None:
         self.bank = bank
         self.pressure_map = pressure_map or ElongationMap(max_psi=bank.max_pressure)
-        self.play = None if play_psi is None else PlayInverse(play_psi)
         n = bank.channels
-        if self.play is not None and self.play.width.shape != (n,):
-            raise ParameterError(f"play_psi: expected {n} channels, got {self.play.width.size}")
         if lag is not None and now is None:
             raise ParameterError("lag: needs the clock `now` to count periods")
         self._now = now
@@ -75,16 +88,16 @@ class SafeActuator:
         self._stamp = None if now is None else now()
         # What the regulators were told, boost included (the lag model's input).
         self._drive = np.zeros(n)
-        import os
-
-        frac, kmax = float(os.environ.get("LEAD", "0")), float(os.environ.get("LEADMAX", "5"))
-        a = 0.0 if lag is None or lag[0] <= 0 else float(np.exp(-lag[1] / lag[0]))
-        self._lead = min(kmax, frac * a / (1.0 - a)) if a > 0 else 0.0
+        if not (np.isfinite(lead) and 0.0 <= lead <= 20.0):
+            raise ParameterError(f"lead = {lead!r}: must be in [0, 20]")
+        if lead > 0 and lag is None:
+            raise ParameterError("lead: needs the lag model (`lag`)")
+        self._lead = float(lead)
 
     @property
     def sent(self) -> FloatArray:
-        """The elongations (m) the regulators were last sent, after the safety layer's
-        clamp and rate limit and without the play compensation (a copy)."""
+        """The elongations (m) the regulators were last sent towards, after the safety
+        layer's clamp and rate limit (a copy)."""
         return self._sent.copy()
 
     @property
@@ -107,13 +120,8 @@ class SafeActuator:
         boost = np.zeros_like(wanted)
         if self._lead > 0 and self._stages:
             boost = self._lead * (wanted - self.pressure_map.to_psi(self._stages[0].q))
-        command = wanted + boost
-        if self.play is not None:
-            command = self.play.command(wanted) + boost
-        self.bank.set_pressures(np.clip(command, 0.0, self.bank.max_pressure))
+        self.bank.set_pressures(np.clip(wanted + boost, 0.0, self.bank.max_pressure))
         drive = self.bank.last_sent
-        if self.play is not None:
-            drive = drive - self.play.offset
         self._drive = self.pressure_map.to_elongation(drive)
         # The target the regulators are driven towards: the wanted pressure while the
         # boost pushes past it, what the safety layer let through when it held the
@@ -132,8 +140,6 @@ class SafeActuator:
         self.bank.vent(reason)
         self._sent = np.zeros_like(self._sent)
         self._drive = np.zeros_like(self._drive)
-        if self.play is not None:
-            self.play.reset()
 
     def _catch_up(self) -> None:
         """Advance the lag model over the whole periods since the last command, with the

@@ -1,9 +1,10 @@
 """The controller of the harvest loop: the core resolver's hybrid step (eq. 20) closed on
 the measured pose, with the known canes as obstacles inside it (planning paper eq. 9, the
 lowest-priority task, in the null space of position and orientation) and, when the
-actuators' lag is known, a lag model predicting the motion still in flight (a Smith
-predictor; docs/control.md). All the control math is in Rust; this only keeps the
-predictor's state and adapts the call to the harvest's Controller."""
+actuators' lag is known, the motion still in flight taken out of the measured error (a
+Smith predictor; docs/control.md, section 6). All the control math is in Rust; the lag
+model's state is the actuator's (it sees every command sent); this only adapts the call
+to the harvest's Controller."""
 
 from __future__ import annotations
 
@@ -11,7 +12,6 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
-
 
 __all__ = ["ResolverController"]
 

@@ -30,6 +30,7 @@ from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.vision_loop import CameraVision
+from softarm.identified_plant import IdentifiedPlant
 from softarm.vision import MarkerCube
 from softarm.vision.camera_model import camera_from_config
 from softarm.vision.poses import invert
@@ -50,10 +51,16 @@ class HardwareRig:
 
 
 def build_hardware_rig(
-    config: Config, harvest: HarvestConfig | None = None, log: HarvestLog | None = None
+    config: Config,
+    harvest: HarvestConfig | None = None,
+    log: HarvestLog | None = None,
+    identified: IdentifiedPlant | None = None,
 ) -> HardwareRig:
     """Open every device of ``config`` and wire the machine, tuned by ``harvest`` (default:
-    the config's ``[harvest]``).
+    the config's ``[harvest]``). With the ``identified`` plant (``[plant_model]``) the
+    actuator predicts the regulators' lag and the loop corrects the motion still in
+    flight (docs/control.md); without it the resolver's gain is bounded for the slowest
+    plant (the defaults' 20 periods).
 
     Raises:
         HardwareUnavailableError: a device (or its driver) is absent.
@@ -86,9 +93,14 @@ def build_hardware_rig(
             np.array(cal.T_EE_cube), MarkerCube.standard(), cal.berry_tag, cfg.grasp_offset,
         )  # fmt: skip
         gripper = ArduinoGripper(link)
+        clock = MonotonicClock()
+        lag = None if identified is None else (identified.lag_s, cfg.period)
+        actuator = SafeActuator(
+            bank, ElongationMap(ch.p_max, ch.metres_per_psi), lag=lag, now=clock.now
+        )
+        predicted = None if lag is None else (lambda: actuator.predicted)
         machine = HarvestMachine(
-            MonotonicClock(), vision, ResolverController(resolver),
-            SafeActuator(bank, ElongationMap(ch.p_max, ch.metres_per_psi)), gripper,
+            clock, vision, ResolverController(resolver, (), predicted), actuator, gripper,
             ArduinoRipenessSensor(link), arm.n_actuators, cfg, log,
             planner=ModelIK(planning_resolver(arm), cfg),
         )  # fmt: skip

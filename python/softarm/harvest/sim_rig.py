@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-import os
 
 import numpy as np
 
@@ -19,7 +18,7 @@ from softarm._core import Gains, Resolver
 from softarm.calibration.result import Calibration
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
-from softarm.harvest.actuator import SafeActuator
+from softarm.harvest.actuator import SafeActuator, lead_gain
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
@@ -69,10 +68,10 @@ class SimRigOptions:
     #: A fitted model (``softarm calibrate``, ``--model model.toml``): the controller's arm
     #: and the actuators' gains; None: the nominal blackberry arm.
     calibration: Calibration | None = None
-    #: How the loop handles the plant's lag and play (docs/control.md): "predictor" (a
-    #: lag model of the sent commands, the gain bounded by the pose filter's lag alone,
-    #: and the play inverted at the regulators) or "bound" (the gain bounded by the
-    #: whole lag, no model of it).
+    #: How the loop handles the plant's lag (docs/control.md, section 6): "predictor" (a
+    #: lag model of every command sent, regulators then pose filter, whose motion still
+    #: in flight each step takes out of the measured error; the mode's gain) or "bound"
+    #: (no model: the gain bounded by the whole lag, `Gains.for_lag`).
     lag_control: str = "predictor"
 
 
@@ -194,40 +193,30 @@ def build_sim_rig(
         seed=o.seed, hidden=o.hidden,
     )  # fmt: skip
     gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
-    # The plant's lag and play, measured by `softarm identify` when given, else declared by
-    # the plant description (its regulators' time constant and hysteresis, as a datasheet
-    # states them).
-    if o.identified is None:
-        lag, play = o.plant.pressure_tau, np.full(model.n_actuators, o.plant.hysteresis_psi)
-    else:
-        lag, play = o.identified.lag_s, np.asarray(o.identified.hysteresis_psi)
+    # The plant's lag, measured by `softarm identify` when given, else declared by the
+    # plant description (its regulators' time constant, as a datasheet states it).
+    lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
     if o.lag_control not in ("predictor", "bound"):
         raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
     predict = o.lag_control == "predictor"
     actuator = SafeActuator(
         bank,
         None if o.calibration is None else o.calibration.pressure_map(),
-        play_psi=play if predict and os.environ.get("PLAY", "1") == "1" else None,
         lag=(lag, cfg.period) if predict else None,
         now=clock.now,
         # The tracker's first-order pose filter (10 rad/s): part of what the loop sees.
         sensor_lag_s=0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff,
+        lead=lead_gain(lag, cfg.period) if predict else 0.0,
     )
     if controller is None:
-        if predict:
-            # The lag model takes out the regulators' lag; what it does not model, the
-            # pose filter's, bounds the gain (docs/control.md, section 2).
-            filter_lag = 0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff
-            alpha = float(os.environ.get("ALPHA", "0.3"))
-            gains = Gains().replace(hybrid_alpha=alpha)
-        else:
-            gains = Gains.for_lag(lag, cfg.period)
+        # With the lag model the step is the lag-free iteration (a Smith predictor): the
+        # mode's own gain; without it the gain is bounded by the lag (docs/control.md).
+        gains = Gains() if predict else Gains.for_lag(lag, cfg.period)
         if o.joint_limit_gain is not None:
             gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
         resolver = Resolver(model, mode="hybrid", gains=gains)
-        controller = ResolverController(
-            resolver, canes if o.avoid_canes else (), (lambda: actuator.predicted) if predict else None
-        )
+        predicted = (lambda: actuator.predicted) if predict else None
+        controller = ResolverController(resolver, canes if o.avoid_canes else (), predicted)
     machine = HarvestMachine(
         clock,
         vision,
