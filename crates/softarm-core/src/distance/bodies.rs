@@ -193,10 +193,7 @@ pub fn closest_piece_within(
             if c.distance < limit {
                 limit = c.distance;
                 best = Some(BodyClosest {
-                    closest: Closest {
-                        section: p.section,
-                        ..c
-                    },
+                    closest: c.in_section(p.section),
                     rigid: p.rigid,
                 });
             }
@@ -224,10 +221,7 @@ pub fn closest_body<K: Kinematics + ?Sized>(
         let c = closest_to_arcs(std::slice::from_ref(&p.arc), obstacle);
         if best.is_none_or(|b| c.distance < b.closest.distance) {
             best = Some(BodyClosest {
-                closest: Closest {
-                    section: p.section,
-                    ..c
-                },
+                closest: c.in_section(p.section),
                 rigid: p.rigid,
             });
         }

@@ -289,14 +289,7 @@ pub fn clearance(arcs: &[PlacedArc], obstacles: &[Obstacle]) -> f64 {
 /// The paper's baseline: the arm discretised into `m` points per section, and the closest
 /// pair found by brute force between those points and the obstacle.
 pub fn closest_sampled(arcs: &[PlacedArc], m: usize, obstacle: &Obstacle) -> Closest {
-    let mut best = Closest {
-        distance: f64::INFINITY,
-        section: 0,
-        s: 0.0,
-        u: 0.0,
-        arm_point: Vec3::zeros(),
-        obstacle_point: Vec3::zeros(),
-    };
+    let mut best = Closest::none();
     let denom = (m.max(2) - 1) as f64;
     for (i, arc) in arcs.iter().enumerate() {
         for k in 0..m.max(1) {
@@ -319,14 +312,7 @@ pub fn closest_sampled(arcs: &[PlacedArc], m: usize, obstacle: &Obstacle) -> Clo
                 Obstacle::Curve(_) => continue,
             };
             if d < best.distance {
-                best = Closest {
-                    distance: d,
-                    section: i,
-                    s,
-                    u,
-                    arm_point: x,
-                    obstacle_point: p,
-                };
+                best = Closest::new(i, s, x, u, p, d);
             }
         }
     }
