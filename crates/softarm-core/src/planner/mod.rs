@@ -94,8 +94,52 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
     /// for a curve or mesh obstacle with `arm_samples` set (the sampled baseline supports
     /// points, clouds and segments).
     pub fn plan(&self, q0: &[f64], goal: &Vec3, obstacles: &[Obstacle]) -> Result<Plan> {
-        let model = &self.model;
+        self.check_plan(q0, goal, obstacles)?;
         let o = &self.options;
+        let mut walk = self.start(q0, obstacles);
+        let mut termination = Termination::IterationLimit;
+        let mut iterations = 0;
+        while iterations < o.max_iterations {
+            let err = goal - walk.tip;
+            if err.norm() <= o.goal_tolerance {
+                termination = Termination::Reached;
+                break;
+            }
+            // Repulsion directions first: the closest arm point of each obstacle.
+            self.repulsions(&mut walk, obstacles);
+            self.projected_step(&mut walk, &self.attraction(&err));
+            if walk.dq.iter().any(|v| !v.is_finite()) {
+                // A damping of 0 at a singular Jacobian: no step can be taken (eq. 8 has
+                // no finite solution); stop rather than write NaN into the path.
+                termination = Termination::NonFiniteStep;
+                break;
+            }
+            self.take_step(&mut walk);
+            iterations += 1;
+            self.observe(&mut walk, obstacles);
+            if self.stalled(&walk, iterations) {
+                termination = Termination::Stalled;
+                break;
+            }
+        }
+        if termination == Termination::IterationLimit
+            && (goal - walk.tip).norm() <= o.goal_tolerance
+        {
+            termination = Termination::Reached;
+        }
+        Ok(Plan {
+            path: walk.path,
+            tip_path: walk.tip_path,
+            reached: termination == Termination::Reached,
+            iterations,
+            min_clearance: walk.min_clearance,
+            termination,
+        })
+    }
+
+    /// Checks the inputs of [`PotentialFieldPlanner::plan`] (its errors).
+    fn check_plan(&self, q0: &[f64], goal: &Vec3, obstacles: &[Obstacle]) -> Result<()> {
+        let model = &self.model;
         check_q(model, q0)?;
         check_bounded("goal", goal.as_slice(), MAX_POSITION)?;
         check_obstacles(obstacles)?;
@@ -103,7 +147,7 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
         for i in 0..q0.len() {
             crate::error::check_range(&format!("q0[{i}]"), q0[i], lo[i], hi[i])?;
         }
-        if o.arm_samples.is_some() {
+        if self.options.arm_samples.is_some() {
             if let Some(k) = obstacles
                 .iter()
                 .position(|ob| matches!(ob, Obstacle::Curve(_) | Obstacle::Mesh(_)))
@@ -115,141 +159,192 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The walk at `q0`: its exact closest pairs, clearance and tip.
+    fn start(&self, q0: &[f64], obstacles: &[Obstacle]) -> Walk {
+        let model = &self.model;
+        let (lo, hi) = (model.lower(), model.upper());
         let n = model.n_dofs();
-        let step_limit: Vec<f64> = (0..n)
-            .map(|i| o.max_step_fraction * (hi[i] - lo[i]))
-            .collect();
-        let mut q = q0.to_vec();
+        let q = q0.to_vec();
         let mut jac = DMatrix::zeros(6, n);
-        let mut path = vec![q.clone()];
-        let mut arcs = placed_arcs(model, &q);
+        let arcs = placed_arcs(model, &q);
         // Exact closest pairs at the current configuration: they give the clearance of the
         // whole backbone and, for the proposed method, the repulsion points of the next step.
-        // Pairs farther than both the influence distance and the clearance so far can
-        // change neither, so they are skipped by exact lower bounds (`None`).
-        let mut hits: Vec<Option<Closest>> = obstacles
+        let hits: Vec<Option<Closest>> = obstacles
             .iter()
             .map(|ob| Some(closest_to_arcs(&arcs, ob)))
             .collect();
-        let mut min_clearance = min_distance(&hits);
-        let mut tip = forward_jacobian_into(model, &q, &mut jac).pos;
-        let mut tip_path = vec![tip];
-        let mut termination = Termination::IterationLimit;
-        let mut iterations = 0;
-        let mut dq = vec![0.0; n];
-        let mut free = vec![true; n];
-        let mut first = vec![0.0; n];
-        let mut repulsions: Vec<(Matrix3xX<f64>, Vec3)> = Vec::with_capacity(obstacles.len());
-        while iterations < o.max_iterations {
-            let err = goal - tip;
-            if err.norm() <= o.goal_tolerance {
-                termination = Termination::Reached;
-                break;
-            }
-            // Repulsion directions first: the closest arm point of each obstacle.
-            repulsions.clear();
-            for (ob, hit) in obstacles.iter().zip(&hits) {
-                let c = match (o.arm_samples, hit) {
-                    (None, Some(h)) => *h,
-                    (None, None) => continue,
-                    (Some(m), _) => closest_sampled(&arcs, m, ob),
-                };
-                if c.distance >= o.influence_distance {
-                    continue;
-                }
-                let v = c.obstacle_point - c.arm_point;
-                let d = v.norm();
-                if d == 0.0 {
-                    continue;
-                }
-                let dd = d.max(1e-6);
-                let mag = o.repulsion_gain * (1.0 / dd - 1.0 / o.influence_distance) / (dd * dd);
-                let (_, js) = point_unchecked(model, &q, c.section, c.s);
-                repulsions.push((js, v * (mag / d)));
-            }
-            let mut dx = err * o.attraction_gain;
-            let len = dx.norm();
-            if len > o.max_tip_step {
-                dx *= o.max_tip_step / len;
-            }
-            let je = jac.fixed_rows::<3>(0).into_owned();
-            // Coordinates at a limit that the step pushes further are frozen and the step is
-            // recomputed without them (projection onto the feasible set).
-            free.iter_mut().for_each(|f| *f = true);
-            for pass in 0..4 {
-                dq.iter_mut().for_each(|v| *v = 0.0);
-                // Attraction: J_e⁺ F_e(V_e).
-                add_pinv(&je, &free, &dx, o.damping, 1.0, &mut dq);
-                // Repulsion: − Σ_j J_sj⁺ F_sj(V_sj).
-                for (js, f) in &repulsions {
-                    add_pinv(js, &free, f, o.damping, -1.0, &mut dq);
-                }
-                if pass == 0 {
-                    first.copy_from_slice(&dq);
-                }
-                let mut changed = false;
-                for i in 0..n {
-                    let blocked = (q[i] <= lo[i] && dq[i] < 0.0) || (q[i] >= hi[i] && dq[i] > 0.0);
-                    if free[i] && blocked {
-                        free[i] = false;
-                        changed = true;
-                    }
-                }
-                if !free.iter().any(|&f| f) {
-                    // Everything would freeze: fall back to the unprojected step, clamped.
-                    dq.copy_from_slice(&first);
-                    break;
-                }
-                if !changed {
-                    break;
-                }
-            }
-            if dq.iter().any(|v| !v.is_finite()) {
-                // A damping of 0 at a singular Jacobian: no step can be taken (eq. 8 has
-                // no finite solution); stop rather than write NaN into the path.
-                termination = Termination::NonFiniteStep;
-                break;
-            }
-            // Step limits, then the configuration limits.
-            let mut scale: f64 = 1.0;
-            for i in 0..n {
-                if dq[i].abs() * scale > step_limit[i] {
-                    scale = step_limit[i] / dq[i].abs();
-                }
-            }
-            for i in 0..n {
-                q[i] = (q[i] + scale * dq[i]).clamp(lo[i], hi[i]);
-            }
-            iterations += 1;
-            arcs = placed_arcs(model, &q);
-            let cutoff = o.influence_distance.max(min_clearance);
-            for (hit, ob) in hits.iter_mut().zip(obstacles) {
-                *hit = closest_to_arcs_within(&arcs, ob, cutoff);
-            }
-            min_clearance = min_clearance.min(min_distance(&hits));
-            tip = forward_jacobian_into(model, &q, &mut jac).pos;
-            path.push(q.clone());
-            tip_path.push(tip);
-            if iterations >= o.stall_window {
-                let back = tip_path[tip_path.len() - 1 - o.stall_window];
-                if (tip - back).norm() < o.stall_tolerance {
-                    termination = Termination::Stalled;
-                    break;
-                }
-            }
-        }
-        if termination == Termination::IterationLimit && (goal - tip).norm() <= o.goal_tolerance {
-            termination = Termination::Reached;
-        }
-        Ok(Plan {
-            path,
-            tip_path,
-            reached: termination == Termination::Reached,
-            iterations,
+        let min_clearance = min_distance(&hits);
+        let tip = forward_jacobian_into(model, &q, &mut jac).pos;
+        Walk {
+            step_limit: (0..n)
+                .map(|i| self.options.max_step_fraction * (hi[i] - lo[i]))
+                .collect(),
+            path: vec![q.clone()],
+            q,
+            jac,
+            arcs,
+            hits,
             min_clearance,
-            termination,
-        })
+            tip,
+            tip_path: vec![tip],
+            dq: vec![0.0; n],
+            free: vec![true; n],
+            first: vec![0.0; n],
+            repulsions: Vec::with_capacity(obstacles.len()),
+        }
     }
+
+    /// eq. (9), repulsive terms: for each obstacle whose closest arm point lies within the
+    /// influence distance, that point's Jacobian and `F_sj = k_r (1/d − 1/ρ0) V̂_sj / d²`.
+    fn repulsions(&self, walk: &mut Walk, obstacles: &[Obstacle]) {
+        let o = &self.options;
+        walk.repulsions.clear();
+        for (ob, hit) in obstacles.iter().zip(&walk.hits) {
+            let c = match (o.arm_samples, hit) {
+                (None, Some(h)) => *h,
+                (None, None) => continue,
+                (Some(m), _) => closest_sampled(&walk.arcs, m, ob),
+            };
+            if c.distance >= o.influence_distance {
+                continue;
+            }
+            let v = c.obstacle_point - c.arm_point;
+            let d = v.norm();
+            if d == 0.0 {
+                continue;
+            }
+            let dd = d.max(1e-6);
+            let mag = o.repulsion_gain * (1.0 / dd - 1.0 / o.influence_distance) / (dd * dd);
+            let (_, js) = point_unchecked(&self.model, &walk.q, c.section, c.s);
+            walk.repulsions.push((js, v * (mag / d)));
+        }
+    }
+
+    /// eq. (9), attractive term: `F_e = k_a V_e`, saturated at `max_tip_step`.
+    fn attraction(&self, err: &Vec3) -> Vec3 {
+        let o = &self.options;
+        let mut dx = err * o.attraction_gain;
+        let len = dx.norm();
+        if len > o.max_tip_step {
+            dx *= o.max_tip_step / len;
+        }
+        dx
+    }
+
+    /// eq. (9): `Δq = J_e⁺ F_e − Σ_j J_sj⁺ F_sj` into `walk.dq`. Coordinates at a limit
+    /// that the step pushes further are frozen and the step is recomputed without them
+    /// (projection onto the feasible set, at most four passes); should every coordinate
+    /// freeze, the unprojected step is kept (and clamped later).
+    fn projected_step(&self, walk: &mut Walk, dx: &Vec3) {
+        let damping = self.options.damping;
+        let (lo, hi) = (self.model.lower(), self.model.upper());
+        let je = walk.jac.fixed_rows::<3>(0).into_owned();
+        walk.free.iter_mut().for_each(|f| *f = true);
+        for pass in 0..4 {
+            walk.dq.iter_mut().for_each(|v| *v = 0.0);
+            // Attraction: J_e⁺ F_e(V_e).
+            add_pinv(&je, &walk.free, dx, damping, 1.0, &mut walk.dq);
+            // Repulsion: − Σ_j J_sj⁺ F_sj(V_sj).
+            for (js, f) in &walk.repulsions {
+                add_pinv(js, &walk.free, f, damping, -1.0, &mut walk.dq);
+            }
+            if pass == 0 {
+                walk.first.copy_from_slice(&walk.dq);
+            }
+            let mut changed = false;
+            for i in 0..walk.q.len() {
+                let (q, dq) = (walk.q[i], walk.dq[i]);
+                let blocked = (q <= lo[i] && dq < 0.0) || (q >= hi[i] && dq > 0.0);
+                if walk.free[i] && blocked {
+                    walk.free[i] = false;
+                    changed = true;
+                }
+            }
+            if !walk.free.iter().any(|&f| f) {
+                // Everything would freeze: fall back to the unprojected step, clamped.
+                walk.dq.copy_from_slice(&walk.first);
+                break;
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
+
+    /// Applies `walk.dq`: scaled so that no coordinate moves by more than its step limit,
+    /// then clamped to the model's limits.
+    fn take_step(&self, walk: &mut Walk) {
+        let (lo, hi) = (self.model.lower(), self.model.upper());
+        let mut scale: f64 = 1.0;
+        for (d, limit) in walk.dq.iter().zip(&walk.step_limit) {
+            if d.abs() * scale > *limit {
+                scale = limit / d.abs();
+            }
+        }
+        for i in 0..walk.q.len() {
+            walk.q[i] = (walk.q[i] + scale * walk.dq[i]).clamp(lo[i], hi[i]);
+        }
+    }
+
+    /// The walk's new configuration: its arcs, exact closest pairs, clearance and tip,
+    /// recorded in the path. Pairs farther than both the influence distance and the
+    /// clearance so far can change neither, so they are skipped by exact lower bounds
+    /// (`None`).
+    fn observe(&self, walk: &mut Walk, obstacles: &[Obstacle]) {
+        walk.arcs = placed_arcs(&self.model, &walk.q);
+        let cutoff = self.options.influence_distance.max(walk.min_clearance);
+        for (hit, ob) in walk.hits.iter_mut().zip(obstacles) {
+            *hit = closest_to_arcs_within(&walk.arcs, ob, cutoff);
+        }
+        walk.min_clearance = walk.min_clearance.min(min_distance(&walk.hits));
+        walk.tip = forward_jacobian_into(&self.model, &walk.q, &mut walk.jac).pos;
+        walk.path.push(walk.q.clone());
+        walk.tip_path.push(walk.tip);
+    }
+
+    /// Whether the tip has moved less than `stall_tolerance` over the last `stall_window`
+    /// iterations (`iterations` taken so far).
+    fn stalled(&self, walk: &Walk, iterations: usize) -> bool {
+        let o = &self.options;
+        if iterations < o.stall_window {
+            return false;
+        }
+        let back = walk.tip_path[walk.tip_path.len() - 1 - o.stall_window];
+        (walk.tip - back).norm() < o.stall_tolerance
+    }
+}
+
+/// The state of one plan: the path so far and the buffers of a step.
+struct Walk {
+    /// Largest move of each coordinate per step (`max_step_fraction` of its range).
+    step_limit: Vec<f64>,
+    /// The current configuration.
+    q: Vec<f64>,
+    /// The 6×n Jacobian at `q`.
+    jac: DMatrix<f64>,
+    /// The arcs at `q`.
+    arcs: Vec<PlacedArc>,
+    /// Each obstacle's exact closest pair at `q`, `None` when provably irrelevant.
+    hits: Vec<Option<Closest>>,
+    /// Smallest exact clearance so far.
+    min_clearance: f64,
+    /// The tip at `q`.
+    tip: Vec3,
+    /// Configurations so far, `q0` first.
+    path: Vec<Vec<f64>>,
+    /// Tips so far.
+    tip_path: Vec<Vec3>,
+    /// The step being computed.
+    dq: Vec<f64>,
+    /// Coordinates not frozen at a limit.
+    free: Vec<bool>,
+    /// The first (unprojected) pass's step.
+    first: Vec<f64>,
+    /// Each repelling obstacle's point Jacobian and push.
+    repulsions: Vec<(Matrix3xX<f64>, Vec3)>,
 }
 
 /// `dq += sign · Jᵀ (J Jᵀ + λ² I)⁻¹ f` (eq. 8, damped), using only the `free` columns.
