@@ -249,6 +249,17 @@ class StepResult:
     def clearance(self) -> float:
         """Smallest surface gap (m) of the model arm at q to the obstacles within the
         influence distance; inf when none is."""
+    def __reduce__(self) -> tuple[object, tuple[_F64, _F64, bool, float, float, float]]: ...
+
+def _rebuild_step_result(
+    q: _ArrayLike,
+    unclamped: _ArrayLike,
+    saturated: bool,
+    position_error: float,
+    orientation_error: float,
+    clearance: float,
+) -> StepResult:
+    """Unpickler of ``StepResult``."""
 
 @final
 class Solution:
@@ -271,6 +282,17 @@ class Solution:
     def termination(self) -> str:
         """Why the iteration stopped: "converged", "stuck" (a step left q unchanged, e.g.
         the straight rest pose in position mode) or "step_limit"."""
+    def __reduce__(self) -> tuple[object, tuple[_F64, bool, int, float, float, str]]: ...
+
+def _rebuild_solution(
+    q: _ArrayLike,
+    converged: bool,
+    steps: int,
+    position_error: float,
+    orientation_error: float,
+    termination: str,
+) -> Solution:
+    """Unpickler of ``Solution``."""
 
 @final
 class Resolver:
@@ -335,6 +357,8 @@ class LagModel:
         """One period with ``command`` held; the predicted elongations after it."""
     def reset(self, q: _ArrayLike) -> None:
         """Settles the model at ``q``."""
+    def __reduce__(self) -> tuple[type[LagModel], tuple[float, float, _F64]]:
+        """Pickles as ``LagModel(tau_s, period_s, q)``: the predicted state travels."""
 
 # --- distance queries and planning (planning paper eq. 9-18) -------------------------
 

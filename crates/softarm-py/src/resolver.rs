@@ -213,6 +213,38 @@ impl StepResult {
     fn clearance(&self) -> f64 {
         self.info.clearance
     }
+    /// Pickling and `copy.deepcopy`, through `_core._rebuild_step_result`.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Bound<'py, PyArray1<f64>>,
+            Bound<'py, PyArray1<f64>>,
+            bool,
+            f64,
+            f64,
+            f64,
+        ),
+    )> {
+        let f = py
+            .import("softarm._core")?
+            .getattr("_rebuild_step_result")?;
+        let i = &self.info;
+        Ok((
+            f,
+            (
+                self.q(py),
+                self.unclamped(py),
+                i.saturated,
+                i.position_error,
+                i.orientation_error,
+                i.clearance,
+            ),
+        ))
+    }
     fn __repr__(&self) -> String {
         format!(
             "StepResult(saturated={}, position_error={:.3e}, orientation_error={:.3e})",
@@ -259,6 +291,36 @@ impl Solution {
     #[getter]
     fn termination(&self) -> &'static str {
         self.inner.termination.name()
+    }
+    /// Pickling and `copy.deepcopy`, through `_core._rebuild_solution`.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Bound<'py, PyArray1<f64>>,
+            bool,
+            usize,
+            f64,
+            f64,
+            &'static str,
+        ),
+    )> {
+        let f = py.import("softarm._core")?.getattr("_rebuild_solution")?;
+        let s = &self.inner;
+        Ok((
+            f,
+            (
+                self.q(py),
+                s.converged,
+                s.steps,
+                s.position_error,
+                s.orientation_error,
+                s.termination.name(),
+            ),
+        ))
     }
     fn __repr__(&self) -> String {
         format!(
@@ -538,6 +600,22 @@ impl LagModel {
         let q = crate::convert::vector(q, "q", n)?;
         self.inner.reset(&q).py()
     }
+    /// Pickling and `copy.deepcopy`: `LagModel(tau_s, period_s, q)` with the predicted
+    /// elongations as `q0`, which is the whole state (the gain follows from the lag).
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (Bound<'py, PyType>, (f64, f64, Bound<'py, PyArray1<f64>>)) {
+        let m = slf.borrow();
+        (
+            slf.get_type(),
+            (
+                m.inner.tau_s(),
+                m.inner.period_s(),
+                PyArray1::from_slice(slf.py(), m.inner.state()),
+            ),
+        )
+    }
     fn __repr__(&self) -> String {
         format!(
             "LagModel(tau_s={}, period_s={})",
@@ -573,6 +651,72 @@ fn add_float_properties(py: Python<'_>) -> PyResult<()> {
     Ok(())
 }
 
+/// Reads a pickled `(n,)` vector of 1 to 1024 finite values.
+fn pickled_vector(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<f64>> {
+    let (v, _) = array(obj, arg, &[None])?;
+    if v.is_empty() || v.len() > 1024 {
+        return Err(ShapeError::new_err(format!(
+            "{arg}: expected 1 to 1024 values, got {}",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
+/// Rebuilds a `StepResult` from its fields (the unpickler of `StepResult.__reduce__`).
+#[pyfunction]
+fn _rebuild_step_result(
+    q: &Bound<'_, PyAny>,
+    unclamped: &Bound<'_, PyAny>,
+    saturated: bool,
+    position_error: f64,
+    orientation_error: f64,
+    clearance: f64,
+) -> PyResult<StepResult> {
+    let q = pickled_vector(q, "q")?;
+    let unclamped = crate::convert::vector(unclamped, "unclamped", q.len())?;
+    Ok(StepResult {
+        q,
+        unclamped,
+        info: core::StepInfo {
+            saturated,
+            position_error,
+            orientation_error,
+            clearance,
+        },
+    })
+}
+
+/// Rebuilds a `Solution` from its fields (the unpickler of `Solution.__reduce__`).
+#[pyfunction]
+fn _rebuild_solution(
+    q: &Bound<'_, PyAny>,
+    converged: bool,
+    steps: usize,
+    position_error: f64,
+    orientation_error: f64,
+    termination: &str,
+) -> PyResult<Solution> {
+    let termination = [
+        core::SolveTermination::Converged,
+        core::SolveTermination::Stuck,
+        core::SolveTermination::StepLimit,
+    ]
+    .into_iter()
+    .find(|t| t.name() == termination)
+    .ok_or_else(|| InputError::new_err(format!("termination: unknown {termination:?}")))?;
+    Ok(Solution {
+        inner: core::Solution {
+            q: pickled_vector(q, "q")?,
+            converged,
+            steps,
+            position_error,
+            orientation_error,
+            termination,
+        },
+    })
+}
+
 /// Registers the resolver classes.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Gains>()?;
@@ -581,5 +725,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<StepResult>()?;
     m.add_class::<Solution>()?;
     m.add_class::<LagModel>()?;
+    m.add_function(wrap_pyfunction!(_rebuild_step_result, m)?)?;
+    m.add_function(wrap_pyfunction!(_rebuild_solution, m)?)?;
     Ok(())
 }
