@@ -115,12 +115,12 @@ impl Gains {
         }
     }
 
-    /// Gains that converge for `arm` (the blackberry-tuned preset).
+    /// The blackberry-tuned preset with the body radius of `arm` (its widest section
+    /// plus an actuator and a cane).
     #[staticmethod]
     fn default_for(arm: PyRef<'_, SoftArm>) -> Self {
-        let _ = arm;
         Gains {
-            inner: core::Gains::blackberry(),
+            inner: core::Gains::for_arm(&arm.inner),
         }
     }
 

@@ -245,6 +245,13 @@ declare_gains! {
     }
 }
 
+/// Radius (m) of an actuator: the body reaches this far beyond the actuators' axes.
+pub const ACTUATOR_RADIUS: f64 = 0.008;
+
+/// Radius (m) of a cane, the obstacle the repulsion is tuned for: a cane's backbone
+/// curve must stay this much farther away.
+pub const CANE_RADIUS: f64 = 0.005;
+
 /// Lag the default gains tolerate in closed loop (control periods): 20, i.e. 1 s at the
 /// 50 ms period of the harvest, the slow end of pneumatic regulators behind long hoses.
 pub const DEFAULT_LAG_PERIODS: f64 = 20.0;
@@ -325,8 +332,21 @@ impl Gains {
             // 1 mm per step at a 1 cm gap, 0 at 3 cm (ρ₀).
             repulsion_gain: 1.5e-9,
             influence_distance: 0.03,
-            // Largest section radius (28 mm) + actuator (8 mm) + a cane (5 mm).
+            // Largest section radius (28 mm) + actuator (8 mm) + a cane (5 mm): what
+            // `Gains::for_arm` gives the blackberry arm.
             body_radius: 0.041,
+        }
+    }
+
+    /// [`Gains::blackberry`] with the body radius of `arm`: its largest actuator radius
+    /// plus [`ACTUATOR_RADIUS`] and [`CANE_RADIUS`] (capped at the field's bound, 1 m).
+    /// The other gains are dimensionless or tuned per step and carry over to arms of
+    /// similar size. `for_arm(&SoftArm::blackberry())` equals [`Gains::blackberry`].
+    pub fn for_arm(arm: &crate::SoftArm) -> Self {
+        let widest = arm.sections().iter().map(|s| s.radius).fold(0.0, f64::max);
+        Gains {
+            body_radius: (widest + ACTUATOR_RADIUS + CANE_RADIUS).min(1.0),
+            ..Gains::blackberry()
         }
     }
 
@@ -414,6 +434,25 @@ mod tests {
         assert_eq!(s.weight(-1.0, 0.0, 0.0), 0.0);
         let (a, b) = (s.weight(-1.0, 0.03, 0.03), s.weight(-1.0, 0.03, 0.030_001));
         assert!((a - b).abs() < 1e-4);
+    }
+
+    #[test]
+    fn for_arm_takes_the_body_radius_from_the_widest_section() {
+        let arm = crate::SoftArm::blackberry();
+        assert_eq!(Gains::for_arm(&arm), Gains::blackberry());
+        let mut sections = arm.sections().to_vec();
+        sections[1].radius = 0.05;
+        let wide = crate::SoftArm::new(sections).unwrap();
+        let g = Gains::for_arm(&wide);
+        assert!((g.body_radius - 0.063).abs() < 1e-15, "{}", g.body_radius);
+        assert!(g.validate().is_ok());
+        assert_eq!(
+            Gains {
+                body_radius: 0.041,
+                ..g
+            },
+            Gains::blackberry()
+        );
     }
 
     #[test]
