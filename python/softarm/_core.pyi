@@ -111,7 +111,7 @@ class Gains:
     """Tuning parameters of :class:`Resolver` (redundancy paper eq. 7, 13, 20, 23-25).
 
     Keyword-only constructor; every field defaults to the blackberry preset
-    (``Gains.default_for(arm)``). Units: every ``*_alpha`` and the task weights
+    (``Gains.default_for(SoftArm.blackberry())``). Units: every ``*_alpha`` and the task weights
     ``hybrid_position`` (gamma_6) and ``hybrid_orientation`` (gamma_4) are dimensionless
     fractions per step. The joint-limit weights ``position_gamma`` (gamma_2),
     ``orientation_gamma`` (gamma_3) and ``hybrid_gamma`` (gamma_5) multiply grad H, which is
@@ -169,7 +169,9 @@ class Gains:
         """The paper's printed gains, eq. (23)-(25), read in the units above."""
     @staticmethod
     def default_for(arm: SoftArm) -> Gains:
-        """Gains that converge for ``arm`` (the blackberry-tuned preset)."""
+        """The blackberry-tuned preset with ``body_radius`` from ``arm``: its widest
+        section's actuator radius + 8 mm (actuator) + 5 mm (a cane), at most 1 m. Equal
+        to ``Gains()`` for ``SoftArm.blackberry()``."""
     def replace(self, **changes: object) -> Gains:
         """A copy with some fields changed (same keywords as the constructor)."""
     def as_dict(self) -> dict[str, object]: ...
@@ -249,6 +251,17 @@ class StepResult:
     def clearance(self) -> float:
         """Smallest surface gap (m) of the model arm at q to the obstacles within the
         influence distance; inf when none is."""
+    def __reduce__(self) -> tuple[object, tuple[_F64, _F64, bool, float, float, float]]: ...
+
+def _rebuild_step_result(
+    q: _ArrayLike,
+    unclamped: _ArrayLike,
+    saturated: bool,
+    position_error: float,
+    orientation_error: float,
+    clearance: float,
+) -> StepResult:
+    """Unpickler of ``StepResult``."""
 
 @final
 class Solution:
@@ -271,6 +284,17 @@ class Solution:
     def termination(self) -> str:
         """Why the iteration stopped: "converged", "stuck" (a step left q unchanged, e.g.
         the straight rest pose in position mode) or "step_limit"."""
+    def __reduce__(self) -> tuple[object, tuple[_F64, bool, int, float, float, str]]: ...
+
+def _rebuild_solution(
+    q: _ArrayLike,
+    converged: bool,
+    steps: int,
+    position_error: float,
+    orientation_error: float,
+    termination: str,
+) -> Solution:
+    """Unpickler of ``Solution``."""
 
 @final
 class Resolver:
@@ -278,7 +302,8 @@ class Resolver:
 
     ``mode``: "conventional" (eq. 7; full Jacobian for a pose target, position Jacobian
     for a point), "position" / "orientation" (eq. 13, over joint-limit avoidance) or
-    "hybrid" (eq. 20). ``gains=None`` uses ``Gains.default_for(arm)``.
+    "hybrid" (eq. 20). ``gains=None`` uses ``Gains()``; ``Gains.default_for(arm)`` sizes
+    the body radius for another arm.
     """
 
     def __new__(cls, arm: SoftArm, mode: str | None = None, gains: Gains | None = None) -> Resolver:
@@ -335,6 +360,8 @@ class LagModel:
         """One period with ``command`` held; the predicted elongations after it."""
     def reset(self, q: _ArrayLike) -> None:
         """Settles the model at ``q``."""
+    def __reduce__(self) -> tuple[type[LagModel], tuple[float, float, _F64]]:
+        """Pickles as ``LagModel(tau_s, period_s, q)``: the predicted state travels."""
 
 # --- distance queries and planning (planning paper eq. 9-18) -------------------------
 

@@ -512,14 +512,14 @@ fn _rebuild_closest(
     let a = vector(arm_point, "arm_point", 3)?;
     let o = vector(obstacle_point, "obstacle_point", 3)?;
     Ok(Closest {
-        inner: dist::Closest {
-            distance,
+        inner: dist::Closest::new(
             section,
             s,
+            Vec3::new(a[0], a[1], a[2]),
             u,
-            arm_point: Vec3::new(a[0], a[1], a[2]),
-            obstacle_point: Vec3::new(o[0], o[1], o[2]),
-        },
+            Vec3::new(o[0], o[1], o[2]),
+            distance,
+        ),
     })
 }
 

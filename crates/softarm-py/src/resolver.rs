@@ -15,56 +15,17 @@ use crate::distance::obstacle_from;
 use crate::errors::{InputError, IntoPyResult, ParameterError, ShapeError};
 use crate::kinematics::SoftArm;
 
-/// Every field name of `Gains`, in declaration order.
-const FIELDS: [&str; 22] = [
-    "conventional_alpha",
-    "position_alpha",
-    "position_gamma",
-    "position_switch",
-    "orientation_alpha",
-    "orientation_gamma",
-    "orientation_switch",
-    "hybrid_alpha",
-    "hybrid_position",
-    "hybrid_orientation",
-    "hybrid_gamma",
-    "hybrid_switch",
-    "schedule",
-    "axis_mask",
-    "damping",
-    "singular_threshold",
-    "limit_margin",
-    "max_step",
-    "lag_periods",
-    "repulsion_gain",
-    "influence_distance",
-    "body_radius",
-];
+/// The core's declaration of a float gain named `name`.
+fn float_field(name: &str) -> Option<&'static core::gains::FloatField> {
+    core::Gains::FLOAT_FIELDS.iter().find(|f| f.name == name)
+}
 
-fn float_field<'a>(g: &'a mut core::Gains, name: &str) -> Option<&'a mut f64> {
-    Some(match name {
-        "conventional_alpha" => &mut g.conventional_alpha,
-        "position_alpha" => &mut g.position_alpha,
-        "position_gamma" => &mut g.position_gamma,
-        "position_switch" => &mut g.position_switch,
-        "orientation_alpha" => &mut g.orientation_alpha,
-        "orientation_gamma" => &mut g.orientation_gamma,
-        "orientation_switch" => &mut g.orientation_switch,
-        "hybrid_alpha" => &mut g.hybrid_alpha,
-        "hybrid_position" => &mut g.hybrid_position,
-        "hybrid_orientation" => &mut g.hybrid_orientation,
-        "hybrid_gamma" => &mut g.hybrid_gamma,
-        "hybrid_switch" => &mut g.hybrid_switch,
-        "damping" => &mut g.damping,
-        "singular_threshold" => &mut g.singular_threshold,
-        "limit_margin" => &mut g.limit_margin,
-        "max_step" => &mut g.max_step,
-        "lag_periods" => &mut g.lag_periods,
-        "repulsion_gain" => &mut g.repulsion_gain,
-        "influence_distance" => &mut g.influence_distance,
-        "body_radius" => &mut g.body_radius,
-        _ => return None,
-    })
+/// Every field name of `Gains`: the floats, then `schedule` and `axis_mask`.
+fn field_names() -> impl Iterator<Item = &'static str> {
+    core::Gains::FLOAT_FIELDS
+        .iter()
+        .map(|f| f.name)
+        .chain(core::Gains::OTHER_FIELDS.iter().copied())
 }
 
 /// Applies keyword overrides to `g`, then validates the result.
@@ -72,10 +33,11 @@ fn apply(mut g: core::Gains, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<cor
     if let Some(kw) = kwargs {
         for (k, v) in kw.iter() {
             let name: String = k.extract()?;
-            if let Some(f) = float_field(&mut g, &name) {
-                *f = v.extract::<f64>().map_err(|_| {
+            if let Some(f) = float_field(&name) {
+                let x = v.extract::<f64>().map_err(|_| {
                     ParameterError::new_err(format!("{name}: expected a float, got {v}"))
                 })?;
+                (f.set)(&mut g, x);
             } else if name == "schedule" {
                 let s: String = v.extract().map_err(|_| {
                     ParameterError::new_err(format!("schedule: expected a str, got {v}"))
@@ -91,7 +53,7 @@ fn apply(mut g: core::Gains, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<cor
             } else {
                 return Err(ParameterError::new_err(format!(
                     "{name}: unknown gain; expected one of {}",
-                    FIELDS.join(", ")
+                    field_names().collect::<Vec<_>>().join(", ")
                 )));
             }
         }
@@ -107,108 +69,10 @@ pub struct Gains {
     pub(crate) inner: core::Gains,
 }
 
+/// The float fields' properties are added at registration, from the core's one list
+/// ([`add_float_properties`]); the methods below are the rest.
 #[pymethods]
 impl Gains {
-    #[getter]
-    fn conventional_alpha(&self) -> f64 {
-        self.inner.conventional_alpha
-    }
-
-    #[getter]
-    fn position_alpha(&self) -> f64 {
-        self.inner.position_alpha
-    }
-
-    #[getter]
-    fn position_gamma(&self) -> f64 {
-        self.inner.position_gamma
-    }
-
-    #[getter]
-    fn position_switch(&self) -> f64 {
-        self.inner.position_switch
-    }
-
-    #[getter]
-    fn orientation_alpha(&self) -> f64 {
-        self.inner.orientation_alpha
-    }
-
-    #[getter]
-    fn orientation_gamma(&self) -> f64 {
-        self.inner.orientation_gamma
-    }
-
-    #[getter]
-    fn orientation_switch(&self) -> f64 {
-        self.inner.orientation_switch
-    }
-
-    #[getter]
-    fn hybrid_alpha(&self) -> f64 {
-        self.inner.hybrid_alpha
-    }
-
-    #[getter]
-    fn hybrid_position(&self) -> f64 {
-        self.inner.hybrid_position
-    }
-
-    #[getter]
-    fn hybrid_orientation(&self) -> f64 {
-        self.inner.hybrid_orientation
-    }
-
-    #[getter]
-    fn hybrid_gamma(&self) -> f64 {
-        self.inner.hybrid_gamma
-    }
-
-    #[getter]
-    fn hybrid_switch(&self) -> f64 {
-        self.inner.hybrid_switch
-    }
-
-    #[getter]
-    fn damping(&self) -> f64 {
-        self.inner.damping
-    }
-
-    #[getter]
-    fn singular_threshold(&self) -> f64 {
-        self.inner.singular_threshold
-    }
-
-    #[getter]
-    fn limit_margin(&self) -> f64 {
-        self.inner.limit_margin
-    }
-
-    #[getter]
-    fn max_step(&self) -> f64 {
-        self.inner.max_step
-    }
-
-    #[getter]
-    fn lag_periods(&self) -> f64 {
-        self.inner.lag_periods
-    }
-
-    #[getter]
-    fn repulsion_gain(&self) -> f64 {
-        self.inner.repulsion_gain
-    }
-
-    #[getter]
-    fn influence_distance(&self) -> f64 {
-        self.inner.influence_distance
-    }
-
-    #[getter]
-    fn body_radius(&self) -> f64 {
-        self.inner.body_radius
-    }
-
     /// The default gains for actuators lagging `tau_s` (s, sensor filter included)
     /// behind commands sent every `period_s` (s): the closed-loop α cap at that lag.
     #[staticmethod]
@@ -251,12 +115,12 @@ impl Gains {
         }
     }
 
-    /// Gains that converge for `arm` (the blackberry-tuned preset).
+    /// The blackberry-tuned preset with the body radius of `arm` (its widest section
+    /// plus an actuator and a cane).
     #[staticmethod]
     fn default_for(arm: PyRef<'_, SoftArm>) -> Self {
-        let _ = arm;
         Gains {
-            inner: core::Gains::blackberry(),
+            inner: core::Gains::for_arm(&arm.inner),
         }
     }
 
@@ -284,11 +148,8 @@ impl Gains {
     /// Every field as a dict.
     fn as_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        let mut g = self.inner;
-        for name in FIELDS {
-            if let Some(v) = float_field(&mut g, name) {
-                d.set_item(name, *v)?;
-            }
+        for f in core::Gains::FLOAT_FIELDS {
+            d.set_item(f.name, (f.get)(&self.inner))?;
         }
         d.set_item("schedule", self.inner.schedule.name())?;
         d.set_item("axis_mask", PyTuple::new(py, self.inner.axis_mask)?)?;
@@ -352,6 +213,38 @@ impl StepResult {
     fn clearance(&self) -> f64 {
         self.info.clearance
     }
+    /// Pickling and `copy.deepcopy`, through `_core._rebuild_step_result`.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Bound<'py, PyArray1<f64>>,
+            Bound<'py, PyArray1<f64>>,
+            bool,
+            f64,
+            f64,
+            f64,
+        ),
+    )> {
+        let f = py
+            .import("softarm._core")?
+            .getattr("_rebuild_step_result")?;
+        let i = &self.info;
+        Ok((
+            f,
+            (
+                self.q(py),
+                self.unclamped(py),
+                i.saturated,
+                i.position_error,
+                i.orientation_error,
+                i.clearance,
+            ),
+        ))
+    }
     fn __repr__(&self) -> String {
         format!(
             "StepResult(saturated={}, position_error={:.3e}, orientation_error={:.3e})",
@@ -398,6 +291,36 @@ impl Solution {
     #[getter]
     fn termination(&self) -> &'static str {
         self.inner.termination.name()
+    }
+    /// Pickling and `copy.deepcopy`, through `_core._rebuild_solution`.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Bound<'py, PyArray1<f64>>,
+            bool,
+            usize,
+            f64,
+            f64,
+            &'static str,
+        ),
+    )> {
+        let f = py.import("softarm._core")?.getattr("_rebuild_solution")?;
+        let s = &self.inner;
+        Ok((
+            f,
+            (
+                self.q(py),
+                s.converged,
+                s.steps,
+                s.position_error,
+                s.orientation_error,
+                s.termination.name(),
+            ),
+        ))
     }
     fn __repr__(&self) -> String {
         format!(
@@ -677,6 +600,22 @@ impl LagModel {
         let q = crate::convert::vector(q, "q", n)?;
         self.inner.reset(&q).py()
     }
+    /// Pickling and `copy.deepcopy`: `LagModel(tau_s, period_s, q)` with the predicted
+    /// elongations as `q0`, which is the whole state (the gain follows from the lag).
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (Bound<'py, PyType>, (f64, f64, Bound<'py, PyArray1<f64>>)) {
+        let m = slf.borrow();
+        (
+            slf.get_type(),
+            (
+                m.inner.tau_s(),
+                m.inner.period_s(),
+                PyArray1::from_slice(slf.py(), m.inner.state()),
+            ),
+        )
+    }
     fn __repr__(&self) -> String {
         format!(
             "LagModel(tau_s={}, period_s={})",
@@ -686,12 +625,107 @@ impl LagModel {
     }
 }
 
+/// Adds a read-only property to `Gains` for every float field of the core's list
+/// ([`core::Gains::FLOAT_FIELDS`]), documented by the field's doc comment and range.
+fn add_float_properties(py: Python<'_>) -> PyResult<()> {
+    let cls = py.get_type::<Gains>();
+    let property = py.import("builtins")?.getattr("property")?;
+    for f in core::Gains::FLOAT_FIELDS {
+        let get = f.get;
+        let getter = pyo3::types::PyCFunction::new_closure(
+            py,
+            None,
+            None,
+            move |args: &Bound<'_, PyTuple>,
+                  _kwargs: Option<&Bound<'_, PyDict>>|
+                  -> PyResult<f64> {
+                let slf = args.get_item(0)?;
+                let g = slf.cast::<Gains>()?;
+                Ok(get(&g.get().inner))
+            },
+        )?;
+        let doc: Vec<&str> = f.doc.lines().map(str::trim).collect();
+        let doc = format!("{}\n\nAccepted range: {}.", doc.join("\n"), f.range);
+        cls.setattr(f.name, property.call1((getter, py.None(), py.None(), doc))?)?;
+    }
+    Ok(())
+}
+
+/// Reads a pickled `(n,)` vector of 1 to 1024 finite values.
+fn pickled_vector(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<f64>> {
+    let (v, _) = array(obj, arg, &[None])?;
+    if v.is_empty() || v.len() > 1024 {
+        return Err(ShapeError::new_err(format!(
+            "{arg}: expected 1 to 1024 values, got {}",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
+/// Rebuilds a `StepResult` from its fields (the unpickler of `StepResult.__reduce__`).
+#[pyfunction]
+fn _rebuild_step_result(
+    q: &Bound<'_, PyAny>,
+    unclamped: &Bound<'_, PyAny>,
+    saturated: bool,
+    position_error: f64,
+    orientation_error: f64,
+    clearance: f64,
+) -> PyResult<StepResult> {
+    let q = pickled_vector(q, "q")?;
+    let unclamped = crate::convert::vector(unclamped, "unclamped", q.len())?;
+    Ok(StepResult {
+        q,
+        unclamped,
+        info: core::StepInfo {
+            saturated,
+            position_error,
+            orientation_error,
+            clearance,
+        },
+    })
+}
+
+/// Rebuilds a `Solution` from its fields (the unpickler of `Solution.__reduce__`).
+#[pyfunction]
+fn _rebuild_solution(
+    q: &Bound<'_, PyAny>,
+    converged: bool,
+    steps: usize,
+    position_error: f64,
+    orientation_error: f64,
+    termination: &str,
+) -> PyResult<Solution> {
+    let termination = [
+        core::SolveTermination::Converged,
+        core::SolveTermination::Stuck,
+        core::SolveTermination::StepLimit,
+    ]
+    .into_iter()
+    .find(|t| t.name() == termination)
+    .ok_or_else(|| InputError::new_err(format!("termination: unknown {termination:?}")))?;
+    Ok(Solution {
+        inner: core::Solution {
+            q: pickled_vector(q, "q")?,
+            converged,
+            steps,
+            position_error,
+            orientation_error,
+            termination,
+        },
+    })
+}
+
 /// Registers the resolver classes.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Gains>()?;
+    add_float_properties(m.py())?;
     m.add_class::<Resolver>()?;
     m.add_class::<StepResult>()?;
     m.add_class::<Solution>()?;
     m.add_class::<LagModel>()?;
+    m.add_function(wrap_pyfunction!(_rebuild_step_result, m)?)?;
+    m.add_function(wrap_pyfunction!(_rebuild_solution, m)?)?;
     Ok(())
 }

@@ -13,7 +13,7 @@ use crate::arc::ArcParams;
 use crate::chain::{check_q, SectionModel};
 use crate::error::Result;
 use crate::kinematics::Kinematics;
-use crate::math::Frame;
+use crate::math::{Frame, Vec3};
 
 /// One piece of the arm's body.
 #[derive(Debug, Clone, Copy)]
@@ -24,6 +24,75 @@ pub struct Piece {
     pub section: usize,
     /// True for the rigid plate or gripper after the arc.
     pub rigid: bool,
+    /// The midpoint of the piece's chord: with [`Piece::half`], a ball holding it.
+    pub centre: Vec3,
+    /// Half the piece's length L. Every point x of a curve of length L from A to B has
+    /// |x − A| + |x − B| ≤ L, hence |x − (A + B)/2| ≤ L/2: the ball needs no
+    /// trigonometry beyond the arc's tip, which the queries need anyway.
+    pub half: f64,
+}
+
+impl Piece {
+    /// The piece `arc` of `section`, with its bounding ball.
+    fn new(arc: PlacedArc, section: usize, rigid: bool) -> Self {
+        Piece {
+            centre: arc.frame.pos + arc.frame.rot * (0.5 * arc.arc.tip()),
+            half: 0.5 * arc.arc.params.length,
+            arc,
+            section,
+            rigid,
+        }
+    }
+}
+
+/// An axis-aligned box holding the whole body: the union of every piece's bounding ball.
+/// Built once per configuration, it lets a far obstacle be dismissed with a handful of
+/// sphere tests instead of one per piece and sphere.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyBox {
+    lo: Vec3,
+    hi: Vec3,
+}
+
+impl BodyBox {
+    /// The box around the bounding balls of `pieces` (empty, i.e. clear of everything,
+    /// when there are none).
+    pub fn around(pieces: &[Piece]) -> Self {
+        let inf = Vec3::repeat(f64::INFINITY);
+        pieces.iter().fold(BodyBox { lo: inf, hi: -inf }, |b, p| {
+            let r = Vec3::repeat(p.half);
+            BodyBox {
+                lo: b.lo.inf(&(p.centre - r)),
+                hi: b.hi.sup(&(p.centre + r)),
+            }
+        })
+    }
+
+    /// Squared distance between this box and the box (`lo`, `hi`): the per-axis gaps
+    /// (0 where the boxes overlap along the axis), squared and summed.
+    #[inline]
+    fn distance_squared(&self, lo: &Vec3, hi: &Vec3) -> f64 {
+        (0..3)
+            .map(|i| {
+                let gap = (lo[i] - self.hi[i]).max(self.lo[i] - hi[i]).max(0.0);
+                gap * gap
+            })
+            .sum()
+    }
+
+    /// True when the ball (`centre`, `radius`) lies at least `limit` from every point of
+    /// the box, hence of the body: `|c − box| ≥ radius + limit` (squared, no square root).
+    #[inline]
+    pub fn clear_of(&self, centre: &Vec3, radius: f64, limit: f64) -> bool {
+        let reach = radius + limit;
+        self.distance_squared(centre, centre) >= reach * reach
+    }
+
+    /// True when the box (`lo`, `hi`) lies at least `limit` from every point of this box.
+    #[inline]
+    pub fn clear_of_box(&self, lo: &Vec3, hi: &Vec3, limit: f64) -> bool {
+        self.distance_squared(lo, hi) >= limit * limit
+    }
 }
 
 /// The closest pair between the arm's body (arcs and rigid parts) and an obstacle.
@@ -43,11 +112,7 @@ pub fn placed_pieces_into<K: SectionModel + ?Sized>(model: &K, q: &[f64], out: &
     let mut f = Frame::identity();
     for i in 0..model.n_sections() {
         let st = model.section_state(i, &q[3 * i..3 * i + 3]);
-        out.push(Piece {
-            arc: PlacedArc::new(f, st.arc),
-            section: i,
-            rigid: false,
-        });
+        out.push(Piece::new(PlacedArc::new(f, st.arc), i, false));
         let tip = f.compose(&st.arc.frame(1.0));
         if st.offset > 0.0 {
             let straight = ArcParams {
@@ -55,11 +120,7 @@ pub fn placed_pieces_into<K: SectionModel + ?Sized>(model: &K, q: &[f64], out: &
                 ux: 0.0,
                 uy: 0.0,
             };
-            out.push(Piece {
-                arc: PlacedArc::new(tip, straight),
-                section: i,
-                rigid: true,
-            });
+            out.push(Piece::new(PlacedArc::new(tip, straight), i, true));
         }
         // The next section's base: the offset along the tip's z, then the twist about it.
         let (c, s) = st.twist;
@@ -75,33 +136,56 @@ pub fn placed_pieces_into<K: SectionModel + ?Sized>(model: &K, q: &[f64], out: &
     }
 }
 
-/// The closest pair over `pieces` to `obstacle`, when closer than `cutoff` (exact; far
-/// pieces are skipped by bounding spheres). `None` when every piece is at least `cutoff`
-/// away.
+/// The closest pair over `pieces` (held by `bound`, [`BodyBox::around`] them) to
+/// `obstacle`, when closer than `cutoff` (exact; far pieces are skipped by bounding
+/// spheres). `None` when every piece is at least `cutoff` away.
 pub fn closest_piece_within(
     pieces: &[Piece],
+    bound: &BodyBox,
     obstacle: &Obstacle,
     cutoff: f64,
 ) -> Option<BodyClosest> {
-    let mut best: Option<BodyClosest> = None;
-    let mut limit = cutoff;
-    let spheres = match obstacle {
-        Obstacle::Curve(c) => Some(c.interval_spheres()),
-        Obstacle::Segment(s) => Some(s.as_curve().interval_spheres()),
+    let curve = match obstacle {
+        Obstacle::Curve(c) => Some(c),
+        Obstacle::Segment(s) => Some(s.as_curve()),
         _ => None,
     };
+    // The curve's interval spheres that reach the body's box (bit k for sphere k; a curve
+    // has at most 64 intervals). A sphere clear of the box is clear of every piece inside
+    // it, so the usual far obstacle costs a few sphere tests and no per-piece work.
+    let near = curve.map(|c| {
+        let spheres = c.interval_spheres();
+        debug_assert!(spheres.len() <= 64);
+        let (lo, hi) = c.bounding_box();
+        if bound.clear_of_box(&lo, &hi, cutoff) {
+            return 0u64;
+        }
+        spheres
+            .iter()
+            .enumerate()
+            .filter(|(_, (c, r))| !bound.clear_of(c, *r, cutoff))
+            .fold(0u64, |m, (k, _)| m | (1 << k))
+    });
+    if near == Some(0) {
+        return None;
+    }
+    let mut best: Option<BodyClosest> = None;
+    let mut limit = cutoff;
     for p in pieces {
-        if let Some(spheres) = spheres {
+        if let (Some(c), Some(mut mask)) = (curve, near) {
             // Cull by the curve's per-interval bounding spheres (the whole-curve sphere of
-            // a long cane holds most of the arm): a piece lies within half its length of
-            // its middle point.
-            let middle = p.arc.point(0.5);
-            let half = 0.5 * p.arc.arc.params.length;
-            // Squared, to spare a square root per interval: |m − c| ≥ r + L/2 + limit.
-            if spheres.iter().all(|(c, r)| {
-                let reach = r + half + limit;
-                (middle - c).norm_squared() >= reach * reach
-            }) {
+            // a long cane holds most of the arm), those that reach the box: skip the piece
+            // when each is at least `limit` from the piece's ball. Squared, to spare a
+            // square root per interval: |centre − c| ≥ r + L/2 + limit.
+            let spheres = c.interval_spheres();
+            let mut far = true;
+            while mask != 0 && far {
+                let (c, r) = spheres[mask.trailing_zeros() as usize];
+                mask &= mask - 1;
+                let reach = r + p.half + limit;
+                far = (p.centre - c).norm_squared() >= reach * reach;
+            }
+            if far {
                 continue;
             }
         }
@@ -109,10 +193,7 @@ pub fn closest_piece_within(
             if c.distance < limit {
                 limit = c.distance;
                 best = Some(BodyClosest {
-                    closest: Closest {
-                        section: p.section,
-                        ..c
-                    },
+                    closest: c.in_section(p.section),
                     rigid: p.rigid,
                 });
             }
@@ -140,10 +221,7 @@ pub fn closest_body<K: Kinematics + ?Sized>(
         let c = closest_to_arcs(std::slice::from_ref(&p.arc), obstacle);
         if best.is_none_or(|b| c.distance < b.closest.distance) {
             best = Some(BodyClosest {
-                closest: Closest {
-                    section: p.section,
-                    ..c
-                },
+                closest: c.in_section(p.section),
                 rigid: p.rigid,
             });
         }
@@ -193,5 +271,57 @@ mod tests {
         for w in pieces.chunks(2) {
             assert!((w[0].arc.point(1.0) - w[1].arc.point(0.0)).norm() < 1e-12);
         }
+    }
+
+    /// The box holds every piece (sampled), and the culled query agrees with the exact
+    /// whole-body distance for canes from touching to far beyond the cutoff: a cull only
+    /// skips what is provably at least `cutoff` away.
+    #[test]
+    fn culled_query_agrees_with_the_exact_distance() {
+        use crate::distance::PolynomialCurve;
+        let arm = SoftArm::blackberry();
+        let configs = [
+            [0.0166; 9],
+            [
+                0.016, 0.012, 0.020, 0.018, 0.015, 0.014, 0.017, 0.019, 0.013,
+            ],
+            [0.0, 0.03, 0.01, 0.03, 0.0, 0.02, 0.005, 0.03, 0.0],
+        ];
+        let cutoff = 0.071;
+        let mut pieces = Vec::new();
+        let (mut culled, mut near) = (0, 0);
+        for q in &configs {
+            placed_pieces_into(&arm, q, &mut pieces);
+            let bound = BodyBox::around(&pieces);
+            for p in &pieces {
+                for k in 0..=20 {
+                    let x = p.arc.point(k as f64 / 20.0);
+                    assert!(!bound.clear_of(&x, 0.0, 1e-9), "{x:?} outside {bound:?}");
+                    assert!((x - p.centre).norm() <= p.half + 1e-12);
+                }
+            }
+            for k in 0..24 {
+                let a = k as f64 * std::f64::consts::PI / 12.0;
+                let radius = 0.02 + 0.01 * k as f64;
+                let coeffs = [
+                    Vec3::new(radius * a.cos(), radius * a.sin(), 0.0),
+                    Vec3::new(0.0, 0.0, 1.0),
+                    Vec3::new(0.03, 0.01, 0.0),
+                ];
+                let cane = Obstacle::Curve(PolynomialCurve::new(&coeffs, (0.0, 0.6)).unwrap());
+                let exact = closest_body(&arm, q, &cane).unwrap().closest.distance;
+                match closest_piece_within(&pieces, &bound, &cane, cutoff) {
+                    Some(hit) => {
+                        near += 1;
+                        assert!((hit.closest.distance - exact).abs() < 1e-12);
+                    }
+                    None => {
+                        culled += 1;
+                        assert!(exact >= cutoff - 1e-12, "missed a cane at {exact}");
+                    }
+                }
+            }
+        }
+        assert!(culled > 0 && near > 0, "{culled} culled, {near} near");
     }
 }

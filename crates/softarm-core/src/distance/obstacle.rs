@@ -1,7 +1,7 @@
 //! Obstacles of every kind, and the closest pair between an arm and one obstacle.
 
 use super::arc_cloud::PointCloud;
-use super::arc_curve::{closest_arc_curve, closest_arc_curve_within};
+use super::arc_curve::{closest_arc_curve, closest_arc_curve_within, ArcCurveHit};
 use super::arc_mesh::TriangleMesh;
 use super::arc_point::PlacedArc;
 use super::polynomial::{PolynomialCurve, Segment};
@@ -131,6 +131,68 @@ pub struct Closest {
     pub obstacle_point: Vec3,
 }
 
+impl Closest {
+    /// The pair of the arm point `arm_point` (fraction `s` of section `section`) and the
+    /// obstacle point `obstacle_point` (parameter `u`, see [`Closest::u`]), `distance`
+    /// apart.
+    #[inline]
+    pub fn new(
+        section: usize,
+        s: f64,
+        arm_point: Vec3,
+        u: f64,
+        obstacle_point: Vec3,
+        distance: f64,
+    ) -> Self {
+        Closest {
+            distance,
+            section,
+            s,
+            u,
+            arm_point,
+            obstacle_point,
+        }
+    }
+
+    /// No pair: infinitely far (what a search over no arc returns).
+    pub fn none() -> Self {
+        Closest::new(0, 0.0, Vec3::zeros(), 0.0, Vec3::zeros(), f64::INFINITY)
+    }
+
+    /// An arc ↔ curve (or segment) pair on section `section`.
+    #[inline]
+    pub fn from_curve_hit(section: usize, h: &ArcCurveHit) -> Self {
+        Closest::new(section, h.s, h.arc_point, h.u, h.curve_point, h.distance)
+    }
+
+    /// The arc point `s` of `arc` (section `section`) and the cloud's point `index`,
+    /// `distance` apart.
+    #[inline]
+    fn cloud_point(
+        section: usize,
+        arc: &PlacedArc,
+        s: f64,
+        cloud: &PointCloud,
+        index: usize,
+        distance: f64,
+    ) -> Self {
+        Closest::new(
+            section,
+            s,
+            arc.point(s),
+            index as f64,
+            cloud.points()[index],
+            distance,
+        )
+    }
+
+    /// The same pair, credited to section `section`.
+    #[inline]
+    pub fn in_section(self, section: usize) -> Self {
+        Closest { section, ..self }
+    }
+}
+
 /// Every section's arc at configuration `q` (which must already be checked).
 pub fn placed_arcs<K: Kinematics + ?Sized>(model: &K, q: &[f64]) -> Vec<PlacedArc> {
     (0..model.n_sections())
@@ -144,62 +206,30 @@ pub fn placed_arcs<K: Kinematics + ?Sized>(model: &K, q: &[f64]) -> Vec<PlacedAr
 /// Closest pair between one arc (section `section`) and `obstacle`.
 pub fn closest_to_arc(arc: &PlacedArc, section: usize, obstacle: &Obstacle) -> Closest {
     match obstacle {
-        Obstacle::Curve(c) => {
-            let h = closest_arc_curve(arc, c);
-            Closest {
-                distance: h.distance,
-                section,
-                s: h.s,
-                u: h.u,
-                arm_point: h.arc_point,
-                obstacle_point: h.curve_point,
-            }
-        }
+        Obstacle::Curve(c) => Closest::from_curve_hit(section, &closest_arc_curve(arc, c)),
         Obstacle::Segment(seg) => {
-            let h = closest_arc_curve(arc, seg.as_curve());
-            Closest {
-                distance: h.distance,
-                section,
-                s: h.s,
-                u: h.u,
-                arm_point: h.arc_point,
-                obstacle_point: h.curve_point,
-            }
+            Closest::from_curve_hit(section, &closest_arc_curve(arc, seg.as_curve()))
         }
         Obstacle::Point(p) => {
             let (s, a, d) = arc.closest_to_point(p);
-            Closest {
-                distance: d,
-                section,
-                s,
-                u: 0.0,
-                arm_point: a,
-                obstacle_point: *p,
-            }
+            Closest::new(section, s, a, 0.0, *p, d)
         }
         Obstacle::Cloud(cloud) => {
             let (d, s, i) = cloud
                 .closest_to_arc(arc, f64::MAX)
                 .unwrap_or_else(|| cloud.closest_to_arc_brute_force(arc));
-            Closest {
-                distance: d,
-                section,
-                s,
-                u: i as f64,
-                arm_point: arc.point(s),
-                obstacle_point: cloud.points()[i],
-            }
+            Closest::cloud_point(section, arc, s, cloud, i, d)
         }
         Obstacle::Mesh(mesh) => {
             let h = mesh.closest_to_arc(arc);
-            Closest {
-                distance: h.distance,
+            Closest::new(
                 section,
-                s: h.s,
-                u: h.triangle as f64,
-                arm_point: h.arc_point,
-                obstacle_point: h.mesh_point,
-            }
+                h.s,
+                h.arc_point,
+                h.triangle as f64,
+                h.mesh_point,
+                h.distance,
+            )
         }
     }
 }
@@ -211,14 +241,7 @@ pub fn closest_to_arcs(arcs: &[PlacedArc], obstacle: &Obstacle) -> Closest {
     for (i, arc) in arcs.iter().enumerate() {
         let hit = match (obstacle, &best) {
             (Obstacle::Cloud(cloud), Some(b)) => match cloud.closest_to_arc(arc, b.distance) {
-                Some((d, s, k)) => Closest {
-                    distance: d,
-                    section: i,
-                    s,
-                    u: k as f64,
-                    arm_point: arc.point(s),
-                    obstacle_point: cloud.points()[k],
-                },
+                Some((d, s, k)) => Closest::cloud_point(i, arc, s, cloud, k, d),
                 None => continue,
             },
             _ => closest_to_arc(arc, i, obstacle),
@@ -227,14 +250,7 @@ pub fn closest_to_arcs(arcs: &[PlacedArc], obstacle: &Obstacle) -> Closest {
             best = Some(hit);
         }
     }
-    best.unwrap_or(Closest {
-        distance: f64::INFINITY,
-        section: 0,
-        s: 0.0,
-        u: 0.0,
-        arm_point: Vec3::zeros(),
-        obstacle_point: Vec3::zeros(),
-    })
+    best.unwrap_or_else(Closest::none)
 }
 
 /// [`closest_to_arcs`] when the distance is below `cutoff`, else `None`. Exact; curves and
@@ -254,14 +270,7 @@ pub fn closest_to_arcs_within(
             for (i, arc) in arcs.iter().enumerate() {
                 if let Some((d, s, k)) = cloud.closest_to_arc(arc, limit) {
                     limit = d;
-                    best = Some(Closest {
-                        distance: d,
-                        section: i,
-                        s,
-                        u: k as f64,
-                        arm_point: arc.point(s),
-                        obstacle_point: cloud.points()[k],
-                    });
+                    best = Some(Closest::cloud_point(i, arc, s, cloud, k, d));
                 }
             }
             return best;
@@ -276,14 +285,7 @@ pub fn closest_to_arcs_within(
     for (i, arc) in arcs.iter().enumerate() {
         if let Some(h) = closest_arc_curve_within(arc, curve, limit) {
             limit = h.distance;
-            best = Some(Closest {
-                distance: h.distance,
-                section: i,
-                s: h.s,
-                u: h.u,
-                arm_point: h.arc_point,
-                obstacle_point: h.curve_point,
-            });
+            best = Some(Closest::from_curve_hit(i, &h));
         }
     }
     best

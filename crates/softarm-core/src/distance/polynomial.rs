@@ -29,6 +29,8 @@ pub struct PolynomialCurve {
     spheres: Vec<(Vec3, f64)>,
     /// Bounding sphere of the whole curve: centre and radius.
     sphere: (Vec3, f64),
+    /// Axis-aligned box (lowest, highest corner) around the interval spheres.
+    aabb: (Vec3, Vec3),
     /// The largest radius of the interval spheres (whether the search may need to split).
     longest: f64,
 }
@@ -146,6 +148,11 @@ impl PolynomialCurve {
             .collect();
         let sphere = bounding_sphere(&coeffs, u_min, u_max);
         let longest = spheres.iter().map(|s| s.1).fold(0.0, f64::max);
+        let inf = Vec3::repeat(f64::INFINITY);
+        let aabb = spheres.iter().fold((inf, -inf), |(lo, hi), (c, r)| {
+            let r = Vec3::repeat(*r);
+            (lo.inf(&(c - r)), hi.sup(&(c + r)))
+        });
         PolynomialCurve {
             coeffs,
             u_min,
@@ -155,6 +162,7 @@ impl PolynomialCurve {
             accel,
             spheres,
             sphere,
+            aabb,
             longest,
         }
     }
@@ -226,6 +234,12 @@ impl PolynomialCurve {
     /// A sphere (centre, radius) holding the whole curve.
     pub fn bounding_sphere(&self) -> (Vec3, f64) {
         self.sphere
+    }
+
+    /// An axis-aligned box (lowest, highest corner) holding the curve: the box around
+    /// its interval spheres.
+    pub fn bounding_box(&self) -> (Vec3, Vec3) {
+        self.aabb
     }
 
     /// The largest radius of [`PolynomialCurve::interval_spheres`].

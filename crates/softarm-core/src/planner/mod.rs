@@ -22,15 +22,13 @@
 
 mod options;
 pub mod scenarios;
+mod walk;
 
 pub use options::{PlannerOptions, Termination, MAX_ARM_SAMPLES, MAX_OPTION};
 
-use nalgebra::{DMatrix, Matrix3, Matrix3xX};
-
-use crate::chain::{check_q, check_q_arcs, forward_jacobian_into, point_unchecked};
+use crate::chain::{check_q, check_q_arcs};
 use crate::distance::{
-    check_obstacles, closest_to_arcs, closest_to_arcs_within, placed_arcs, Closest, Obstacle,
-    PlacedArc,
+    check_obstacles, closest_to_arcs, placed_arcs, Closest, Obstacle, PlacedArc,
 };
 use crate::error::{check_bounded, check_count, Error, Result, MAX_POSITION};
 
@@ -94,8 +92,52 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
     /// for a curve or mesh obstacle with `arm_samples` set (the sampled baseline supports
     /// points, clouds and segments).
     pub fn plan(&self, q0: &[f64], goal: &Vec3, obstacles: &[Obstacle]) -> Result<Plan> {
-        let model = &self.model;
+        self.check_plan(q0, goal, obstacles)?;
         let o = &self.options;
+        let mut walk = self.start(q0, obstacles);
+        let mut termination = Termination::IterationLimit;
+        let mut iterations = 0;
+        while iterations < o.max_iterations {
+            let err = goal - walk.tip;
+            if err.norm() <= o.goal_tolerance {
+                termination = Termination::Reached;
+                break;
+            }
+            // Repulsion directions first: the closest arm point of each obstacle.
+            self.repulsions(&mut walk, obstacles);
+            self.projected_step(&mut walk, &self.attraction(&err));
+            if walk.dq.iter().any(|v| !v.is_finite()) {
+                // A damping of 0 at a singular Jacobian: no step can be taken (eq. 8 has
+                // no finite solution); stop rather than write NaN into the path.
+                termination = Termination::NonFiniteStep;
+                break;
+            }
+            self.take_step(&mut walk);
+            iterations += 1;
+            self.observe(&mut walk, obstacles);
+            if self.stalled(&walk, iterations) {
+                termination = Termination::Stalled;
+                break;
+            }
+        }
+        if termination == Termination::IterationLimit
+            && (goal - walk.tip).norm() <= o.goal_tolerance
+        {
+            termination = Termination::Reached;
+        }
+        Ok(Plan {
+            path: walk.path,
+            tip_path: walk.tip_path,
+            reached: termination == Termination::Reached,
+            iterations,
+            min_clearance: walk.min_clearance,
+            termination,
+        })
+    }
+
+    /// Checks the inputs of [`PotentialFieldPlanner::plan`] (its errors).
+    fn check_plan(&self, q0: &[f64], goal: &Vec3, obstacles: &[Obstacle]) -> Result<()> {
+        let model = &self.model;
         check_q(model, q0)?;
         check_bounded("goal", goal.as_slice(), MAX_POSITION)?;
         check_obstacles(obstacles)?;
@@ -103,7 +145,7 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
         for i in 0..q0.len() {
             crate::error::check_range(&format!("q0[{i}]"), q0[i], lo[i], hi[i])?;
         }
-        if o.arm_samples.is_some() {
+        if self.options.arm_samples.is_some() {
             if let Some(k) = obstacles
                 .iter()
                 .position(|ob| matches!(ob, Obstacle::Curve(_) | Obstacle::Mesh(_)))
@@ -115,167 +157,8 @@ impl<K: Kinematics> PotentialFieldPlanner<K> {
                 ));
             }
         }
-        let n = model.n_dofs();
-        let step_limit: Vec<f64> = (0..n)
-            .map(|i| o.max_step_fraction * (hi[i] - lo[i]))
-            .collect();
-        let mut q = q0.to_vec();
-        let mut jac = DMatrix::zeros(6, n);
-        let mut path = vec![q.clone()];
-        let mut arcs = placed_arcs(model, &q);
-        // Exact closest pairs at the current configuration: they give the clearance of the
-        // whole backbone and, for the proposed method, the repulsion points of the next step.
-        // Pairs farther than both the influence distance and the clearance so far can
-        // change neither, so they are skipped by exact lower bounds (`None`).
-        let mut hits: Vec<Option<Closest>> = obstacles
-            .iter()
-            .map(|ob| Some(closest_to_arcs(&arcs, ob)))
-            .collect();
-        let mut min_clearance = min_distance(&hits);
-        let mut tip = forward_jacobian_into(model, &q, &mut jac).pos;
-        let mut tip_path = vec![tip];
-        let mut termination = Termination::IterationLimit;
-        let mut iterations = 0;
-        let mut dq = vec![0.0; n];
-        let mut free = vec![true; n];
-        let mut first = vec![0.0; n];
-        let mut repulsions: Vec<(Matrix3xX<f64>, Vec3)> = Vec::with_capacity(obstacles.len());
-        while iterations < o.max_iterations {
-            let err = goal - tip;
-            if err.norm() <= o.goal_tolerance {
-                termination = Termination::Reached;
-                break;
-            }
-            // Repulsion directions first: the closest arm point of each obstacle.
-            repulsions.clear();
-            for (ob, hit) in obstacles.iter().zip(&hits) {
-                let c = match (o.arm_samples, hit) {
-                    (None, Some(h)) => *h,
-                    (None, None) => continue,
-                    (Some(m), _) => closest_sampled(&arcs, m, ob),
-                };
-                if c.distance >= o.influence_distance {
-                    continue;
-                }
-                let v = c.obstacle_point - c.arm_point;
-                let d = v.norm();
-                if d == 0.0 {
-                    continue;
-                }
-                let dd = d.max(1e-6);
-                let mag = o.repulsion_gain * (1.0 / dd - 1.0 / o.influence_distance) / (dd * dd);
-                let (_, js) = point_unchecked(model, &q, c.section, c.s);
-                repulsions.push((js, v * (mag / d)));
-            }
-            let mut dx = err * o.attraction_gain;
-            let len = dx.norm();
-            if len > o.max_tip_step {
-                dx *= o.max_tip_step / len;
-            }
-            let je = jac.fixed_rows::<3>(0).into_owned();
-            // Coordinates at a limit that the step pushes further are frozen and the step is
-            // recomputed without them (projection onto the feasible set).
-            free.iter_mut().for_each(|f| *f = true);
-            for pass in 0..4 {
-                dq.iter_mut().for_each(|v| *v = 0.0);
-                // Attraction: J_e⁺ F_e(V_e).
-                add_pinv(&je, &free, &dx, o.damping, 1.0, &mut dq);
-                // Repulsion: − Σ_j J_sj⁺ F_sj(V_sj).
-                for (js, f) in &repulsions {
-                    add_pinv(js, &free, f, o.damping, -1.0, &mut dq);
-                }
-                if pass == 0 {
-                    first.copy_from_slice(&dq);
-                }
-                let mut changed = false;
-                for i in 0..n {
-                    let blocked = (q[i] <= lo[i] && dq[i] < 0.0) || (q[i] >= hi[i] && dq[i] > 0.0);
-                    if free[i] && blocked {
-                        free[i] = false;
-                        changed = true;
-                    }
-                }
-                if !free.iter().any(|&f| f) {
-                    // Everything would freeze: fall back to the unprojected step, clamped.
-                    dq.copy_from_slice(&first);
-                    break;
-                }
-                if !changed {
-                    break;
-                }
-            }
-            if dq.iter().any(|v| !v.is_finite()) {
-                // A damping of 0 at a singular Jacobian: no step can be taken (eq. 8 has
-                // no finite solution); stop rather than write NaN into the path.
-                termination = Termination::NonFiniteStep;
-                break;
-            }
-            // Step limits, then the configuration limits.
-            let mut scale: f64 = 1.0;
-            for i in 0..n {
-                if dq[i].abs() * scale > step_limit[i] {
-                    scale = step_limit[i] / dq[i].abs();
-                }
-            }
-            for i in 0..n {
-                q[i] = (q[i] + scale * dq[i]).clamp(lo[i], hi[i]);
-            }
-            iterations += 1;
-            arcs = placed_arcs(model, &q);
-            let cutoff = o.influence_distance.max(min_clearance);
-            for (hit, ob) in hits.iter_mut().zip(obstacles) {
-                *hit = closest_to_arcs_within(&arcs, ob, cutoff);
-            }
-            min_clearance = min_clearance.min(min_distance(&hits));
-            tip = forward_jacobian_into(model, &q, &mut jac).pos;
-            path.push(q.clone());
-            tip_path.push(tip);
-            if iterations >= o.stall_window {
-                let back = tip_path[tip_path.len() - 1 - o.stall_window];
-                if (tip - back).norm() < o.stall_tolerance {
-                    termination = Termination::Stalled;
-                    break;
-                }
-            }
-        }
-        if termination == Termination::IterationLimit && (goal - tip).norm() <= o.goal_tolerance {
-            termination = Termination::Reached;
-        }
-        Ok(Plan {
-            path,
-            tip_path,
-            reached: termination == Termination::Reached,
-            iterations,
-            min_clearance,
-            termination,
-        })
+        Ok(())
     }
-}
-
-/// `dq += sign · Jᵀ (J Jᵀ + λ² I)⁻¹ f` (eq. 8, damped), using only the `free` columns.
-fn add_pinv(j: &Matrix3xX<f64>, free: &[bool], f: &Vec3, damping: f64, sign: f64, dq: &mut [f64]) {
-    let mut j = j.clone();
-    for (k, &ok) in free.iter().enumerate() {
-        if !ok {
-            j.column_mut(k).fill(0.0);
-        }
-    }
-    let jjt: Matrix3<f64> = &j * j.transpose() + Matrix3::identity() * (damping * damping);
-    let Some(chol) = jjt.cholesky() else {
-        return;
-    };
-    let y = chol.solve(f);
-    let step = j.transpose() * y;
-    for (d, s) in dq.iter_mut().zip(step.iter()) {
-        *d += sign * s;
-    }
-}
-
-fn min_distance(hits: &[Option<Closest>]) -> f64 {
-    hits.iter()
-        .flatten()
-        .map(|h| h.distance)
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// Exact clearance of the whole backbone: the smallest distance of any arc to any obstacle.
@@ -289,14 +172,7 @@ pub fn clearance(arcs: &[PlacedArc], obstacles: &[Obstacle]) -> f64 {
 /// The paper's baseline: the arm discretised into `m` points per section, and the closest
 /// pair found by brute force between those points and the obstacle.
 pub fn closest_sampled(arcs: &[PlacedArc], m: usize, obstacle: &Obstacle) -> Closest {
-    let mut best = Closest {
-        distance: f64::INFINITY,
-        section: 0,
-        s: 0.0,
-        u: 0.0,
-        arm_point: Vec3::zeros(),
-        obstacle_point: Vec3::zeros(),
-    };
+    let mut best = Closest::none();
     let denom = (m.max(2) - 1) as f64;
     for (i, arc) in arcs.iter().enumerate() {
         for k in 0..m.max(1) {
@@ -319,14 +195,7 @@ pub fn closest_sampled(arcs: &[PlacedArc], m: usize, obstacle: &Obstacle) -> Clo
                 Obstacle::Curve(_) => continue,
             };
             if d < best.distance {
-                best = Closest {
-                    distance: d,
-                    section: i,
-                    s,
-                    u,
-                    arm_point: x,
-                    obstacle_point: p,
-                };
+                best = Closest::new(i, s, x, u, p, d);
             }
         }
     }

@@ -18,7 +18,7 @@ use nalgebra::DMatrix;
 use super::pinv::normal_inverse3;
 use super::Gains;
 use crate::chain::point_unchecked;
-use crate::distance::bodies::{closest_piece_within, placed_pieces_into, Piece};
+use crate::distance::bodies::{closest_piece_within, placed_pieces_into, BodyBox, Piece};
 use crate::distance::Obstacle;
 use crate::kinematics::Kinematics;
 use crate::math::{Mat3, Vec3};
@@ -60,12 +60,14 @@ pub fn repulsions_into<K: Kinematics + ?Sized>(
         return f64::INFINITY;
     }
     placed_pieces_into(arm, q, pieces);
+    // One box around the whole body per step; each obstacle is tested against it first.
+    let bound = BodyBox::around(pieces);
     let cutoff = gains.body_radius + gains.influence_distance;
     let rho = gains.influence_distance;
     let mut clearance = f64::INFINITY;
     let n_sections = arm.n_sections();
     for ob in obstacles {
-        let Some(hit) = closest_piece_within(pieces, ob, cutoff) else {
+        let Some(hit) = closest_piece_within(pieces, &bound, ob, cutoff) else {
             continue;
         };
         let c = hit.closest;

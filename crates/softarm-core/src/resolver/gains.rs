@@ -69,69 +69,188 @@ impl Schedule {
     }
 }
 
-/// All tuning parameters. Field names follow the paper's symbols.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Gains {
-    /// α of eq. (7), conventional resolved rate (dimensionless, per step).
-    pub conventional_alpha: f64,
-    /// α₂ of eq. (13), position over joint limits.
-    pub position_alpha: f64,
-    /// γ₂ of eq. (13)/(23), joint-limit weight in position mode (m², ≤ 0).
-    pub position_gamma: f64,
-    /// Switch distance of γ₂ on ‖e_p‖ (m); eq. (23): 30 mm.
-    pub position_switch: f64,
-    /// α₃ of eq. (13), orientation over joint limits.
-    pub orientation_alpha: f64,
-    /// γ₃ of eq. (13)/(24), joint-limit weight in orientation mode (m², ≤ 0).
-    pub orientation_gamma: f64,
-    /// Switch distance of γ₃ on ‖e_ζ‖ (rad); eq. (24): 30°.
-    pub orientation_switch: f64,
-    /// α₄ of eq. (20).
-    pub hybrid_alpha: f64,
-    /// γ₆ of eq. (20), weight of the position task.
-    pub hybrid_position: f64,
-    /// γ₄ of eq. (20), weight of the orientation task (in the null space of position).
-    pub hybrid_orientation: f64,
-    /// γ₅ of eq. (20)/(25), joint-limit weight in hybrid mode (m², ≤ 0).
-    pub hybrid_gamma: f64,
-    /// Switch distance of γ₅ on ‖e_p‖ (m); eq. (25): 50 mm.
-    pub hybrid_switch: f64,
-    /// Step or smooth scheduling of every joint-limit weight.
-    pub schedule: Schedule,
-    /// Which components (x, y, z, base frame) of the orientation error are controlled;
-    /// the paper controls x and z (IV-D).
-    pub axis_mask: [bool; 3],
-    /// Largest damping λ of the damped least-squares pseudo-inverses (m for position,
-    /// rad for orientation rows; applied only near a singularity).
-    pub damping: f64,
-    /// Smallest singular value below which damping starts (same units as J).
-    pub singular_threshold: f64,
-    /// Fraction of each actuator range next to a limit where ∇H is frozen at its value
-    /// at the band's edge, so that it stays finite at and beyond the limits.
-    pub limit_margin: f64,
-    /// Largest Euclidean norm of the task part of one increment Δq (m); a longer one is
-    /// shortened along its direction. The joint-limit part is capped at half of it.
-    /// `f64::INFINITY` disables both caps.
-    pub max_step: f64,
-    /// First-order lag of the actuators, sensor filter included, in control periods
-    /// (`τ / T`), that a closed-loop step (one given a measured pose and no lag
-    /// prediction) must tolerate. The mode's largest task gain (α, or α₄ max(γ₆, γ₄) in
-    /// hybrid mode) is then capped at [`lag_alpha`]`(lag_periods)`, the largest gain for
-    /// which an integrator behind that lag does not overshoot (see `docs/control.md`);
-    /// the other weights keep their ratios.
-    /// 0 = no lag: no cap. Steps on the model (no measurement, and `solve`) are not capped.
-    pub lag_periods: f64,
-    /// `k_r` of the repulsion law (planning paper eq. 9): the closest arm point of an
-    /// obstacle is pushed away by `k_r (1/g − 1/ρ₀) / g²` metres per step, with `g` the
-    /// surface gap (clamped at 1 mm) and ρ₀ = `influence_distance` (m⁴ per step).
-    pub repulsion_gain: f64,
-    /// ρ₀ of eq. (9): surface gap (m) below which an obstacle repels.
-    pub influence_distance: f64,
-    /// Distance (m) from the arm's backbone to the surfaces that must not touch, the
-    /// obstacle's own radius included: the surface gap is the exact backbone distance
-    /// minus this.
-    pub body_radius: f64,
+/// Which ends of a [`FloatField`]'s range are accepted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ends {
+    /// `[min, max]`.
+    Closed,
+    /// `(min, max]`: a gain of 0 would never move.
+    OpenMin,
+    /// `(min, max]` or `+∞` (no cap).
+    OpenMinOrInfinite,
 }
+
+/// One floating-point field of [`Gains`] with its bounds. [`Gains::FLOAT_FIELDS`] is the
+/// one list that the validation, the Python binding's properties, keywords, `as_dict`
+/// and pickling iterate.
+#[derive(Debug, Clone, Copy)]
+pub struct FloatField {
+    /// The field's name.
+    pub name: &'static str,
+    /// The field's documentation (its doc comment, one line per line).
+    pub doc: &'static str,
+    /// Reads the field.
+    pub get: fn(&Gains) -> f64,
+    /// Writes the field.
+    pub set: fn(&mut Gains, f64),
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound.
+    pub max: f64,
+    /// Which ends are accepted.
+    pub ends: Ends,
+    /// The range as error messages state it.
+    pub range: &'static str,
+}
+
+impl FloatField {
+    /// Whether `v` lies in the field's range (NaN never does).
+    pub fn accepts(&self, v: f64) -> bool {
+        match self.ends {
+            Ends::Closed => v >= self.min && v <= self.max,
+            Ends::OpenMin => v > self.min && v <= self.max,
+            Ends::OpenMinOrInfinite => v == f64::INFINITY || (v > self.min && v <= self.max),
+        }
+    }
+}
+
+/// Declares [`Gains`] once: each float field with its doc comment and its bounds
+/// (`floats`), then the other fields (`others`). It generates the struct (each float's
+/// doc ends with its range), [`Gains::FLOAT_FIELDS`] and [`Gains::OTHER_FIELDS`].
+macro_rules! declare_gains {
+    (
+        $(#[doc = $sdoc:literal])*
+        pub struct Gains {
+            floats {
+                $(
+                    $(#[doc = $doc:literal])*
+                    pub $name:ident: f64 in ($min:expr, $max:expr, $ends:ident, $range:literal),
+                )*
+            }
+            others {
+                $(
+                    $(#[doc = $odoc:literal])*
+                    pub $oname:ident: $oty:ty,
+                )*
+            }
+        }
+    ) => {
+        $(#[doc = $sdoc])*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub struct Gains {
+            $(
+                $(#[doc = $doc])*
+                #[doc = ""]
+                #[doc = concat!("Accepted range: ", $range, ".")]
+                pub $name: f64,
+            )*
+            $(
+                $(#[doc = $odoc])*
+                pub $oname: $oty,
+            )*
+        }
+
+        impl Gains {
+            /// Every float field with its bounds, in declaration order.
+            pub const FLOAT_FIELDS: &'static [FloatField] = &[
+                $(FloatField {
+                    name: stringify!($name),
+                    doc: concat!($($doc, "\n"),*),
+                    get: |g: &Gains| g.$name,
+                    set: |g: &mut Gains, v: f64| g.$name = v,
+                    min: $min,
+                    max: $max,
+                    ends: Ends::$ends,
+                    range: $range,
+                }),*
+            ];
+
+            /// The fields that are not floats (`schedule`, `axis_mask`), in order.
+            pub const OTHER_FIELDS: &'static [&'static str] = &[$(stringify!($oname)),*];
+        }
+    };
+}
+
+declare_gains! {
+    /// All tuning parameters. Field names follow the paper's symbols.
+    pub struct Gains {
+        floats {
+            /// α of eq. (7), conventional resolved rate (dimensionless, per step).
+            pub conventional_alpha: f64 in (0.0, 2.0, OpenMin, "(0, 2]"),
+            /// α₂ of eq. (13), position over joint limits.
+            pub position_alpha: f64 in (0.0, 2.0, OpenMin, "(0, 2]"),
+            /// γ₂ of eq. (13)/(23), joint-limit weight in position mode (m², ≤ 0).
+            pub position_gamma: f64 in
+                (-1.0, 0.0, Closed, "[-1, 0] m² (a negative weight descends H)"),
+            /// Switch distance of γ₂ on ‖e_p‖ (m); eq. (23): 30 mm.
+            pub position_switch: f64 in (0.0, 10.0, Closed, "[0, 10] m"),
+            /// α₃ of eq. (13), orientation over joint limits.
+            pub orientation_alpha: f64 in (0.0, 2.0, OpenMin, "(0, 2]"),
+            /// γ₃ of eq. (13)/(24), joint-limit weight in orientation mode (m², ≤ 0).
+            pub orientation_gamma: f64 in
+                (-1.0, 0.0, Closed, "[-1, 0] m² (a negative weight descends H)"),
+            /// Switch distance of γ₃ on ‖e_ζ‖ (rad); eq. (24): 30°.
+            pub orientation_switch: f64 in (0.0, std::f64::consts::PI, Closed, "[0, π] rad"),
+            /// α₄ of eq. (20).
+            pub hybrid_alpha: f64 in (0.0, 2.0, OpenMin, "(0, 2]"),
+            /// γ₆ of eq. (20), weight of the position task.
+            pub hybrid_position: f64 in (0.0, 10.0, Closed, "[0, 10]"),
+            /// γ₄ of eq. (20), weight of the orientation task (in the null space of position).
+            pub hybrid_orientation: f64 in (0.0, 10.0, Closed, "[0, 10]"),
+            /// γ₅ of eq. (20)/(25), joint-limit weight in hybrid mode (m², ≤ 0).
+            pub hybrid_gamma: f64 in
+                (-1.0, 0.0, Closed, "[-1, 0] m² (a negative weight descends H)"),
+            /// Switch distance of γ₅ on ‖e_p‖ (m); eq. (25): 50 mm.
+            pub hybrid_switch: f64 in (0.0, 10.0, Closed, "[0, 10] m"),
+            /// Largest damping λ of the damped least-squares pseudo-inverses (m for position,
+            /// rad for orientation rows; applied only near a singularity).
+            pub damping: f64 in (0.0, 1.0, Closed, "[0, 1]"),
+            /// Smallest singular value below which damping starts (same units as J).
+            pub singular_threshold: f64 in (0.0, 1.0, Closed, "[0, 1]"),
+            /// Fraction of each actuator range next to a limit where ∇H is frozen at its value
+            /// at the band's edge, so that it stays finite at and beyond the limits. Below
+            /// ~1e-6 of the range, ∇H at the band's edge (∝ 1/margin²) is no longer a
+            /// meaningful number; 0 would make it infinite.
+            pub limit_margin: f64 in (1e-6, 0.45, Closed, "[1e-6, 0.45]"),
+            /// Largest Euclidean norm of the task part of one increment Δq (m); a longer one is
+            /// shortened along its direction. The joint-limit part is capped at half of it.
+            /// `f64::INFINITY` disables both caps.
+            pub max_step: f64 in (0.0, 1.0, OpenMinOrInfinite, "(0, 1] m or inf"),
+            /// First-order lag of the actuators, sensor filter included, in control periods
+            /// (`τ / T`), that a closed-loop step (one given a measured pose and no lag
+            /// prediction) must tolerate. The mode's largest task gain (α, or α₄ max(γ₆, γ₄) in
+            /// hybrid mode) is then capped at [`lag_alpha`]`(lag_periods)`, the largest gain for
+            /// which an integrator behind that lag does not overshoot (see `docs/control.md`);
+            /// the other weights keep their ratios.
+            /// 0 = no lag: no cap. Steps on the model (no measurement, and `solve`) are not capped.
+            pub lag_periods: f64 in (0.0, 1e4, Closed, "[0, 10000] control periods"),
+            /// `k_r` of the repulsion law (planning paper eq. 9): the closest arm point of an
+            /// obstacle is pushed away by `k_r (1/g − 1/ρ₀) / g²` metres per step, with `g` the
+            /// surface gap (clamped at 1 mm) and ρ₀ = `influence_distance` (m⁴ per step).
+            pub repulsion_gain: f64 in (0.0, 1e-3, Closed, "[0, 1e-3] m⁴"),
+            /// ρ₀ of eq. (9): surface gap (m) below which an obstacle repels.
+            pub influence_distance: f64 in (0.0, 1.0, Closed, "[0, 1] m"),
+            /// Distance (m) from the arm's backbone to the surfaces that must not touch, the
+            /// obstacle's own radius included: the surface gap is the exact backbone distance
+            /// minus this.
+            pub body_radius: f64 in (0.0, 1.0, Closed, "[0, 1] m"),
+        }
+        others {
+            /// Step or smooth scheduling of every joint-limit weight.
+            pub schedule: Schedule,
+            /// Which components (x, y, z, base frame) of the orientation error are controlled;
+            /// the paper controls x and z (IV-D).
+            pub axis_mask: [bool; 3],
+        }
+    }
+}
+
+/// Radius (m) of an actuator: the body reaches this far beyond the actuators' axes.
+pub const ACTUATOR_RADIUS: f64 = 0.008;
+
+/// Radius (m) of a cane, the obstacle the repulsion is tuned for: a cane's backbone
+/// curve must stay this much farther away.
+pub const CANE_RADIUS: f64 = 0.005;
 
 /// Lag the default gains tolerate in closed loop (control periods): 20, i.e. 1 s at the
 /// 50 ms period of the harvest, the slow end of pneumatic regulators behind long hoses.
@@ -213,8 +332,21 @@ impl Gains {
             // 1 mm per step at a 1 cm gap, 0 at 3 cm (ρ₀).
             repulsion_gain: 1.5e-9,
             influence_distance: 0.03,
-            // Largest section radius (28 mm) + actuator (8 mm) + a cane (5 mm).
+            // Largest section radius (28 mm) + actuator (8 mm) + a cane (5 mm): what
+            // `Gains::for_arm` gives the blackberry arm.
             body_radius: 0.041,
+        }
+    }
+
+    /// [`Gains::blackberry`] with the body radius of `arm`: its largest actuator radius
+    /// plus [`ACTUATOR_RADIUS`] and [`CANE_RADIUS`] (capped at the field's bound, 1 m).
+    /// The other gains are dimensionless or tuned per step and carry over to arms of
+    /// similar size. `for_arm(&SoftArm::blackberry())` equals [`Gains::blackberry`].
+    pub fn for_arm(arm: &crate::SoftArm) -> Self {
+        let widest = arm.sections().iter().map(|s| s.radius).fold(0.0, f64::max);
+        Gains {
+            body_radius: (widest + ACTUATOR_RADIUS + CANE_RADIUS).min(1.0),
+            ..Gains::blackberry()
         }
     }
 
@@ -246,138 +378,26 @@ impl Gains {
         }
     }
 
-    /// Checks every field against a physically meaningful range (so that no step can
-    /// overflow into a non-finite command).
+    /// Checks every float field against its range in [`Gains::FLOAT_FIELDS`] (physically
+    /// meaningful ranges, so that no step can overflow into a non-finite command).
     ///
     /// # Errors
-    /// [`Error::Parameter`] naming the first invalid field: an α not in (0, 2]; a task
-    /// weight (γ₄, γ₆) not in [0, 10]; a joint-limit weight (γ₂, γ₃, γ₅) not in [−1, 0] m²;
-    /// a position switch distance not in [0, 10] m or the orientation one not in [0, π];
-    /// damping or threshold not in [0, 1]; `limit_margin` not in [1e-6, 0.45]; `max_step`
-    /// not in (0, 1] m or infinite; `lag_periods` not in [0, 10 000]; `repulsion_gain` not in
-    /// [0, 1e-3]; `influence_distance` or `body_radius` not in [0, 1] m.
+    /// [`Error::Parameter`] naming the first field (in declaration order) outside its
+    /// range: an α not in (0, 2]; a task weight (γ₄, γ₆) not in [0, 10]; a joint-limit
+    /// weight (γ₂, γ₃, γ₅) not in [−1, 0] m²; a position switch distance not in [0, 10] m or
+    /// the orientation one not in [0, π]; damping or threshold not in [0, 1];
+    /// `limit_margin` not in [1e-6, 0.45]; `max_step` not in (0, 1] m or infinite;
+    /// `lag_periods` not in [0, 10 000]; `repulsion_gain` not in [0, 1e-3];
+    /// `influence_distance` or `body_radius` not in [0, 1] m.
     pub fn validate(&self) -> Result<()> {
-        let pi = std::f64::consts::PI;
-        let ranges: [(&str, f64, f64, f64, &str); 20] = [
-            (
-                "conventional_alpha",
-                self.conventional_alpha,
-                0.0,
-                2.0,
-                "(0, 2]",
-            ),
-            ("position_alpha", self.position_alpha, 0.0, 2.0, "(0, 2]"),
-            (
-                "orientation_alpha",
-                self.orientation_alpha,
-                0.0,
-                2.0,
-                "(0, 2]",
-            ),
-            ("hybrid_alpha", self.hybrid_alpha, 0.0, 2.0, "(0, 2]"),
-            (
-                "hybrid_position",
-                self.hybrid_position,
-                0.0,
-                10.0,
-                "[0, 10]",
-            ),
-            (
-                "hybrid_orientation",
-                self.hybrid_orientation,
-                0.0,
-                10.0,
-                "[0, 10]",
-            ),
-            (
-                "position_gamma",
-                self.position_gamma,
-                -1.0,
-                0.0,
-                "[-1, 0] m² (a negative weight descends H)",
-            ),
-            (
-                "orientation_gamma",
-                self.orientation_gamma,
-                -1.0,
-                0.0,
-                "[-1, 0] m² (a negative weight descends H)",
-            ),
-            (
-                "hybrid_gamma",
-                self.hybrid_gamma,
-                -1.0,
-                0.0,
-                "[-1, 0] m² (a negative weight descends H)",
-            ),
-            (
-                "position_switch",
-                self.position_switch,
-                0.0,
-                10.0,
-                "[0, 10] m",
-            ),
-            ("hybrid_switch", self.hybrid_switch, 0.0, 10.0, "[0, 10] m"),
-            (
-                "orientation_switch",
-                self.orientation_switch,
-                0.0,
-                pi,
-                "[0, π] rad",
-            ),
-            ("damping", self.damping, 0.0, 1.0, "[0, 1]"),
-            (
-                "singular_threshold",
-                self.singular_threshold,
-                0.0,
-                1.0,
-                "[0, 1]",
-            ),
-            // Below ~1e-6 of the range, ∇H at the band's edge (∝ 1/margin²) is no longer a
-            // meaningful number; 0 would make it infinite.
-            (
-                "limit_margin",
-                self.limit_margin,
-                1e-6,
-                0.45,
-                "[1e-6, 0.45]",
-            ),
-            (
-                "lag_periods",
-                self.lag_periods,
-                0.0,
-                1e4,
-                "[0, 10000] control periods",
-            ),
-            ("max_step", self.max_step, 0.0, 1.0, "(0, 1] m or inf"),
-            (
-                "repulsion_gain",
-                self.repulsion_gain,
-                0.0,
-                1e-3,
-                "[0, 1e-3] m⁴",
-            ),
-            (
-                "influence_distance",
-                self.influence_distance,
-                0.0,
-                1.0,
-                "[0, 1] m",
-            ),
-            ("body_radius", self.body_radius, 0.0, 1.0, "[0, 1] m"),
-        ];
-        for (name, v, lo, hi, text) in ranges {
-            // α and max_step exclude their lower bound; max_step also accepts +inf (no cap).
-            let open_low = name.ends_with("_alpha") || name == "max_step";
-            let ok = if name == "max_step" && v == f64::INFINITY {
-                true
-            } else if open_low {
-                v > lo && v <= hi
-            } else {
-                v >= lo && v <= hi
-            };
-            if !ok {
-                return Err(Error::parameter(name, v, format!("must lie in {text}")));
+        for f in Self::FLOAT_FIELDS {
+            let v = (f.get)(self);
+            if !f.accepts(v) {
+                return Err(Error::parameter(
+                    f.name,
+                    v,
+                    format!("must lie in {}", f.range),
+                ));
             }
         }
         Ok(())
@@ -414,6 +434,25 @@ mod tests {
         assert_eq!(s.weight(-1.0, 0.0, 0.0), 0.0);
         let (a, b) = (s.weight(-1.0, 0.03, 0.03), s.weight(-1.0, 0.03, 0.030_001));
         assert!((a - b).abs() < 1e-4);
+    }
+
+    #[test]
+    fn for_arm_takes_the_body_radius_from_the_widest_section() {
+        let arm = crate::SoftArm::blackberry();
+        assert_eq!(Gains::for_arm(&arm), Gains::blackberry());
+        let mut sections = arm.sections().to_vec();
+        sections[1].radius = 0.05;
+        let wide = crate::SoftArm::new(sections).unwrap();
+        let g = Gains::for_arm(&wide);
+        assert!((g.body_radius - 0.063).abs() < 1e-15, "{}", g.body_radius);
+        assert!(g.validate().is_ok());
+        assert_eq!(
+            Gains {
+                body_radius: 0.041,
+                ..g
+            },
+            Gains::blackberry()
+        );
     }
 
     #[test]

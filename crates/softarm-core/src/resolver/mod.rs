@@ -31,8 +31,10 @@ pub mod joint_limits;
 pub mod lag;
 pub mod orientation;
 pub mod pinv;
+mod saturation;
 mod solve;
 mod step;
+mod tasks;
 
 pub use gains::{lag_alpha, Gains, Schedule};
 pub use lag::LagModel;

@@ -1,0 +1,152 @@
+//! Saturation in the null space (Flacco et al. 2012), simplified, and the step-length
+//! caps: the rounds of one resolver step.
+
+use super::step::{subtract_masked, TaskErrors, Workspace};
+use super::{Mode, Resolver};
+use crate::kinematics::Kinematics;
+use crate::math::Vec3;
+
+/// The factor that shortens `v` to Euclidean length `max` when it is longer (else 1).
+#[inline]
+fn cap_scale(v: &[f64], max: f64) -> f64 {
+    let len = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if len > max {
+        max / len
+    } else {
+        1.0
+    }
+}
+
+/// Clamps saturation round `round` (of `rounds`): a fixed coordinate keeps its fixed
+/// increment; a free one whose command `q + Δq` leaves `[lower, upper]` is fixed at the
+/// limit for the next round (none after the last). The first round records the unclamped
+/// command. Returns (whether a command left the limits, whether a coordinate was newly
+/// fixed).
+fn fix_saturated(
+    ws: &mut Workspace,
+    q: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    round: usize,
+    rounds: usize,
+) -> (bool, bool) {
+    let mut saturated = false;
+    let mut newly_fixed = false;
+    for k in 0..q.len() {
+        if !ws.free[k] {
+            ws.dq[k] = ws.fixed[k];
+            continue;
+        }
+        let raw = q[k] + ws.dq[k];
+        if round == 0 {
+            ws.unclamped[k] = raw;
+        }
+        let c = raw.clamp(lower[k], upper[k]);
+        if c != raw {
+            saturated = true;
+            if round + 1 < rounds {
+                ws.free[k] = false;
+                ws.fixed[k] = c - q[k];
+                newly_fixed = true;
+            }
+        }
+    }
+    (saturated, newly_fixed)
+}
+
+impl<K: Kinematics> Resolver<K> {
+    /// Saturation in the null space (Flacco et al. 2012), simplified: a coordinate whose
+    /// command would leave the limits is fixed at the limit, its column removed from every
+    /// task, what it still delivers subtracted from the task errors, and the step
+    /// recomputed with the other coordinates (at most n + 1 rounds). The conventional
+    /// controller is only clamped (it is unconstrained by definition): one round. Leaves
+    /// the increment in `ws.dq`; returns whether any command left the limits.
+    pub(super) fn saturation_rounds(
+        &self,
+        ws: &mut Workspace,
+        q: &[f64],
+        errors: &TaskErrors,
+        pose_target: bool,
+        alpha: f64,
+    ) -> bool {
+        let n = q.len();
+        ws.free.iter_mut().for_each(|f| *f = true);
+        ws.fixed.iter_mut().for_each(|v| *v = 0.0);
+        let conventional = self.mode == Mode::Conventional;
+        let rounds = if conventional { 1 } else { n + 1 };
+        let mut saturated = false;
+        for round in 0..rounds {
+            let (e_p, e_w) = self.round_errors(ws, errors, round, alpha);
+            self.load_task_columns(ws);
+            ws.dq.iter_mut().for_each(|v| *v = 0.0);
+            ws.null.iter_mut().for_each(|v| *v = 0.0);
+            ws.avoid.iter_mut().for_each(|v| *v = 0.0);
+            match self.mode {
+                Mode::Position => self.position_task(ws, q, &e_p, errors.p_norm, alpha),
+                Mode::Orientation => self.orientation_task(ws, q, &e_w, errors.w_norm, alpha),
+                Mode::Hybrid => self.hybrid_task(ws, q, &e_p, &e_w, errors.p_norm, alpha),
+                Mode::Conventional => self.conventional_task(ws, &e_p, &e_w, pose_target, alpha),
+            }
+            self.cap_and_combine(ws);
+            let (lower, upper) = (self.arm.lower(), self.arm.upper());
+            let (clamped, newly_fixed) = fix_saturated(ws, q, lower, upper, round, rounds);
+            saturated |= clamped;
+            if round == 0 && conventional {
+                ws.unclamped
+                    .iter_mut()
+                    .zip(q)
+                    .zip(&ws.dq)
+                    .for_each(|((u, x), d)| *u = x + d);
+            }
+            if !newly_fixed {
+                break;
+            }
+        }
+        saturated
+    }
+
+    /// The task errors of saturation round `round`: after the first, less what the fixed
+    /// coordinates still deliver (per unit α).
+    fn round_errors(
+        &self,
+        ws: &Workspace,
+        errors: &TaskErrors,
+        round: usize,
+        alpha: f64,
+    ) -> (Vec3, Vec3) {
+        let (mut e_p, mut e_w) = (errors.p, errors.w);
+        if round > 0 {
+            let (jp, jw) = self.fixed_motion(ws);
+            e_p -= jp / alpha;
+            subtract_masked(&mut e_w, &(jw / alpha), self.gains.axis_mask);
+        }
+        (e_p, e_w)
+    }
+
+    /// Step-length caps: the task part at `max_step`, each null-space part (joint limits,
+    /// obstacles) at half of it, so that ∇H, large next to a limit, can never starve the
+    /// tasks nor the repulsion. Leaves the sum of the three capped parts in `ws.dq`.
+    fn cap_and_combine(&self, ws: &mut Workspace) {
+        let max = self.gains.max_step;
+        let s_task = cap_scale(&ws.dq, max);
+        let s_null = cap_scale(&ws.null, 0.5 * max);
+        let s_avoid = cap_scale(&ws.avoid, 0.5 * max);
+        for ((d, v), a) in ws.dq.iter_mut().zip(&ws.null).zip(&ws.avoid) {
+            *d = s_task * *d + s_null * v + s_avoid * a;
+        }
+    }
+
+    /// Position and angular motion (base frame) of the fixed coordinates' increments.
+    fn fixed_motion(&self, ws: &Workspace) -> (Vec3, Vec3) {
+        let mut v = Vec3::zeros();
+        let mut w = Vec3::zeros();
+        for (k, (&d, &free)) in ws.fixed.iter().zip(&ws.free).enumerate() {
+            if !free {
+                let c = ws.jac.column(k);
+                v += Vec3::new(c[0], c[1], c[2]) * d;
+                w += Vec3::new(c[3], c[4], c[5]) * d;
+            }
+        }
+        (v, w)
+    }
+}
