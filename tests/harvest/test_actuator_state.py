@@ -105,3 +105,27 @@ def test_lead_gain_is_half_the_overshoot_free_bound_capped(tau: float, expected:
     assert lead_gain(tau, 0.05) == pytest.approx(expected, rel=1e-3)
     with pytest.raises(ParameterError):
         lead_gain(-1.0, 0.05)
+
+
+def test_lead_is_scaled_as_one_vector_inside_the_range_and_rate() -> None:
+    tau, k = 1.0, 1.5
+    # A 100 ms period: 100 psi a period at 1000 psi/s, so the range binds first.
+    act, clock = _actuator(rate=1000.0, lag=(tau, 0.1), lead=k)
+    act.send(np.zeros(3))
+    clock.t = 0.1
+    q = np.array([0.03, 0.01, 0.0])  # 63 / 21 / 0 psi: the full boost would ask 157 psi
+    act.send(q)
+    wanted = q / METRES_PER_PSI
+    boost = act.bank.last_sent - wanted
+    full = k * wanted  # the lag model still at 0
+    assert np.max(act.bank.last_sent) == pytest.approx(70.0)  # scaled to the range...
+    np.testing.assert_allclose(boost / np.linalg.norm(boost), full / np.linalg.norm(full))
+    np.testing.assert_allclose(act.sent, q, atol=1e-15)  # ...in the same direction
+    # At 50 ms, 50 psi a period: the safety layer's rate bounds the boost alike.
+    act2, clock2 = _actuator(rate=1000.0, lag=(tau, 0.05), lead=k)
+    act2.send(np.zeros(3))
+    clock2.t = 0.05
+    act2.send(np.array([0.02, 0.005, 0.0]))  # 42 / 10.5 psi, boosts 63 / 15.75
+    sent = act2.bank.last_sent
+    assert sent[0] == pytest.approx(50.0)
+    assert (sent[1] - 10.5) / (sent[0] - 42.0) == pytest.approx(10.5 / 42.0)

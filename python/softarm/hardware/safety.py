@@ -161,6 +161,11 @@ class SafePressureBank:
         return self._p_max
 
     @property
+    def max_rate(self) -> float:
+        """The rate limit (psi/s) every command is held to."""
+        return self._rate
+
+    @property
     def stopped(self) -> bool:
         """Whether the emergency stop is latched."""
         return self._latched

@@ -119,7 +119,9 @@ class SafeActuator:
         wanted = self.pressure_map.to_psi(q)
         boost = np.zeros_like(wanted)
         if self._lead > 0 and self._stages:
-            boost = self._lead * (wanted - self.pressure_map.to_psi(self._stages[0].q))
+            boost = self._boost(
+                wanted, self._lead * (wanted - self.pressure_map.to_psi(self._stages[0].q))
+            )
         self.bank.set_pressures(np.clip(wanted + boost, 0.0, self.bank.max_pressure))
         drive = self.bank.last_sent
         self._drive = self.pressure_map.to_elongation(drive)
@@ -133,6 +135,20 @@ class SafeActuator:
         )
         self._sent = self.pressure_map.to_elongation(target)
         return self.sent
+
+    def _boost(self, wanted: FloatArray, boost: FloatArray) -> FloatArray:
+        """``boost`` scaled as one vector, never clipped channel by channel, so that the
+        command stays in ``[0, p_max]`` and within one period of the safety layer's rate
+        limit: the regulators then head along the same direction in q as without it, and
+        the arm stays on the straight line between plan waypoints (docs/control.md §6)."""
+        last = self.bank.last_sent
+        step = self.bank.max_rate * (self._lag[1] if self._lag is not None else 0.0)
+        lo = np.maximum(0.0, last - step) - wanted  # s * boost must stay in [lo, hi]
+        hi = np.minimum(self.bank.max_pressure, last + step) - wanted
+        with np.errstate(divide="ignore", invalid="ignore"):
+            limit = np.where(boost > 0, hi / boost, np.where(boost < 0, lo / boost, np.inf))
+        scale = float(np.clip(np.min(limit, initial=1.0), 0.0, 1.0))
+        return scale * boost
 
     def vent(self, reason: str) -> None:
         """Vent every channel; the safety layer logs ``reason``."""
