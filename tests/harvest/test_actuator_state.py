@@ -98,7 +98,9 @@ def test_lead_speeds_a_first_order_regulator_up_by_one_plus_k() -> None:
         np.testing.assert_allclose(act.predicted, y, rtol=1e-9, atol=1e-15)
 
 
-@pytest.mark.parametrize(("tau", "expected"), [(0.0, 0.0), (0.08, 0.5 * 0.5353 / 0.4647), (1.0, 1.5)])
+@pytest.mark.parametrize(
+    ("tau", "expected"), [(0.0, 0.0), (0.08, 0.5 * 0.5353 / 0.4647), (1.0, 1.5)]
+)
 def test_lead_gain_is_half_the_overshoot_free_bound_capped(tau: float, expected: float) -> None:
     from softarm.harvest.actuator import lead_gain
 
