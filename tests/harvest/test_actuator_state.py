@@ -64,18 +64,18 @@ def test_prediction_is_two_first_order_lags_in_series() -> None:
         y1 = q + (y1 - q) * math.exp(-period / tau)
         y2 = y1 + (y2 - y1) * math.exp(-period / filt)
     clock.t = 80 * period
-    np.testing.assert_allclose(act.predicted, y2, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(act.plant_q, y2, rtol=1e-12, atol=1e-15)
     # Nothing sent for 2 s (a grasp): the model goes on with the command held.
     clock.t += 2.0
     for _ in range(40):
         y1 = q + (y1 - q) * math.exp(-period / tau)
         y2 = y1 + (y2 - y1) * math.exp(-period / filt)
-    np.testing.assert_allclose(act.predicted, y2, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(act.plant_q, y2, rtol=1e-9, atol=1e-12)
 
 
 def test_no_lag_no_prediction_and_a_lag_needs_a_clock() -> None:
     act, _ = _actuator()
-    assert act.predicted is None
+    assert act.plant_q is None
     bank = act.bank
     with pytest.raises(ParameterError, match="lag"):
         SafeActuator(bank, lag=(0.5, 0.05))
@@ -95,7 +95,7 @@ def test_lead_speeds_a_first_order_regulator_up_by_one_plus_k() -> None:
         clock.t = (n + 1) * period
         # ZOH of u = q + k (q - y) through the lag: y - q shrinks by a - (1 - a) k.
         y = q + (a - (1 - a) * k) * (y - q)
-        np.testing.assert_allclose(act.predicted, y, rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(act.plant_q, y, rtol=1e-9, atol=1e-15)
 
 
 @pytest.mark.parametrize(

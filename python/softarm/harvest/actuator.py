@@ -3,9 +3,10 @@
 It owns what the arm was actually sent: the safety layer clamps and rate-limits every
 command, so the q a controller asked for is not always the q the regulators got.
 :attr:`SafeActuator.sent` is the latter (the state the resolver linearises at), and with
-a known lag :attr:`SafeActuator.predicted` is where the actuators are now, a
-:class:`softarm.LagModel` fed with every command sent (ramps and holds included), for
-the lag-aware closed loop (docs/control.md, section 2).
+a known lag :attr:`SafeActuator.plant_q` is the resolver's ``plant_q``: the q sent less
+the motion still in flight by a :class:`~softarm.harvest.plant_model.MeasurementModel`
+fed with every command sent (ramps and holds included), for the lag-aware closed loop
+(docs/control.md, section 6).
 """
 
 from __future__ import annotations
@@ -15,10 +16,10 @@ from collections.abc import Callable
 import numpy as np
 import numpy.typing as npt
 
-from softarm._core import LagModel
 from softarm.errors import NonFiniteError, ParameterError
 from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.safety import SafePressureBank
+from softarm.harvest.plant_model import MeasurementModel
 
 __all__ = ["SafeActuator", "lead_gain"]
 
@@ -48,11 +49,10 @@ class SafeActuator:
     Args:
         bank: the safety layer.
         pressure_map: elongation ↔ psi (``to_psi``/``to_elongation``).
-        lag: ``(tau_s, period_s)`` of the actuators: :attr:`predicted` follows the sent
+        lag: ``(tau_s, period_s)`` of the regulators: :attr:`plant_q` follows the sent
             commands through that lag. None: no prediction.
         sensor_lag_s: the time constant (s) of the pose measurement's own first-order
-            filter, in series after the actuators' lag: :attr:`predicted` is then the
-            elongations the *measured* pose reflects (0: no filter).
+            filter, after the actuators (0: no filter).
         lead: pre-compensation of the regulators' lag, ``k``: they are told
             ``q + k (q − ŷ)`` with ``ŷ`` the lag model's pressure, so that a first-order
             regulator approaches ``q`` ``1 + k`` times faster (``k ≤ a/(1 − a)``,
@@ -79,12 +79,7 @@ class SafeActuator:
         self._now = now
         self._lag = lag
         self._sent = np.zeros(n)
-        # The regulators' lag, then the pose filter's: one first-order model each.
-        self._stages = (
-            []
-            if lag is None
-            else [LagModel(tau, lag[1], self._sent) for tau in (lag[0], sensor_lag_s) if tau > 0]
-        )
+        self._model = None if lag is None else MeasurementModel(n, lag[0], lag[1], sensor_lag_s)
         self._stamp = None if now is None else now()
         # What the regulators were told, boost included (the lag model's input).
         self._drive = np.zeros(n)
@@ -101,13 +96,14 @@ class SafeActuator:
         return self._sent.copy()
 
     @property
-    def predicted(self) -> FloatArray | None:
-        """The elongations (m) the measured pose reflects now by the lag model (the
-        actuators' lag, then the pose filter's), or None without a lag."""
-        if self._lag is None:
+    def plant_q(self) -> FloatArray | None:
+        """The resolver's ``plant_q`` (m): :attr:`sent` less the motion the measured pose
+        will still make towards it, i.e. ŷ (docs/control.md §6); None
+        without a lag model."""
+        if self._model is None:
             return None
         self._catch_up()
-        return np.asarray(self._stages[-1].q) if self._stages else self._sent.copy()
+        return self._sent - self._model.in_flight()
 
     def send(self, q: FloatArray) -> FloatArray:
         """Command elongations ``q`` (m); returns :attr:`sent`. A NaN raises before
@@ -118,9 +114,9 @@ class SafeActuator:
         self._catch_up()
         wanted = self.pressure_map.to_psi(q)
         boost = np.zeros_like(wanted)
-        if self._lead > 0 and self._stages:
+        if self._lead > 0 and self._model is not None:
             boost = self._boost(
-                wanted, self._lead * (wanted - self.pressure_map.to_psi(self._stages[0].q))
+                wanted, self._lead * (wanted - self.pressure_map.to_psi(self._model.regulators))
             )
         self.bank.set_pressures(np.clip(wanted + boost, 0.0, self.bank.max_pressure))
         drive = self.bank.last_sent
@@ -134,6 +130,8 @@ class SafeActuator:
             np.where(boost < 0, np.maximum(wanted, drive), drive),
         )
         self._sent = self.pressure_map.to_elongation(target)
+        if self._model is not None:
+            self._model.command(self._sent)
         return self.sent
 
     def _boost(self, wanted: FloatArray, boost: FloatArray) -> FloatArray:
@@ -156,16 +154,15 @@ class SafeActuator:
         self.bank.vent(reason)
         self._sent = np.zeros_like(self._sent)
         self._drive = np.zeros_like(self._drive)
+        if self._model is not None:
+            self._model.command(self._sent)
 
     def _catch_up(self) -> None:
         """Advance the lag model over the whole periods since the last command, with the
         command held (the regulators held it)."""
-        if not self._stages or self._now is None or self._lag is None:
+        if self._model is None or self._now is None or self._stamp is None:
             return
-        now = self._now()
-        periods = int(np.floor((now - self._stamp) / self._lag[1] + 1e-9))
+        periods = int(np.floor((self._now() - self._stamp) / self._model.period + 1e-9))
         for _ in range(min(periods, 10_000)):
-            u = self._drive
-            for stage in self._stages:
-                u = stage.advance(u)
-        self._stamp += periods * self._lag[1]
+            self._model.advance(self._drive)
+        self._stamp += periods * self._model.period

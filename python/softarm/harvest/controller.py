@@ -27,10 +27,12 @@ class ResolverController:
         obstacles: the known obstacles (``softarm.closest`` forms, e.g. the canes as
             ``PolynomialCurve``) that repel the arm's body in every step.
         plant_q: where the actuators are now by a lag model, e.g.
-            :attr:`SafeActuator.predicted <softarm.harvest.actuator.SafeActuator.predicted>`
+            :attr:`SafeActuator.plant_q <softarm.harvest.actuator.SafeActuator.plant_q>`
             (the actuator sees every command sent, ramps and holds included); each
             closed-loop step then corrects the measured error by the motion still in
             flight (a Smith predictor). None: no prediction.
+        transport: a resolver for :meth:`follow_step` (following a placement plan), or
+            None to use ``resolver`` there too.
     """
 
     def __init__(
@@ -38,11 +40,25 @@ class ResolverController:
         resolver: object,
         obstacles: Sequence[object] = (),
         plant_q: Callable[[], FloatArray | None] | None = None,
+        transport: object | None = None,
     ) -> None:
         self.resolver = resolver
         self.obstacles = list(obstacles)
         self.arm = resolver.arm  # type: ignore[attr-defined]
         self.plant_q = plant_q
+        self.transport = transport
+
+    def follow_step(
+        self, q: FloatArray, target: FloatArray, current: FloatArray
+    ) -> tuple[FloatArray, bool]:
+        """The correction while following a plan: the ``transport`` resolver (its gain
+        bounded by the whole lag, no prediction) when given, else :meth:`step`."""
+        if self.transport is None:
+            return self.step(q, target, current)
+        info = self.transport.step(  # type: ignore[attr-defined]
+            np.asarray(q, dtype=np.float64), target, current, obstacles=self.obstacles or None
+        )
+        return np.asarray(info.q, dtype=np.float64), bool(info.saturated)
 
     def step(
         self, q: FloatArray, target: FloatArray, current: FloatArray | None

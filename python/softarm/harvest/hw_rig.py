@@ -96,11 +96,23 @@ def build_hardware_rig(
         clock = MonotonicClock()
         lag = None if identified is None else (identified.lag_s, cfg.period)
         actuator = SafeActuator(
-            bank, ElongationMap(ch.p_max, ch.metres_per_psi), lag=lag, now=clock.now
+            bank,
+            ElongationMap(ch.p_max, ch.metres_per_psi),
+            lag=lag,
+            now=clock.now,
         )
-        predicted = None if lag is None else (lambda: actuator.predicted)
+        predicted = None if lag is None else (lambda: actuator.plant_q)
+        # Following a placement plan: the gain bounded by the whole lag, no prediction
+        # (docs/control.md, section 6).
+        transport = None
+        if identified is not None:
+            base = gains if gains is not None else Gains()
+            transport = Resolver(
+                arm, mode="hybrid", gains=base.replace(lag_periods=identified.lag_s / cfg.period)
+            )
+        controller = ResolverController(resolver, (), predicted, transport)
         machine = HarvestMachine(
-            clock, vision, ResolverController(resolver, (), predicted), actuator, gripper,
+            clock, vision, controller, actuator, gripper,
             ArduinoRipenessSensor(link), arm.n_actuators, cfg, log,
             planner=ModelIK(planning_resolver(arm), cfg),
         )  # fmt: skip

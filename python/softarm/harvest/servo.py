@@ -200,7 +200,8 @@ class Servo:
                     f"{stage.value}: waypoint not reached, error {err:.4f} m",
                 )
             goal = model_pose(nominal)
-            q_fb, saturated = self.controller.step(q, goal, seen.pose)
+            step_fn = getattr(self.controller, "follow_step", self.controller.step)
+            q_fb, saturated = step_fn(q, goal, seen.pose)
             advance = np.clip(q_way - nominal, -step, step)
             nominal = nominal + advance
             # Feedforward of the plan's motion on top of the closed-loop correction, kept

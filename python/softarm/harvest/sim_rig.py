@@ -215,8 +215,19 @@ def build_sim_rig(
         if o.joint_limit_gain is not None:
             gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
         resolver = Resolver(model, mode="hybrid", gains=gains)
-        predicted = (lambda: actuator.predicted) if predict else None
-        controller = ResolverController(resolver, canes if o.avoid_canes else (), predicted)
+        predicted = (lambda: actuator.plant_q) if predict else None
+        # Following a placement plan, the correction's gain stays bounded by the whole
+        # lag, without the prediction: on a slow plant with play the predictor's gain
+        # swung the arm into a cane early in the move (docs/control.md, section 6).
+        transport = None
+        if predict:
+            bound = Gains.for_lag(lag, cfg.period)
+            if o.joint_limit_gain is not None:
+                bound = bound.replace(hybrid_gamma=o.joint_limit_gain)
+            transport = Resolver(model, mode="hybrid", gains=bound)
+        controller = ResolverController(
+            resolver, canes if o.avoid_canes else (), predicted, transport
+        )
     machine = HarvestMachine(
         clock,
         vision,

@@ -1,0 +1,75 @@
+"""The controller's model of the measurement chain behind the actuator: what the measured
+pose will still do after the commands already sent (docs/control.md, section 6).
+
+    command ──regulators (first-order lag τ)──► elongation ──pose filter (lag τ_f)──►
+    what the camera pipeline reports
+
+Both lags are :class:`softarm.LagModel` (Rust). The loop needs the motion still *in
+flight*, ``q − ŷ``: where the last target puts the arm once everything sent has arrived,
+less what the measured pose reflects now. At rest ``ŷ = q``: nothing is in flight and
+the loop closes on the measured error alone, whatever the model's errors (a Smith
+predictor). The play hysteresis is not modelled: a model with it was tried and was worse
+(docs/control.md, section 6).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import LagModel
+from softarm.errors import ParameterError
+
+__all__ = ["MeasurementModel"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+class MeasurementModel:
+    """Regulators' lag then the pose filter's, per channel, in elongations (m).
+
+    Args:
+        n: channels.
+        tau_s: the regulators' time constant (s, >= 0).
+        period_s: the control period (s) each :meth:`advance` lasts.
+        filter_s: the pose filter's time constant (s, >= 0).
+    """
+
+    def __init__(self, n: int, tau_s: float, period_s: float, filter_s: float = 0.0) -> None:
+        for name, value in (("tau_s", tau_s), ("filter_s", filter_s)):
+            if not (np.isfinite(value) and value >= 0):
+                raise ParameterError(f"{name} = {value!r}: must be finite and >= 0")
+        self.period = float(period_s)
+        zeros = np.zeros(n)
+        self._regulators = LagModel(tau_s, period_s, zeros) if tau_s > 0 else None
+        self._filter = LagModel(filter_s, period_s, zeros) if filter_s > 0 else None
+        self._pressure = zeros.copy()  # the regulators' output, as an elongation
+        self._target = zeros.copy()
+
+    @property
+    def regulators(self) -> FloatArray:
+        """The regulators' output now (m): what a lead on them acts against."""
+        return self._pressure.copy()
+
+    @property
+    def measured(self) -> FloatArray:
+        """What the measured pose reflects now (m): ŷ."""
+        return np.asarray(self._filter.q) if self._filter is not None else self._pressure.copy()
+
+    def advance(self, drive: FloatArray) -> None:
+        """One period with ``drive`` (m, the regulators' command, boost included) held."""
+        if self._regulators is not None:
+            self._pressure = np.asarray(self._regulators.advance(drive))
+        else:
+            self._pressure = np.asarray(drive, dtype=np.float64).copy()
+        if self._filter is not None:
+            self._filter.advance(self._pressure)
+
+    def command(self, target: FloatArray) -> None:
+        """The q sent (m, without the boost): where the regulators are headed."""
+        self._target = np.asarray(target, dtype=np.float64).copy()
+
+    def in_flight(self) -> FloatArray:
+        """``q − ŷ`` (m): the motion the measured pose will still make once the
+        regulators reach the last target."""
+        return self._target - self.measured
