@@ -49,6 +49,8 @@ class HarvestConfig:
             moves to the ready pose: 0.045 m/s is 94.5 psi/s, inside the safety layer's
             default 100 psi/s rate limit.
         home_elongation: every actuator's elongation (m) at the ready pose (straight arm).
+        arrival_tolerance: an open-loop ramp ends once the lag model has every actuator
+            within this (m) of the ramp's end (with a known lag; see docs/control.md §6).
     """
 
     period: float = 0.05
@@ -71,11 +73,12 @@ class HarvestConfig:
     ripeness_threshold: float = 0.5
     home_speed: float = 0.045
     home_elongation: float = 0.0167
+    arrival_tolerance: float = 0.001
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
                      "grasp_workspace", "marker_timeout", "placement_timeout", "fine_timeout",
-                     "fine_budget", "home_timeout", "stall_time", "home_speed",
+                     "fine_budget", "home_timeout", "stall_time", "home_speed", "arrival_tolerance",
                      "angle_tolerance_deg"):  # fmt: skip
             value = _real(self, name)
             if not value > 0:

@@ -131,3 +131,16 @@ def test_lead_is_scaled_as_one_vector_inside_the_range_and_rate() -> None:
     sent = act2.bank.last_sent
     assert sent[0] == pytest.approx(50.0)
     assert (sent[1] - 10.5) / (sent[0] - 42.0) == pytest.approx(10.5 / 42.0)
+
+
+def test_in_flight_is_what_the_lag_model_still_expects() -> None:
+    act, clock = _actuator(rate=1000.0, lag=(0.5, 0.05), sensor_lag_s=0.1)
+    assert _actuator()[0].in_flight() is None
+    act.send(np.zeros(3))
+    q = np.array([0.01, 0.0, 0.002])
+    clock.t = 0.05
+    act.send(q)
+    np.testing.assert_allclose(act.in_flight(), q, atol=1e-15)  # nothing arrived yet
+    clock.t = 0.05 + 5.0  # ten time constants later, nothing more sent
+    np.testing.assert_allclose(act.in_flight(), 0.0, atol=1e-6)
+    np.testing.assert_allclose(act.plant_q, q, atol=1e-6)

@@ -105,6 +105,14 @@ class SafeActuator:
         self._catch_up()
         return self._sent - self._model.in_flight()
 
+    def in_flight(self) -> FloatArray | None:
+        """The motion (m) the measured pose will still make towards :attr:`sent`, by the
+        lag model; None without one."""
+        if self._model is None:
+            return None
+        self._catch_up()
+        return self._model.in_flight()
+
     def send(self, q: FloatArray) -> FloatArray:
         """Command elongations ``q`` (m); returns :attr:`sent`. A NaN raises before
         anything is sent."""

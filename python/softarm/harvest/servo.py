@@ -236,6 +236,19 @@ class Servo:
             seen = watch.observe(need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
+        # An open-loop ramp ends where the arm is, not where it was told to be: on a
+        # lagging plant the arm trails the ramp, and the next move (the next waypoint,
+        # the next berry's placement) would cut the corner through the canes.
+        in_flight = getattr(self.actuator, "in_flight", lambda: None)
+        while (left := in_flight()) is not None and np.max(
+            np.abs(left)
+        ) > self.cfg.arrival_tolerance:
+            if self.clock.now() > deadline:
+                raise Fault(FaultReason.TIMEOUT, f"{stage.value}: arm not settled in time")
+            self.actuator.send(q)
+            seen = watch.observe(need_fix=False) if observe else watch.blind()
+            watch.log_step(stage, seen, q, None, None, False)
+            self.clock.sleep(self.cfg.period)
         return q
 
     # -- the loop -------------------------------------------------------------------
