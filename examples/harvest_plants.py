@@ -88,7 +88,12 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=list(range(500, 505)))
     ap.add_argument("--berries", type=int, default=8)
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--out", type=Path, default=Path("out/plants"))
+    ap.add_argument(
+        "--out",
+        type=Path,
+        default=Path("out/plants"),
+        help="where reports.json (per bush) and summary.json go",
+    )
     ap.add_argument(
         "--lag-control",
         choices=["predictor", "bound"],
