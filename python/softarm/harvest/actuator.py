@@ -77,7 +77,6 @@ class SafeActuator:
         if lag is not None and now is None:
             raise ParameterError("lag: needs the clock `now` to count periods")
         self._now = now
-        self._lag = lag
         self._sent = np.zeros(n)
         self._model = None if lag is None else MeasurementModel(n, lag[0], lag[1], sensor_lag_s)
         self._stamp = None if now is None else now()
@@ -148,7 +147,7 @@ class SafeActuator:
         limit: the regulators then head along the same direction in q as without it, and
         the arm stays on the straight line between plan waypoints (docs/control.md §6)."""
         last = self.bank.last_sent
-        step = self.bank.max_rate * (self._lag[1] if self._lag is not None else 0.0)
+        step = self.bank.max_rate * (self._model.period if self._model is not None else 0.0)
         lo = np.maximum(0.0, last - step) - wanted  # s * boost must stay in [lo, hi]
         hi = np.minimum(self.bank.max_pressure, last + step) - wanted
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -110,6 +110,11 @@ class PressureActuator(Protocol):
         """Exhaust every channel now (the safe state)."""
         ...
 
+    def in_flight(self) -> FloatArray | None:
+        """The motion (m) the arm will still make towards the last q sent, by a lag model
+        of the actuators; None when there is none (the arm is taken to be there)."""
+        ...
+
 
 #: Old names of the device protocols of :mod:`softarm.hardware.protocols`.
 GripperDevice = Gripper

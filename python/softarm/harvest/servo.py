@@ -239,10 +239,7 @@ class Servo:
         # An open-loop ramp ends where the arm is, not where it was told to be: on a
         # lagging plant the arm trails the ramp, and the next move (the next waypoint,
         # the next berry's placement) would cut the corner through the canes.
-        in_flight = getattr(self.actuator, "in_flight", lambda: None)
-        while (left := in_flight()) is not None and np.max(
-            np.abs(left)
-        ) > self.cfg.arrival_tolerance:
+        while not self._arrived():
             if self.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: arm not settled in time")
             self.actuator.send(q)
@@ -250,6 +247,12 @@ class Servo:
             watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
         return q
+
+    def _arrived(self) -> bool:
+        """Whether the lag model (if any) has every actuator within ``arrival_tolerance``
+        of the q last sent."""
+        left = self.actuator.in_flight()
+        return left is None or float(np.max(np.abs(left))) <= self.cfg.arrival_tolerance
 
     # -- the loop -------------------------------------------------------------------
 

@@ -209,22 +209,21 @@ def build_sim_rig(
         lead=lead_gain(lag, cfg.period) if predict else 0.0,
     )
     if controller is None:
-        # With the lag model the step is the lag-free iteration (a Smith predictor): the
-        # mode's own gain; without it the gain is bounded by the lag (docs/control.md).
-        gains = Gains() if predict else Gains.for_lag(lag, cfg.period)
-        if o.joint_limit_gain is not None:
-            gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
-        resolver = Resolver(model, mode="hybrid", gains=gains)
-        predicted = (lambda: actuator.plant_q) if predict else None
-        # Following a placement plan, the correction's gain stays bounded by the whole
-        # lag, without the prediction: on a slow plant with play the predictor's gain
-        # swung the arm into a cane early in the move (docs/control.md, section 6).
-        transport = None
-        if predict:
-            bound = Gains.for_lag(lag, cfg.period)
+
+        def hybrid(gains: Gains) -> Resolver:
             if o.joint_limit_gain is not None:
-                bound = bound.replace(hybrid_gamma=o.joint_limit_gain)
-            transport = Resolver(model, mode="hybrid", gains=bound)
+                gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
+            return Resolver(model, mode="hybrid", gains=gains)
+
+        bounded = hybrid(Gains.for_lag(lag, cfg.period))
+        predicted = (lambda: actuator.plant_q) if predict else None
+        # With the lag model the closed loop on the berry is the lag-free iteration (a
+        # Smith predictor) at the mode's own gain. Following a placement plan keeps the
+        # gain bounded by the whole lag, without the prediction: on a slow plant with
+        # play the predictor's gain swung the arm into a cane early in the move
+        # (docs/control.md, section 6). Without the model the bound is used throughout.
+        resolver = hybrid(Gains()) if predict else bounded
+        transport = bounded if predict else None
         controller = ResolverController(
             resolver, canes if o.avoid_canes else (), predicted, transport
         )
