@@ -29,6 +29,7 @@ from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
+from softarm.harvest.plant_model import predicted_loop_alpha
 from softarm.harvest.vision_loop import CameraVision
 from softarm.identified_plant import IdentifiedPlant
 from softarm.vision import MarkerCube
@@ -102,6 +103,13 @@ def build_hardware_rig(
             now=clock.now,
         )
         predicted = None if lag is None else (lambda: actuator.plant_q)
+        if identified is not None and "hybrid_alpha" not in config.gains.values:
+            # The loop on the berry goes through the lag model: its gain is cut as the
+            # identified lag grows (docs/control.md, section 6), unless [gains] sets it.
+            alpha = predicted_loop_alpha(identified.lag_s)
+            resolver = Resolver(
+                arm, mode="hybrid", gains=(gains or Gains()).replace(hybrid_alpha=alpha)
+            )
         # Following a placement plan: the gain bounded by the whole lag, no prediction
         # (docs/control.md, section 6).
         transport = None

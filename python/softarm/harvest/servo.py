@@ -187,6 +187,13 @@ class Servo:
             err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
             if on_plan_end and err <= c.placement_tolerance:
                 return q
+            if on_plan_end and self.actuator.in_flight() is not None and self._arrived():
+                # The plan is done and the arm has caught up with it (lag model): what is
+                # left is the model's error, which the lag-bounded correction here takes
+                # out at a few per cent a period on a slow plant. The loop on the berry
+                # that follows takes it out at the predictor's full gain.
+                self.log.event("waypoint_handover", t=seen.t, error=err)
+                return q
             if err < best - c.stall_progress:
                 best, best_t = err, seen.t
             elif on_plan_end and seen.t - best_t > c.stall_time:

@@ -26,6 +26,7 @@ from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
+from softarm.harvest.plant_model import predicted_loop_alpha
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import ArmPlant
@@ -199,13 +200,14 @@ def build_sim_rig(
     if o.lag_control not in ("predictor", "bound"):
         raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
     predict = o.lag_control == "predictor"
+    # The tracker's first-order pose filter (10 rad/s): part of what the loop sees.
+    sensor_lag = 0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff
     actuator = SafeActuator(
         bank,
         None if o.calibration is None else o.calibration.pressure_map(),
         lag=(lag, cfg.period) if predict else None,
         now=clock.now,
-        # The tracker's first-order pose filter (10 rad/s): part of what the loop sees.
-        sensor_lag_s=0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff,
+        sensor_lag_s=sensor_lag,
         lead=lead_gain(lag, cfg.period) if predict else 0.0,
     )
     if controller is None:
@@ -218,11 +220,13 @@ def build_sim_rig(
         bounded = hybrid(Gains.for_lag(lag, cfg.period))
         predicted = (lambda: actuator.plant_q) if predict else None
         # With the lag model the closed loop on the berry is the lag-free iteration (a
-        # Smith predictor) at the mode's own gain. Following a placement plan keeps the
-        # gain bounded by the whole lag, without the prediction: on a slow plant with
-        # play the predictor's gain swung the arm into a cane early in the move
-        # (docs/control.md, section 6). Without the model the bound is used throughout.
-        resolver = hybrid(Gains()) if predict else bounded
+        # Smith predictor) at a gain cut as the lag grows (predicted_loop_alpha).
+        # Following a placement plan keeps the gain bounded by the whole lag, without
+        # the prediction: on a slow plant with play the predictor's gain swung the arm
+        # into a cane early in the move (docs/control.md, section 6). Without the model
+        # the bound is used throughout.
+        loop_alpha = predicted_loop_alpha(lag + sensor_lag)
+        resolver = hybrid(Gains().replace(hybrid_alpha=loop_alpha)) if predict else bounded
         transport = bounded if predict else None
         controller = ResolverController(
             resolver, canes if o.avoid_canes else (), predicted, transport
