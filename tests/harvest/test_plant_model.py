@@ -4,7 +4,13 @@ import numpy as np
 import pytest
 
 from softarm.errors import ParameterError
-from softarm.harvest.plant_model import MeasurementModel
+from softarm.harvest.plant_model import (
+    PREDICTED_ALPHA_LAG_S,
+    PREDICTED_ALPHA_MAX,
+    PREDICTED_ALPHA_MIN,
+    MeasurementModel,
+    predicted_loop_alpha,
+)
 from softarm.sim.pressure import PressureDynamics
 
 
@@ -37,3 +43,33 @@ def test_bad_arguments_name_themselves(kwargs: dict, arg: str) -> None:
     args = {"n": 2, "tau_s": 0.5, "period_s": 0.05, **kwargs}
     with pytest.raises(ParameterError, match=arg):
         MeasurementModel(**args)
+
+
+def test_predicted_loop_gain_is_cut_as_the_lag_grows() -> None:
+    lags = np.linspace(0.0, 3.0, 61)
+    alphas = [predicted_loop_alpha(float(s)) for s in lags]
+    assert np.all(np.diff(alphas) <= 0)  # never larger on a slower chain
+    assert alphas[0] == PREDICTED_ALPHA_MAX
+    assert alphas[-1] == PREDICTED_ALPHA_MIN
+    # Between the bounds the lag-gain product is the constant.
+    assert predicted_loop_alpha(0.6) * 0.6 == pytest.approx(PREDICTED_ALPHA_LAG_S)
+    # The simulated rig's quick plant (80 ms + the 0.1 s pose filter) and its slowest.
+    assert predicted_loop_alpha(0.18) == PREDICTED_ALPHA_MAX
+    assert predicted_loop_alpha(1.1) == PREDICTED_ALPHA_MIN
+
+
+@pytest.mark.parametrize("lag", [-0.1, np.nan, np.inf])
+def test_predicted_loop_gain_rejects_a_bad_lag(lag: float) -> None:
+    with pytest.raises(ParameterError, match="lag_s"):
+        predicted_loop_alpha(lag)
+
+
+def test_the_arm_arrives_before_the_measurement_shows_it() -> None:
+    # Arrival reads the regulators alone; the predictor reads them and the pose filter.
+    model = MeasurementModel(1, 0.3, 0.05, filter_s=0.1)
+    model.command(np.array([0.01]))
+    for _ in range(10):
+        model.advance(np.array([0.01]))
+    arm, measured = model.arm_in_flight()[0], model.in_flight()[0]
+    assert arm == pytest.approx(0.01 * np.exp(-0.5 / 0.3), rel=1e-12)  # 0.5 s at tau 0.3 s
+    assert 0.0 < arm < measured < 0.01

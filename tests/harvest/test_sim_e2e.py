@@ -11,6 +11,7 @@ import pytest
 from softarm.cli import main
 from softarm.harvest import FaultReason, HarvestState, read_log
 from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+from softarm.sim.arm import PlantConfig
 
 pytestmark = pytest.mark.slow
 
@@ -49,3 +50,21 @@ def test_cli_sim_writes_the_report(tmp_path, capsys) -> None:
     data = json.loads(out.read_text())
     assert data["success_rate"] == 1.0 and len(data["berries"]) == 1
     assert "berry 1/1" in capsys.readouterr().out
+
+
+def test_slow_plant_hands_the_plan_over_to_the_loop_on_the_berry(tmp_path) -> None:
+    # 1 s regulators and 5 psi of play: the plan's lag-bounded correction would take
+    # seconds to remove the model's error; once the lag model has the arm at the plan's
+    # end, the loop on the berry (predicted, full gain) takes over instead of stalling.
+    options = SimRigOptions(
+        n_berries=1,
+        seed=0,
+        log_path=tmp_path / "log.jsonl",
+        plant=PlantConfig(pressure_tau=1.0, hysteresis_psi=5.0),
+    )
+    rig = build_sim_rig(options)
+    (berry,) = rig.run().berries
+    assert berry.harvested and berry.true_position_error_mm is not None
+    assert berry.true_position_error_mm <= 1.0
+    kinds = [r["kind"] for r in read_log(tmp_path / "log.jsonl")]
+    assert "waypoint_handover" in kinds and "waypoint_stalled" not in kinds

@@ -105,12 +105,13 @@ class SafeActuator:
         return self._sent - self._model.in_flight()
 
     def in_flight(self) -> FloatArray | None:
-        """The motion (m) the measured pose will still make towards :attr:`sent`, by the
-        lag model; None without one."""
+        """The motion (m) the actuators will still make towards :attr:`sent`, by the lag
+        model of the regulators (the measurement's own lag left out: this is where the
+        arm is, not what the cameras show yet); None without a lag model."""
         if self._model is None:
             return None
         self._catch_up()
-        return self._model.in_flight()
+        return self._model.arm_in_flight()
 
     def send(self, q: FloatArray) -> FloatArray:
         """Command elongations ``q`` (m); returns :attr:`sent`. A NaN raises before

@@ -99,3 +99,8 @@ class MeasurementModel:
         """``q − ŷ`` (m): the motion the measured pose will still make once the
         regulators reach the last target."""
         return self._target - self.measured
+
+    def arm_in_flight(self) -> FloatArray:
+        """The motion (m) the actuators themselves will still make towards the last
+        target: what the arm has left to move, whatever the measurement's own lag."""
+        return self._target - self._pressure

@@ -142,9 +142,11 @@ class Servo:
             if fault.reason not in (FaultReason.TIMEOUT, FaultReason.UNREACHABLE):
                 raise
             self.log.event("retreat_incomplete", t=self.clock.now(), detail=str(fault))
-        # Leave by the planned way in (checked against the known canes), reversed.
-        for q_way in reversed(waypoints):
-            q = self.ramp(watch, stage, q, q_way, start + c.home_timeout)
+        # Leave by the planned way in (checked against the known canes), reversed. The
+        # first is the plan's pre-grasp q, a few mm of elongation from where the back-out
+        # left the arm: the ramp on from it need not wait for the arm to settle there.
+        for k, q_way in enumerate(reversed(waypoints)):
+            q = self.ramp(watch, stage, q, q_way, start + c.home_timeout, settle=k > 0)
         return self.ramp(watch, stage, q, home, start + c.home_timeout)
 
     def follow(
@@ -231,9 +233,11 @@ class Servo:
         goal: FloatArray,
         deadline: float = np.inf,
         observe: bool = False,
+        settle: bool = True,
     ) -> FloatArray:
         """Move the elongations straight to ``goal`` at ``home_speed``, open loop; with
-        ``observe`` the cameras are still read (and checked) at every step."""
+        ``observe`` the cameras are still read (and checked) at every step; with
+        ``settle`` (the default) return only once the lag model has the arm there."""
         step = self.cfg.home_speed * self.cfg.period
         while np.any(q != goal):
             if self.clock.now() > deadline:
@@ -246,7 +250,7 @@ class Servo:
         # An open-loop ramp ends where the arm is, not where it was told to be: on a
         # lagging plant the arm trails the ramp, and the next move (the next waypoint,
         # the next berry's placement) would cut the corner through the canes.
-        while not self._arrived():
+        while settle and not self._arrived():
             if self.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: arm not settled in time")
             self.actuator.send(q)
