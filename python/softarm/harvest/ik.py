@@ -88,14 +88,21 @@ class ModelIK:
         on the approach line (the arm then enters the bush along that line). Preferred:
         grasps three times ``limit_room`` from the joint limits (pre-grasp ``limit_room``)
         and ramps ``ramp_margin`` from the canes; then grasps ``limit_room`` from the
-        limits. A berry with no such plan is UNREACHABLE: brushing a cane open loop is
-        not worth one berry."""
-        passes = [  # (joint-limit room at the grasp, gap along the open-loop ramps)
-            (3 * self.limit_room, self.ramp_margin),
-            (self.limit_room, self.ramp_margin),
+        limits; then a via half as far back; then grasps on the limits. Every pass keeps
+        the same cane margins. A berry with no such plan is UNREACHABLE: brushing a cane
+        open loop is not worth one berry."""
+        passes = [  # (joint-limit room at the grasp, gap along the ramps, via points)
+            (3 * self.limit_room, self.ramp_margin, (None, self.via)),
+            (self.limit_room, self.ramp_margin, (None, self.via)),
+            # A via point half as far back: it enters the bush on a shorter line
+            # where the long one leaves the arm's reach (same margins; seed 502's berry 12).
+            (self.limit_room, self.ramp_margin, (0.5 * self.via,)),
+            # Then a grasp on the joint limits: the loop may fall short by the model's
+            # error there, but the canes keep the same margins (seed 500's berry 10).
+            (0.0, self.ramp_margin, (None, self.via, 0.5 * self.via)),
         ]
-        for room, ramp in passes:
-            for via in (None, self.via):
+        for room, ramp, vias in passes:
+            for via in vias:
                 for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
                     path = self._path(q, berry, current, axis, via, room, ramp)
                     if path is not None:

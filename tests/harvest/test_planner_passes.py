@@ -1,0 +1,40 @@
+"""The placement planner's last-resort passes: what it tries before calling a berry
+UNREACHABLE, with the cane margins unchanged."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from softarm import SoftArm
+from softarm.harvest.clearance import Clearance
+from softarm.harvest.config import HarvestConfig
+from softarm.harvest.ik import ModelIK, planning_resolver
+from softarm.sim.bush import Bush
+
+
+def _scene(limit_room: float) -> tuple[ModelIK, np.ndarray, np.ndarray, Bush]:
+    arm = SoftArm.blackberry()
+    bush = Bush.generate(arm, 3, 7)
+    clearance = Clearance(arm, [b.curve() for b in bush.branches], 0.03)
+    planner = ModelIK(
+        planning_resolver(arm), HarvestConfig(), seed=0, clearance=clearance,
+        limit_room=limit_room,
+    )  # fmt: skip
+    q = np.full(arm.n_actuators, 0.0167)  # the harvest's home elongation
+    return planner, q, arm.forward(q), bush
+
+
+def test_a_grasp_on_the_joint_limits_is_tried_before_giving_up() -> None:
+    # No solution of this arm keeps 1 m from its limits: every pass that asks for
+    # joint-limit room fails, and only the last one (a grasp on the limits) can plan.
+    planner, q, current, bush = _scene(limit_room=1.0)
+    berry = bush.berries[0].position
+    plan = planner.plan(q, berry, current)
+    assert plan is not None
+    waypoints, axis = plan
+    assert np.degrees(np.arccos(np.clip(axis @ np.array([0.0, 1.0, 0.0]), -1, 1))) <= 20.0 + 1e-9
+    # The canes keep the ramps' margin on every waypoint's ramp.
+    start = q
+    for q_way in waypoints:
+        assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
+        start = q_way
