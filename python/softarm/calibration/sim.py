@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
-from softarm.calibration.collect import collect
+from softarm.calibration.collect import collect, paced_for
 from softarm.calibration.excitation import excitation_set
 from softarm.calibration.fit import calibrate
 from softarm.calibration.result import Calibration
@@ -68,19 +68,22 @@ def calibrate_plant(
     n_poses: int = 80,
     seed: int = 0,
     on_pose: Callable[[int, F64], None] | None = None,
-    settle: float = 1.0,
     average: float = 0.5,
     bias: bool = False,
 ) -> tuple[Calibration, F64, F64]:
     """Drive ``plant`` through ``n_poses`` excitation poses measured by a tracker with
-    ``config``'s noise, and fit; returns the calibration and the data (commands, poses)."""
+    ``config``'s noise, and fit; returns the calibration and the data (commands, poses).
+    The holds are paced for the plant's declared lag (regulators plus the tracker's
+    filter) and play (:func:`~softarm.calibration.collect.paced_for`)."""
+    filter_s = 0.0 if config.cutoff is None else 1.0 / config.cutoff
+    pace = paced_for(config.pressure_tau + filter_s, config.hysteresis_psi * METRES_PER_PSI)
     tracker = PoseTracker(
         np.random.default_rng(seed), config.position_noise, config.angle_noise, config.cutoff
     )
     drv = PlantDriver(plant, tracker)
     commands = excitation_set(nominal, n_poses, seed=seed)
     c, p = collect(
-        commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose, settle=settle, average=average
+        commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose, average=average, **pace
     )
     return calibrate(nominal, c, p, bias=bias), c, p
 

@@ -9,6 +9,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from softarm.errors import HardwareUnavailableError
 
 if TYPE_CHECKING:
@@ -98,13 +100,24 @@ def _sim(args: argparse.Namespace, progress: Progress) -> Calibration:
 def _hardware(args: argparse.Namespace, progress: Progress) -> Calibration | None:
     from softarm._core import Section, SoftArm
     from softarm.calibration import calibrate
-    from softarm.calibration.collect import collect
+    from softarm.calibration.collect import collect, paced_for
     from softarm.calibration.excitation import excitation_set
     from softarm.config import load_config
     from softarm.harvest.hw_rig import build_hardware_rig
+    from softarm.identified_plant import identified_from_config
 
     config = load_config(args.config)
     nominal = SoftArm([Section(**vars(s)) for s in config.arm.sections])
+    # Holds paced for the identified plant ([plant_model]) when there is one.
+    identified = identified_from_config(config, args.config)
+    pace = (
+        {}
+        if identified is None
+        else paced_for(
+            identified.lag_s,
+            float(np.max(np.multiply(identified.hysteresis_psi, identified.metres_per_psi))),
+        )
+    )
     try:
         rig = build_hardware_rig(config)
     except HardwareUnavailableError as exc:
@@ -118,6 +131,7 @@ def _hardware(args: argparse.Namespace, progress: Progress) -> Calibration | Non
             m.clock.sleep,
             lambda: m.vision.track(m.clock.now()),  # type: ignore[attr-defined]
             on_pose=progress,
+            **pace,
         )
     finally:
         rig.close()  # vents the arm
