@@ -23,9 +23,16 @@ import numpy as np
 
 
 def one_trial(
-    tau: float, hysteresis: float, seed: int, berries: int, lag_control: str = "predictor"
+    tau: float,
+    hysteresis: float,
+    seed: int,
+    berries: int,
+    lag_control: str = "predictor",
+    calibrate: bool = False,
 ) -> dict:
-    """Harvest one bush on one plant; returns the report as a dict plus the plant keys."""
+    """Harvest one bush on one plant; returns the report as a dict plus the plant keys.
+    With ``calibrate`` the plant is first calibrated (``softarm calibrate --sim``, 80
+    poses) and the harvest runs on the fitted model, as on a real arm."""
     from softarm.harvest import sim_rig
     from softarm.sim.arm import PlantConfig
 
@@ -44,12 +51,22 @@ def one_trial(
 
         ArmPlant.seeded = staticmethod(seeded)  # type: ignore[method-assign]
         opts = sim_rig.SimRigOptions(n_berries=berries, seed=seed)
+    if calibrate:
+        from softarm._core import SoftArm
+        from softarm.calibration.sim import build_plant, calibrate_plant
+
+        nominal = SoftArm.blackberry()
+        # The rig's plant is drawn from seed + 1000 (softarm.harvest.sim_rig).
+        opts.calibration = calibrate_plant(
+            build_plant(nominal, plant, seed + 1000), plant, nominal, seed=seed
+        )[0]
     start = time.perf_counter()
     report = sim_rig.build_sim_rig(opts).run().to_dict()
     report["wall_s"] = time.perf_counter() - start
     report["tau"] = tau
     report["hysteresis_psi"] = hysteresis
     report["lag_control"] = lag_control
+    report["calibrated"] = calibrate
     return report
 
 
@@ -100,12 +117,18 @@ def main() -> None:
         default="predictor",
         help="the loop's handling of the lag (SimRigOptions.lag_control, docs/control.md)",
     )
+    ap.add_argument(
+        "--calibrate",
+        action="store_true",
+        help="calibrate each plant first and harvest on the fitted model (softarm calibrate)",
+    )
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     trials = [(t, h, s) for t in args.tau for h in args.hysteresis for s in args.seeds]
     with ProcessPoolExecutor(args.jobs) as pool:
         futures = [
-            pool.submit(one_trial, t, h, s, args.berries, args.lag_control) for t, h, s in trials
+            pool.submit(one_trial, t, h, s, args.berries, args.lag_control, args.calibrate)
+            for t, h, s in trials
         ]
         reports = []
         # Written as each bush finishes, so that a run stopped early keeps what it did.
