@@ -29,7 +29,7 @@ from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
-from softarm.harvest.plant_model import predicted_loop_alpha
+from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_alpha
 from softarm.harvest.vision_loop import CameraVision
 from softarm.identified_plant import IdentifiedPlant
 from softarm.vision import MarkerCube
@@ -96,17 +96,20 @@ def build_hardware_rig(
         gripper = ArduinoGripper(link)
         clock = MonotonicClock()
         lag = None if identified is None else (identified.lag_s, cfg.period)
+        # A camera frame of measurement lag behind the identified regulators.
+        sensor_lag = MEASUREMENT_LAG_PERIODS * cfg.period
         actuator = SafeActuator(
             bank,
             ElongationMap(ch.p_max, ch.metres_per_psi),
             lag=lag,
             now=clock.now,
+            sensor_lag_s=sensor_lag if lag is not None else 0.0,
         )
         predicted = None if lag is None else (lambda: actuator.plant_q)
         if identified is not None and "hybrid_alpha" not in config.gains.values:
             # The loop on the berry goes through the lag model: its gain is cut as the
             # identified lag grows (docs/control.md, section 6), unless [gains] sets it.
-            alpha = predicted_loop_alpha(identified.lag_s)
+            alpha = predicted_loop_alpha(identified.lag_s + sensor_lag)
             resolver = Resolver(
                 arm, mode="hybrid", gains=(gains or Gains()).replace(hybrid_alpha=alpha)
             )

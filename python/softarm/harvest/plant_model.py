@@ -20,10 +20,19 @@ import numpy.typing as npt
 from softarm._core import LagModel
 from softarm.errors import ParameterError
 
-__all__ = ["MeasurementModel", "predicted_loop_alpha"]
+__all__ = ["MEASUREMENT_LAG_PERIODS", "MeasurementModel", "predicted_loop_alpha"]
 
 FloatArray = npt.NDArray[np.float64]
 
+
+#: The measurement's own lag (control periods) the predictor puts behind the regulators:
+#: one camera frame, taken at the start of the period. The simulated cameras have none,
+#: so there it over-estimates the lag, on purpose: the predicted loop then approaches
+#: the berry without overshoot, and on a plant with play each overshoot costs a reversal
+#: through the band. Tuning seeds 0-3, tau = 0.08 s, median s per berry at 1.5 / 5 psi:
+#: 2.95 / 4.0 with none, 2.8 / 3.35 with one period, 3.2 / 3.75 with two (the 0.1 s
+#: tracker filter the rig used to assume; docs/control.md, section 6).
+MEASUREMENT_LAG_PERIODS = 1.0
 
 #: The predicted loop's gain on a quick plant, and the lag-time product it keeps below
 #: on a slower one (:func:`predicted_loop_alpha`; tuned on seeds 0–3, docs/control.md).

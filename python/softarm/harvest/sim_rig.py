@@ -26,7 +26,7 @@ from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
-from softarm.harvest.plant_model import predicted_loop_alpha
+from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_alpha
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import ArmPlant
@@ -200,14 +200,9 @@ def build_sim_rig(
     if o.lag_control not in ("predictor", "bound"):
         raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
     predict = o.lag_control == "predictor"
-    # A measurement lag of 1/cutoff (0.1 s) behind the regulators. The simulated cameras
-    # have none (they see the pose as it is; the plant's own tracker filter is not in
-    # this chain), so here it is a deliberate over-estimate of the lag: the predicted
-    # loop then approaches the berry without overshoot, and each overshoot costs a
-    # reversal through the play. Measured on seeds 0-3 at tau = 0.08 s / 5 psi: fine
-    # positioning 1.3 s with it, 1.9 s without (docs/control.md, section 6). Arrival
-    # (`in_flight`) reads the regulators alone.
-    sensor_lag = 0.0 if o.plant.cutoff is None else 1.0 / o.plant.cutoff
+    # One period of measurement lag behind the regulators (MEASUREMENT_LAG_PERIODS: an
+    # over-estimate here, on purpose). Arrival (`in_flight`) reads the regulators alone.
+    sensor_lag = MEASUREMENT_LAG_PERIODS * cfg.period
     actuator = SafeActuator(
         bank,
         None if o.calibration is None else o.calibration.pressure_map(),
