@@ -103,7 +103,7 @@ def build_hardware_rig(
             ElongationMap(ch.p_max, ch.metres_per_psi),
             lag=lag,
             now=clock.now,
-            sensor_lag_s=sensor_lag if lag is not None else 0.0,
+            sensor_lag_s=sensor_lag,
         )
         predicted = None if lag is None else (lambda: actuator.plant_q)
         if identified is not None and "hybrid_alpha" not in config.gains.values:

@@ -1,7 +1,7 @@
 """The controller's model of the measurement chain behind the actuator: what the measured
 pose will still do after the commands already sent (docs/control.md, section 6).
 
-    command ──regulators (first-order lag τ)──► elongation ──pose filter (lag τ_f)──►
+    command ──regulators (first-order lag τ)──► elongation ──measurement (lag τ_m)──►
     what the camera pipeline reports
 
 Both lags are :class:`softarm.LagModel` (Rust). The loop needs the motion still *in
@@ -44,11 +44,11 @@ PREDICTED_ALPHA_MIN = 0.3
 
 def predicted_loop_alpha(lag_s: float) -> float:
     """The resolver's gain for the loop closed through the lag model, for a measurement
-    chain lagging ``lag_s`` in all (regulators + pose filter, s).
+    chain lagging ``lag_s`` in all (regulators + measurement lag, s).
 
     With an exact model the predicted loop is the lag-free iteration ``u ← u + α J⁺ e(u)``
     and any ``0 < α < 1`` converges without overshoot whatever the lag (docs/control.md,
-    section 2). What the model leaves out (the play, the filter's true order, an error in
+    section 2). What the model leaves out (the play, the measurement's true lag, an error in
     τ) acts for a time that grows with the lag, so the gain is cut as the lag grows:
     ``α = PREDICTED_ALPHA_LAG_S / lag_s`` between the mode's 0.3 and 0.6. Measured on
     seeds 0–3 at 5 psi of play: 0.6 shortens fine positioning by a third at τ = 0.08 and
@@ -61,13 +61,13 @@ def predicted_loop_alpha(lag_s: float) -> float:
 
 
 class MeasurementModel:
-    """Regulators' lag then the pose filter's, per channel, in elongations (m).
+    """Regulators' lag then the measurement's, per channel, in elongations (m).
 
     Args:
         n: channels.
         tau_s: the regulators' time constant (s, >= 0).
         period_s: the control period (s) each :meth:`advance` lasts.
-        filter_s: the pose filter's time constant (s, >= 0).
+        filter_s: the measurement's own lag (s, >= 0): a pose filter, a camera frame.
     """
 
     def __init__(self, n: int, tau_s: float, period_s: float, filter_s: float = 0.0) -> None:
