@@ -20,6 +20,7 @@ def exact(**kw: object) -> Gains:
     """Exact pseudo-inverses, no caps, joint-limit term always on."""
     base = {
         "singular_threshold": 0.0,
+        "loop_singular_threshold": 0.0,
         "max_step": math.inf,
         "schedule": "step",
         "position_switch": 0.0,

@@ -124,10 +124,14 @@ class Gains:
     in control periods) a closed-loop step must tolerate: with a measured pose and no
     ``plant_q``, the largest task gain (alpha, or hybrid_alpha * max(hybrid_position,
     hybrid_orientation)) is capped at tanh(1 / (4 lag_periods)) (docs/control.md);
-    default 20. ``repulsion_gain`` (k_r), ``influence_distance`` (rho_0, m) and
-    ``body_radius`` (m) set the obstacle repulsion of planning paper eq. (9): a push of
-    k_r (1/g - 1/rho_0) / g^2 m per step on the closest arm point, g = distance -
-    body_radius. Every field is bounded (see ``Gains.validate`` in the Rust docs).
+    default 20. ``loop_damping`` and ``loop_singular_threshold`` replace ``damping`` and
+    ``singular_threshold`` in a step given a measured pose (closed loop, with or without
+    ``plant_q``): larger, because the plant is not the model along the ill-conditioned
+    directions of the damped pseudo-inverses (docs/control.md). ``repulsion_gain`` (k_r),
+    ``influence_distance`` (rho_0, m) and ``body_radius`` (m) set the obstacle repulsion of
+    planning paper eq. (9): a push of k_r (1/g - 1/rho_0) / g^2 m per step on the closest
+    arm point, g = distance - body_radius. Every field is bounded (see ``Gains.validate``
+    in the Rust docs).
     """
 
     def __new__(
@@ -149,6 +153,8 @@ class Gains:
         axis_mask: tuple[bool, bool, bool] | list[bool] = ...,
         damping: float = ...,
         singular_threshold: float = ...,
+        loop_damping: float = ...,
+        loop_singular_threshold: float = ...,
         limit_margin: float = ...,
         max_step: float = ...,
         lag_periods: float = ...,
@@ -207,6 +213,10 @@ class Gains:
     def damping(self) -> float: ...
     @property
     def singular_threshold(self) -> float: ...
+    @property
+    def loop_damping(self) -> float: ...
+    @property
+    def loop_singular_threshold(self) -> float: ...
     @property
     def limit_margin(self) -> float: ...
     @property

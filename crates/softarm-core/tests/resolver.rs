@@ -27,6 +27,7 @@ fn random_q(rng: &mut StdRng, arm: &SoftArm, inset: f64) -> Vec<f64> {
 fn exact_gains() -> Gains {
     Gains {
         singular_threshold: 0.0,
+        loop_singular_threshold: 0.0,
         max_step: f64::INFINITY,
         schedule: Schedule::Step,
         position_switch: 0.0,
@@ -490,4 +491,68 @@ fn saturated_coordinates_are_held_and_the_others_still_meet_the_task() {
         assert!(err < 1e-9, "{err}");
     }
     assert!(tested >= 10, "only {tested} saturated cases");
+}
+
+/// A closed-loop step damps with the `loop_*` pair, an open-loop one with the model's:
+/// with the measured pose equal to the model's (no lag cap: `lag_periods = 0`), the two
+/// steps differ only where a damped singular value lies below a threshold. Next to the
+/// joint limits (four actuators held, the reduced Jacobian ill-conditioned) the closed
+/// loop's increment is the shorter; with `loop_*` equal to the model's pair, or on a
+/// well-conditioned state, the steps are identical.
+#[test]
+fn closed_loop_steps_damp_with_the_loop_pair() {
+    let arm = SoftArm::blackberry();
+    let gains = Gains {
+        lag_periods: 0.0,
+        ..Gains::blackberry()
+    };
+    assert_eq!(gains.dls(false), (gains.singular_threshold, gains.damping));
+    assert_eq!(
+        gains.dls(true),
+        (gains.loop_singular_threshold, gains.loop_damping)
+    );
+    assert!(gains.loop_damping > gains.damping);
+    let same = Gains {
+        loop_damping: gains.damping,
+        loop_singular_threshold: gains.singular_threshold,
+        ..gains
+    };
+    let steps = |g: &Gains, q: &[f64], target: &Target| {
+        let res = Resolver::new(arm.clone(), Mode::Hybrid, *g).unwrap();
+        let model = arm.forward(q).unwrap();
+        let open = res.step(q, target, None).unwrap().q;
+        let closed = res.step(q, target, Some(&model)).unwrap().q;
+        let norm = |c: &[f64]| {
+            c.iter()
+                .zip(q)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        (open.clone(), closed.clone(), norm(&open), norm(&closed))
+    };
+    // The state the closed-loop experiment limit-cycled at (docs/control.md §3), and a
+    // target 1 mm and 0.5° away from it.
+    let q = [
+        0.0284, 0.0128, 0.03333, 0.0319, 0.03333, 0.0, 0.0085, 0.03333, 0.01313,
+    ];
+    let mut t = arm.forward(&q).unwrap();
+    let r = nalgebra::Rotation3::from_euler_angles(0.5f64.to_radians(), 0.0, 0.0);
+    let rot = r.matrix() * t.fixed_view::<3, 3>(0, 0);
+    t.fixed_view_mut::<3, 3>(0, 0).copy_from(&rot);
+    t[(0, 3)] += 0.001;
+    let target = Target::Pose(t);
+    let (open, closed, n_open, n_closed) = steps(&gains, &q, &target);
+    assert!(open != closed);
+    assert!(n_closed < n_open, "{n_closed} vs {n_open}");
+    let (open, closed, _, _) = steps(&same, &q, &target);
+    assert_eq!(open, closed);
+    // Mid-range: every singular value clears both thresholds, so no damping at all.
+    let q = [
+        0.012, 0.020, 0.016, 0.018, 0.010, 0.022, 0.015, 0.017, 0.013,
+    ];
+    let mut t = arm.forward(&q).unwrap();
+    t[(0, 3)] += 0.001;
+    let (open, closed, _, _) = steps(&gains, &q, &Target::Pose(t));
+    assert_eq!(open, closed);
 }

@@ -207,6 +207,15 @@ declare_gains! {
             pub damping: f64 in (0.0, 1.0, Closed, "[0, 1]"),
             /// Smallest singular value below which damping starts (same units as J).
             pub singular_threshold: f64 in (0.0, 1.0, Closed, "[0, 1]"),
+            /// `damping` of a step that closes the loop through the plant (a measured pose is
+            /// given, with or without a lag prediction). Larger than `damping` because the
+            /// plant is not the model: along a direction where the model's (reduced) Jacobian
+            /// has a small singular value σ, the plant's response differs from σ by the model
+            /// error, so an undamped 1/σ turns it into a loop gain far above α; near the
+            /// joint limits this is what limit-cycles through the play (docs/control.md §3).
+            pub loop_damping: f64 in (0.0, 1.0, Closed, "[0, 1]"),
+            /// `singular_threshold` of a closed-loop step (see `loop_damping`).
+            pub loop_singular_threshold: f64 in (0.0, 1.0, Closed, "[0, 1]"),
             /// Fraction of each actuator range next to a limit where ∇H is frozen at its value
             /// at the band's edge, so that it stays finite at and beyond the limits. Below
             /// ~1e-6 of the range, ∇H at the band's edge (∝ 1/margin²) is no longer a
@@ -297,6 +306,9 @@ impl Gains {
             axis_mask: [true, false, true],
             damping: 0.02,
             singular_threshold: 0.05,
+            // The paper has no closed-loop damping of its own: the same values.
+            loop_damping: 0.02,
+            loop_singular_threshold: 0.05,
             limit_margin: 0.01,
             max_step: 0.005,
             lag_periods: 0.0,
@@ -326,6 +338,11 @@ impl Gains {
             axis_mask: [true, false, true],
             damping: 0.02,
             singular_threshold: 0.05,
+            // Twice the threshold and 2.5 times the damping in closed loop: the largest
+            // gain σ/(σ² + λ²) of a damped direction drops from 27 to 11.5
+            // (docs/control.md §3).
+            loop_damping: 0.05,
+            loop_singular_threshold: 0.1,
             limit_margin: 0.01,
             max_step: 0.004,
             lag_periods: DEFAULT_LAG_PERIODS,
@@ -366,6 +383,17 @@ impl Gains {
         };
         g.validate()?;
         Ok(g)
+    }
+
+    /// The (singular threshold, damping) of the damped pseudo-inverses: the `loop_*` pair
+    /// when the step closes the loop through the plant (`closed_loop`, with or without a
+    /// lag prediction), else the model's pair.
+    pub fn dls(&self, closed_loop: bool) -> (f64, f64) {
+        if closed_loop {
+            (self.loop_singular_threshold, self.loop_damping)
+        } else {
+            (self.singular_threshold, self.damping)
+        }
     }
 
     /// The α of `mode`'s step, capped at [`lag_alpha`] when the step closes the loop

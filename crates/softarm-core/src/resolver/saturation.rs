@@ -2,6 +2,7 @@
 //! caps: the rounds of one resolver step.
 
 use super::step::{subtract_masked, TaskErrors, Workspace};
+use super::tasks::{Dls, Scale};
 use super::{Mode, Resolver};
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
@@ -68,7 +69,9 @@ impl<K: Kinematics> Resolver<K> {
         errors: &TaskErrors,
         pose_target: bool,
         alpha: f64,
+        (eps, lam): Dls,
     ) -> bool {
+        let scale = Scale { alpha, eps, lam };
         let n = q.len();
         ws.free.iter_mut().for_each(|f| *f = true);
         ws.fixed.iter_mut().for_each(|v| *v = 0.0);
@@ -82,10 +85,10 @@ impl<K: Kinematics> Resolver<K> {
             ws.null.iter_mut().for_each(|v| *v = 0.0);
             ws.avoid.iter_mut().for_each(|v| *v = 0.0);
             match self.mode {
-                Mode::Position => self.position_task(ws, q, &e_p, errors.p_norm, alpha),
-                Mode::Orientation => self.orientation_task(ws, q, &e_w, errors.w_norm, alpha),
-                Mode::Hybrid => self.hybrid_task(ws, q, &e_p, &e_w, errors.p_norm, alpha),
-                Mode::Conventional => self.conventional_task(ws, &e_p, &e_w, pose_target, alpha),
+                Mode::Position => self.position_task(ws, q, &e_p, errors.p_norm, scale),
+                Mode::Orientation => self.orientation_task(ws, q, &e_w, errors.w_norm, scale),
+                Mode::Hybrid => self.hybrid_task(ws, q, &e_p, &e_w, errors.p_norm, scale),
+                Mode::Conventional => self.conventional_task(ws, &e_p, &e_w, pose_target, scale),
             }
             self.cap_and_combine(ws);
             let (lower, upper) = (self.arm.lower(), self.arm.upper());

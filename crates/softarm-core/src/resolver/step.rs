@@ -263,7 +263,10 @@ impl<K: Kinematics> Resolver<K> {
         // The lag bound applies to a step that closes the loop through the plant without
         // a predictor accounting for the lag.
         let alpha = self.task_alpha(input.current.is_some() && !errors.predicted);
-        let saturated = self.saturation_rounds(ws, q, &errors, goal.1.is_some(), alpha);
+        // A step closed through the plant damps its pseudo-inverses more: the plant is not
+        // the model along their ill-conditioned directions (Gains::loop_damping).
+        let dls = self.gains.dls(input.current.is_some());
+        let saturated = self.saturation_rounds(ws, q, &errors, goal.1.is_some(), alpha, dls);
         self.write_command(ws, q, out)?;
         Ok(StepInfo {
             saturated,

@@ -16,6 +16,19 @@ use super::Resolver;
 use crate::kinematics::Kinematics;
 use crate::math::{Mat3, Vec3};
 
+/// (singular threshold, damping) of the damped pseudo-inverses ([`normal_inverse3`]).
+pub(super) type Dls = (f64, f64);
+
+/// What one round's tasks are scaled by: the task gain α and the damped least squares'
+/// singular threshold ε and largest damping λ (the model's or the closed loop's,
+/// [`crate::resolver::Gains::dls`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Scale {
+    pub alpha: f64,
+    pub eps: f64,
+    pub lam: f64,
+}
+
 /// Σ_k c_k c_kᵀ.
 #[inline]
 fn gram(c: &[Vec3]) -> Mat3 {
@@ -73,15 +86,16 @@ impl<K: Kinematics> Resolver<K> {
         q: &[f64],
         e_p: &Vec3,
         p_norm: f64,
-        alpha: f64,
+        scale: Scale,
     ) {
+        let Scale { alpha, eps, lam } = scale;
         let g = &self.gains;
         let gamma = g
             .schedule
             .weight(g.position_gamma, g.position_switch, p_norm);
-        let pa = normal_inverse3(&gram(&ws.a), [true; 3], g.singular_threshold, g.damping);
+        let pa = normal_inverse3(&gram(&ws.a), [true; 3], eps, lam);
         add_tr_mul(&mut ws.dq, alpha, &ws.a, &(pa * e_p));
-        self.add_null_terms(ws, q, alpha * gamma, &pa, None);
+        self.add_null_terms(ws, q, alpha * gamma, &pa, None, (eps, lam));
     }
 
     /// eq. (13), task 2 (orientation, masked angular Jacobian) over task 3 and the
@@ -92,17 +106,18 @@ impl<K: Kinematics> Resolver<K> {
         q: &[f64],
         e_w: &Vec3,
         w_norm: f64,
-        alpha: f64,
+        scale: Scale,
     ) {
+        let Scale { alpha, eps, lam } = scale;
         let g = &self.gains;
         let gamma = g
             .schedule
             .weight(g.orientation_gamma, g.orientation_switch, w_norm);
-        let pb = normal_inverse3(&gram(&ws.b), g.axis_mask, g.singular_threshold, g.damping);
+        let pb = normal_inverse3(&gram(&ws.b), g.axis_mask, eps, lam);
         add_tr_mul(&mut ws.dq, alpha, &ws.b, &(pb * e_w));
         // The null-space terms project with `ws.a`: the orientation task's columns.
         std::mem::swap(&mut ws.a, &mut ws.b);
-        self.add_null_terms(ws, q, alpha * gamma, &pb, None);
+        self.add_null_terms(ws, q, alpha * gamma, &pb, None, (eps, lam));
         std::mem::swap(&mut ws.a, &mut ws.b);
     }
 
@@ -115,10 +130,10 @@ impl<K: Kinematics> Resolver<K> {
         e_p: &Vec3,
         e_w: &Vec3,
         p_norm: f64,
-        alpha: f64,
+        scale: Scale,
     ) {
+        let Scale { alpha, eps, lam } = scale;
         let g = &self.gains;
-        let (eps, lam) = (g.singular_threshold, g.damping);
         let pa = normal_inverse3(&gram(&ws.a), [true; 3], eps, lam);
         // x1 = J_v⁺ e_p
         let ya = pa * e_p;
@@ -142,7 +157,7 @@ impl<K: Kinematics> Resolver<K> {
             *d = alpha * (g.hybrid_position * x + g.hybrid_orientation * t.dot(&yt));
         }
         let gamma = g.schedule.weight(g.hybrid_gamma, g.hybrid_switch, p_norm);
-        self.add_null_terms(ws, q, alpha * gamma, &pa, Some(&pt));
+        self.add_null_terms(ws, q, alpha * gamma, &pa, Some(&pt), (eps, lam));
     }
 
     /// eq. (7): the conventional resolved rate, with the position Jacobian for a point
@@ -154,10 +169,10 @@ impl<K: Kinematics> Resolver<K> {
         e_p: &Vec3,
         e_w: &Vec3,
         pose_target: bool,
-        alpha: f64,
+        scale: Scale,
     ) {
+        let Scale { alpha, eps, lam } = scale;
         let g = &self.gains;
-        let (eps, lam) = (g.singular_threshold, g.damping);
         if !pose_target {
             let pa = normal_inverse3(&gram(&ws.a), [true; 3], eps, lam);
             add_tr_mul(&mut ws.dq, alpha, &ws.a, &(pa * e_p));
@@ -182,7 +197,15 @@ impl<K: Kinematics> Resolver<K> {
     /// `I − A⁺A − T⁺T` (`A⁺ = Aᵀ pa` with A = `ws.a`; `T⁺ = Tᵀ pt` with T = `ws.t`, if
     /// given): `ws.null = s (I − A⁺A − T⁺T) ∇H` (skipped when the schedule gives `s = 0`)
     /// and `ws.avoid = (I − A⁺A − T⁺T) Σ_j J_sj⁺ F_j` (eq. 9; never scheduled).
-    fn add_null_terms(&self, ws: &mut Workspace, q: &[f64], s: f64, pa: &Mat3, pt: Option<&Mat3>) {
+    fn add_null_terms(
+        &self,
+        ws: &mut Workspace,
+        q: &[f64],
+        s: f64,
+        pa: &Mat3,
+        pt: Option<&Mat3>,
+        (eps, lam): Dls,
+    ) {
         if s != 0.0 {
             joint_limits::gradient_into(
                 q,
@@ -197,13 +220,7 @@ impl<K: Kinematics> Resolver<K> {
             project(&mut ws.null, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
         }
         if !ws.repulsions.is_empty() {
-            avoid::add_pseudo_inverse_pushes(
-                &ws.repulsions,
-                &ws.free,
-                self.gains.singular_threshold,
-                self.gains.damping,
-                &mut ws.avoid,
-            );
+            avoid::add_pseudo_inverse_pushes(&ws.repulsions, &ws.free, eps, lam, &mut ws.avoid);
             project(&mut ws.avoid, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
         }
     }
