@@ -87,7 +87,7 @@ def run_rod(seeds: list[int], gravities: list[str], out: Path) -> None:
             cal, c, p = calibrate_plant(plant, cfg, nominal, seed=s, settle=0.6, average=0.3)
             biased = calibrate(nominal, c, p, bias=True)
             test_c = excitation_set(nominal, 40, seed=s + 77)
-            truth = true_poses(plant, test_c, settle=0.6)
+            truth = true_poses(plant, test_c, cfg, settle=0.6)
             out.mkdir(parents=True, exist_ok=True)
             np.savez(out / f"rod_{g}_{s}.npz", commands=c, poses=p, test_commands=test_c,
                      test_poses=truth)  # fmt: skip

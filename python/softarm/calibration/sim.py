@@ -70,13 +70,17 @@ def calibrate_plant(
     on_pose: Callable[[int, F64], None] | None = None,
     average: float = 0.5,
     bias: bool = False,
+    settle: float | None = None,
 ) -> tuple[Calibration, F64, F64]:
     """Drive ``plant`` through ``n_poses`` excitation poses measured by a tracker with
     ``config``'s noise, and fit; returns the calibration and the data (commands, poses).
     The holds are paced for the plant's declared lag (regulators plus the tracker's
-    filter) and play (:func:`~softarm.calibration.collect.paced_for`)."""
+    filter) and play (:func:`~softarm.calibration.collect.paced_for`); ``settle`` (s),
+    when given, replaces the paced hold at each pose."""
     filter_s = 0.0 if config.cutoff is None else 1.0 / config.cutoff
     pace = paced_for(config.pressure_tau + filter_s, config.hysteresis_psi * METRES_PER_PSI)
+    if settle is not None:
+        pace["settle"] = settle
     tracker = PoseTracker(
         np.random.default_rng(seed), config.position_noise, config.angle_noise, config.cutoff
     )
@@ -88,7 +92,15 @@ def calibrate_plant(
     return calibrate(nominal, c, p, bias=bias), c, p
 
 
-def true_poses(plant: object, commands: F64, settle: float = 1.0) -> F64:
-    """The plant's noise-free settled poses at ``commands`` (driven as in the fit)."""
+def true_poses(
+    plant: object, commands: F64, config: PlantConfig, settle: float | None = None
+) -> F64:
+    """The plant's noise-free settled poses at ``commands``, driven as in the fit: paced
+    for ``config``'s regulator lag and play (no tracker, so no filter lag); ``settle``
+    (s), when given, replaces the paced hold. A fixed hold would leave a slow plant
+    short of its poses, and the held-out reference with it."""
+    pace = paced_for(config.pressure_tau, config.hysteresis_psi * METRES_PER_PSI)
+    if settle is not None:
+        pace["settle"] = settle
     drv = PlantDriver(plant, None)
-    return collect(commands, drv.send, drv.sleep, drv.measure, settle=settle, average=0.05)[1]
+    return collect(commands, drv.send, drv.sleep, drv.measure, average=0.05, **pace)[1]
