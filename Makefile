@@ -15,7 +15,7 @@ help:
 	@echo "make test   - set up .venv, build, run cargo test and pytest"
 	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
 	@echo "make bench  - criterion and pytest-benchmark"
-	@echo "make docs   - regenerate the generated docs (docs/planning.md and its figures)"
+	@echo "make docs   - regenerate the generated docs (docs/planning.md, docs/experiments.md and their figures)"
 
 $(VENV)/.stamp: pyproject.toml
 	python3 -m venv $(VENV)
@@ -52,6 +52,7 @@ test: dev-all test-rust
 # them (tests/test_docs_current.py checks that their deterministic columns are current).
 docs: dev
 	$(PY) -m softarm.planning.report --out docs/planning.md
+	$(VENV)/bin/softarm experiment all --out docs/experiments --report docs/experiments.md -q
 
 demo: install
 	$(VENV)/bin/softarm demo
