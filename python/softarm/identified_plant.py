@@ -71,6 +71,14 @@ class IdentifiedPlant:
         return max(t + d for t, d in zip(self.tau_s, self.dead_time_s, strict=True))
 
     @property
+    def play_m(self) -> tuple[float, ...]:
+        """The play band widths in elongation (m): ``hysteresis_psi × metres_per_psi``
+        per channel (what the lag model's play operator needs)."""
+        return tuple(
+            w * k for w, k in zip(self.hysteresis_psi, self.metres_per_psi, strict=True)
+        )
+
+    @property
     def lag_periods(self) -> float:
         """:attr:`lag_s` in control periods (what a stability bound on the gain needs)."""
         return self.lag_s / self.control_period_s

@@ -144,3 +144,25 @@ def test_in_flight_is_what_the_lag_model_still_expects() -> None:
     clock.t = 0.05 + 5.0  # ten time constants later, nothing more sent
     np.testing.assert_allclose(act.in_flight(), 0.0, atol=1e-6)
     np.testing.assert_allclose(act.plant_q, q, atol=1e-6)
+
+
+def test_play_needs_the_lag_model_and_a_valid_width() -> None:
+    with pytest.raises(ParameterError, match="play_m"):
+        _actuator(play_m=0.002)
+    with pytest.raises(ParameterError, match="play_m"):
+        _actuator(lag=(0.5, 0.05), play_m=-0.002)
+
+
+def test_with_play_plant_q_counts_no_motion_inside_the_band() -> None:
+    # 5 psi of play (2.4 mm): risen and settled, a 1 mm step back is swallowed by the
+    # band, so nothing is in flight and plant_q is the command itself.
+    w = 5.0 * METRES_PER_PSI
+    act, clock = _actuator(rate=1000.0, lag=(0.05, 0.05), play_m=w)
+    q = np.full(3, 0.01)
+    for k in range(60):
+        clock.t = 0.05 * k
+        act.send(q)
+    clock.t = 0.05 * 60
+    back = q - 0.001
+    act.send(back)
+    np.testing.assert_allclose(act.plant_q, back, atol=1e-12)

@@ -73,3 +73,48 @@ def test_the_arm_arrives_before_the_measurement_shows_it() -> None:
     arm, measured = model.arm_in_flight()[0], model.in_flight()[0]
     assert arm == pytest.approx(0.01 * np.exp(-0.5 / 0.3), rel=1e-12)  # 0.5 s at tau 0.3 s
     assert 0.0 < arm < measured < 0.01
+
+
+def test_with_play_it_follows_the_simulated_regulators_and_play() -> None:
+    # The simulator's regulators, then its play operator (sim.hysteresis), fed the same
+    # commands: the model's measured output is the plant's elongation, to rounding.
+    from softarm.sim.hysteresis import PlayHysteresis
+
+    n, tau, period, width = 3, 0.3, 0.05, np.array([2.0, 5.0, 0.0])
+    rng = np.random.default_rng(2)
+    dyn = PressureDynamics(n, tau, 70.0)
+    play = PlayHysteresis(width)
+    model = MeasurementModel(n, tau, period, play_m=width)
+    for _ in range(400):
+        u = np.clip(dyn.pressure + rng.normal(0, 3.0, n), 0.0, 70.0)
+        truth = play(dyn.advance(u, period))
+        model.advance(u)
+        np.testing.assert_allclose(model.measured, truth, rtol=1e-9, atol=1e-9)
+
+
+def test_with_play_a_command_inside_the_band_has_nothing_in_flight() -> None:
+    """The play's closed form: risen to q, the arm sits w/2 below it; a command back
+    inside the band moves nothing; one beyond it moves the arm to the band's edge."""
+    model = MeasurementModel(1, 0.0, 0.05, play_m=2.0)
+    model.command(np.array([10.0]))
+    model.advance(np.array([10.0]))
+    assert model.measured[0] == pytest.approx(9.0)
+    assert model.in_flight()[0] == pytest.approx(0.0)
+    model.command(np.array([8.5]))  # down 1.5 < w: still in the band
+    assert model.in_flight()[0] == pytest.approx(0.0)
+    model.command(np.array([7.0]))  # down 3 > w: the arm follows to q + w/2
+    assert model.in_flight()[0] == pytest.approx(-1.0)
+    model.command(np.array([10.5]))  # up past where it sits: to q - w/2
+    assert model.in_flight()[0] == pytest.approx(0.5)
+    # Without play, the same commands are all in flight.
+    bare = MeasurementModel(1, 0.0, 0.05)
+    bare.command(np.array([10.0]))
+    bare.advance(np.array([10.0]))
+    bare.command(np.array([8.5]))
+    assert bare.in_flight()[0] == pytest.approx(-1.5)
+
+
+@pytest.mark.parametrize("play", [-1.0, np.nan, [1.0, 2.0], "wide"])
+def test_a_bad_play_width_names_itself(play: object) -> None:
+    with pytest.raises(ParameterError, match="play_m"):
+        MeasurementModel(3, 0.1, 0.05, play_m=play)  # type: ignore[arg-type]

@@ -53,6 +53,9 @@ class SafeActuator:
             commands through that lag. None: no prediction.
         sensor_lag_s: the time constant (s) of the pose measurement's own first-order
             filter, after the actuators (0: no filter).
+        play_m: the play band width (m of elongation; one, or one per channel) the lag
+            model puts between the regulators and the measurement (0: none; needs
+            ``lag``).
         lead: pre-compensation of the regulators' lag, ``k``: they are told
             ``q + k (q − ŷ)`` with ``ŷ`` the lag model's pressure, so that a first-order
             regulator approaches ``q`` ``1 + k`` times faster (``k ≤ a/(1 − a)``,
@@ -70,6 +73,7 @@ class SafeActuator:
         now: Callable[[], float] | None = None,
         sensor_lag_s: float = 0.0,
         lead: float = 0.0,
+        play_m: float | FloatArray = 0.0,
     ) -> None:
         self.bank = bank
         self.pressure_map = pressure_map or ElongationMap(max_psi=bank.max_pressure)
@@ -78,7 +82,9 @@ class SafeActuator:
             raise ParameterError("lag: needs the clock `now` to count periods")
         self._now = now
         self._sent = np.zeros(n)
-        self._model = None if lag is None else MeasurementModel(n, lag[0], lag[1], sensor_lag_s)
+        self._model = (
+            None if lag is None else MeasurementModel(n, lag[0], lag[1], sensor_lag_s, play_m)
+        )
         self._stamp = None if now is None else now()
         # What the regulators were told, boost included (the lag model's input).
         self._drive = np.zeros(n)
@@ -86,6 +92,8 @@ class SafeActuator:
             raise ParameterError(f"lead = {lead!r}: must be in [0, 20]")
         if lead > 0 and lag is None:
             raise ParameterError("lead: needs the lag model (`lag`)")
+        if np.any(np.asarray(play_m) != 0) and lag is None:
+            raise ParameterError("play_m: needs the lag model (`lag`)")
         self._lead = float(lead)
 
     @property

@@ -104,6 +104,7 @@ def build_hardware_rig(
             lag=lag,
             now=clock.now,
             sensor_lag_s=sensor_lag,
+            play_m=0.0 if identified is None else np.asarray(identified.play_m),
         )
         predicted = None if lag is None else (lambda: actuator.plant_q)
         if identified is not None and "hybrid_alpha" not in config.gains.values:

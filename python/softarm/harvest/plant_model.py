@@ -1,15 +1,21 @@
 """The controller's model of the measurement chain behind the actuator: what the measured
 pose will still do after the commands already sent (docs/control.md, section 6).
 
-    command ──regulators (first-order lag τ)──► elongation ──measurement (lag τ_m)──►
-    what the camera pipeline reports
+    command ──regulators (first-order lag τ)──► pressure ──play (band w)──► elongation
+            ──measurement (lag τ_m)──► what the camera pipeline reports
 
 Both lags are :class:`softarm.LagModel` (Rust). The loop needs the motion still *in
 flight*, ``q − ŷ``: where the last target puts the arm once everything sent has arrived,
 less what the measured pose reflects now. At rest ``ŷ = q``: nothing is in flight and
 the loop closes on the measured error alone, whatever the model's errors (a Smith
-predictor). The play hysteresis is not modelled: a model with it was tried and was worse
-(docs/control.md, section 6).
+predictor).
+
+With the play's band width known (declared or identified), a play operator sits between
+the regulators and the measurement, and the motion in flight is where the play's output
+ends once the regulators reach the last target, less ŷ. A command that stays inside the
+band then has nothing in flight: the loop goes on integrating at its full gain until the
+command leaves the band, and no longer counts the creep across the band as motion to
+come (docs/control.md, section 6).
 """
 
 from __future__ import annotations
@@ -60,6 +66,21 @@ def predicted_loop_alpha(lag_s: float) -> float:
     return float(np.clip(PREDICTED_ALPHA_LAG_S / lag_s, PREDICTED_ALPHA_MIN, PREDICTED_ALPHA_MAX))
 
 
+def _widths(play_m: float | npt.ArrayLike, n: int) -> FloatArray:
+    """``play_m`` as ``n`` band widths (m): one for every channel, or one per channel."""
+    try:
+        play = np.asarray(play_m, dtype=np.float64)
+    except (TypeError, ValueError):
+        play = np.full(1, np.nan)
+    if play.ndim == 0:
+        play = np.full(n, float(play))
+    if play.shape != (n,) or not np.all(np.isfinite(play)) or np.any(play < 0):
+        raise ParameterError(
+            f"play_m = {play_m!r}: must be one width or {n} widths (m), finite and >= 0"
+        )
+    return play
+
+
 class MeasurementModel:
     """Regulators' lag then the measurement's, per channel, in elongations (m).
 
@@ -68,14 +89,28 @@ class MeasurementModel:
         tau_s: the regulators' time constant (s, >= 0).
         period_s: the control period (s) each :meth:`advance` lasts.
         filter_s: the measurement's own lag (s, >= 0): a pose filter, a camera frame.
+        play_m: the actuators' play band width (m of elongation; one, or one per
+            channel; 0: none), between the regulators and the measurement, as the plant
+            has it (a play operator: the output moves only once the input is more than
+            half the band away).
     """
 
-    def __init__(self, n: int, tau_s: float, period_s: float, filter_s: float = 0.0) -> None:
+    def __init__(
+        self,
+        n: int,
+        tau_s: float,
+        period_s: float,
+        filter_s: float = 0.0,
+        play_m: float | npt.ArrayLike = 0.0,
+    ) -> None:
         for name, value in (("tau_s", tau_s), ("filter_s", filter_s)):
             if not (np.isfinite(value) and value >= 0):
                 raise ParameterError(f"{name} = {value!r}: must be finite and >= 0")
+        play = _widths(play_m, n)
         self.period = float(period_s)
+        self._half_play = 0.5 * play.copy()
         zeros = np.zeros(n)
+        self._arm = zeros.copy()  # the play's output: where the actuators are
         self._regulators = LagModel(tau_s, period_s, zeros) if tau_s > 0 else None
         self._filter = LagModel(filter_s, period_s, zeros) if filter_s > 0 else None
         self._pressure = zeros.copy()  # the regulators' output, as an elongation
@@ -89,7 +124,7 @@ class MeasurementModel:
     @property
     def measured(self) -> FloatArray:
         """What the measured pose reflects now (m): ŷ."""
-        return np.asarray(self._filter.q) if self._filter is not None else self._pressure.copy()
+        return np.asarray(self._filter.q) if self._filter is not None else self._arm.copy()
 
     def advance(self, drive: FloatArray) -> None:
         """One period with ``drive`` (m, the regulators' command, boost included) held."""
@@ -97,17 +132,23 @@ class MeasurementModel:
             self._pressure = np.asarray(self._regulators.advance(drive))
         else:
             self._pressure = np.asarray(drive, dtype=np.float64).copy()
+        h = self._half_play
+        self._arm = np.clip(self._arm, self._pressure - h, self._pressure + h)
         if self._filter is not None:
-            self._filter.advance(self._pressure)
+            self._filter.advance(self._arm)
 
     def command(self, target: FloatArray) -> None:
         """The q sent (m, without the boost): where the regulators are headed."""
         self._target = np.asarray(target, dtype=np.float64).copy()
 
     def in_flight(self) -> FloatArray:
-        """``q − ŷ`` (m): the motion the measured pose will still make once the
-        regulators reach the last target."""
-        return self._target - self.measured
+        """The motion (m) the measured pose will still make once the regulators reach the
+        last target: ``q − ŷ`` without play; with it, the play's output at the end of
+        that monotone approach, ``clip(arm, q − w/2, q + w/2)``, less ŷ (a command
+        inside the band moves nothing)."""
+        h = self._half_play
+        final = np.clip(self._arm, self._target - h, self._target + h)
+        return final - self.measured
 
     def arm_in_flight(self) -> FloatArray:
         """The motion (m) the actuators themselves will still make towards the last

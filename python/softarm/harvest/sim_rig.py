@@ -36,7 +36,7 @@ from softarm.harvest.vision_loop import CameraVision
 from softarm.identification.result import IdentifiedPlant
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
-from softarm.units import MAX_PSI
+from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
 
@@ -197,6 +197,12 @@ def build_sim_rig(
     # The plant's lag, measured by `softarm identify` when given, else declared by the
     # plant description (its regulators' time constant, as a datasheet states it).
     lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
+    # Its play, alike: the band width the lag model puts between regulators and arm.
+    play = (
+        o.plant.hysteresis_psi * METRES_PER_PSI
+        if o.identified is None
+        else np.asarray(o.identified.play_m)
+    )
     if o.lag_control not in ("predictor", "bound"):
         raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
     predict = o.lag_control == "predictor"
@@ -210,6 +216,7 @@ def build_sim_rig(
         now=clock.now,
         sensor_lag_s=sensor_lag,
         lead=lead_gain(lag, cfg.period) if predict else 0.0,
+        play_m=play if predict else 0.0,
     )
     if controller is None:
 
