@@ -74,9 +74,7 @@ class IdentifiedPlant:
     def play_m(self) -> tuple[float, ...]:
         """The play band widths in elongation (m): ``hysteresis_psi × metres_per_psi``
         per channel (what the lag model's play operator needs)."""
-        return tuple(
-            w * k for w, k in zip(self.hysteresis_psi, self.metres_per_psi, strict=True)
-        )
+        return tuple(w * k for w, k in zip(self.hysteresis_psi, self.metres_per_psi, strict=True))
 
     @property
     def lag_periods(self) -> float:
