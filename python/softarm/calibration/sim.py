@@ -60,6 +60,15 @@ class PlantDriver:
         return self.last
 
 
+def _pace(config: PlantConfig, lag_s: float, settle: float | None) -> dict[str, float]:
+    """:func:`~softarm.calibration.collect.paced_for` a chain lagging ``lag_s`` with
+    ``config``'s play; ``settle`` (s), when given, replaces the paced hold."""
+    pace = paced_for(lag_s, config.play_m)
+    if settle is not None:
+        pace["settle"] = settle
+    return pace
+
+
 def calibrate_plant(
     plant: object,
     config: PlantConfig,
@@ -78,9 +87,7 @@ def calibrate_plant(
     filter) and play (:func:`~softarm.calibration.collect.paced_for`); ``settle`` (s),
     when given, replaces the paced hold at each pose."""
     filter_s = 0.0 if config.cutoff is None else 1.0 / config.cutoff
-    pace = paced_for(config.pressure_tau + filter_s, config.hysteresis_psi * METRES_PER_PSI)
-    if settle is not None:
-        pace["settle"] = settle
+    pace = _pace(config, config.pressure_tau + filter_s, settle)
     tracker = PoseTracker(
         np.random.default_rng(seed), config.position_noise, config.angle_noise, config.cutoff
     )
@@ -99,8 +106,6 @@ def true_poses(
     for ``config``'s regulator lag and play (no tracker, so no filter lag); ``settle``
     (s), when given, replaces the paced hold. A fixed hold would leave a slow plant
     short of its poses, and the held-out reference with it."""
-    pace = paced_for(config.pressure_tau, config.hysteresis_psi * METRES_PER_PSI)
-    if settle is not None:
-        pace["settle"] = settle
+    pace = _pace(config, config.pressure_tau, settle)
     drv = PlantDriver(plant, None)
     return collect(commands, drv.send, drv.sleep, drv.measure, average=0.05, **pace)[1]

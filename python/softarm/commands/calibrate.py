@@ -9,8 +9,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from softarm.errors import HardwareUnavailableError
 
 if TYPE_CHECKING:
@@ -110,14 +108,7 @@ def _hardware(args: argparse.Namespace, progress: Progress) -> Calibration | Non
     nominal = SoftArm([Section(**vars(s)) for s in config.arm.sections])
     # Holds paced for the identified plant ([plant_model]) when there is one.
     identified = identified_from_config(config, args.config)
-    pace = (
-        {}
-        if identified is None
-        else paced_for(
-            identified.lag_s,
-            float(np.max(np.multiply(identified.hysteresis_psi, identified.metres_per_psi))),
-        )
-    )
+    pace = {} if identified is None else paced_for(identified.lag_s, max(identified.play_m))
     try:
         rig = build_hardware_rig(config)
     except HardwareUnavailableError as exc:

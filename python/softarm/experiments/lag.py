@@ -70,7 +70,10 @@ def controller(name: str, model: object, tau_total: float, period: float) -> Res
     """The hybrid resolver of one controller (see the module docs)."""
     if name == "today":
         # Before the lag bound and the closed-loop damping.
-        gains = Gains(lag_periods=0.0, loop_damping=0.02, loop_singular_threshold=0.05)
+        d = Gains()
+        gains = d.replace(
+            lag_periods=0.0, loop_damping=d.damping, loop_singular_threshold=d.singular_threshold
+        )
     elif name == "default":
         gains = Gains()
     elif name == MODEL_DAMPING:

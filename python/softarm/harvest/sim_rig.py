@@ -36,7 +36,7 @@ from softarm.harvest.vision_loop import CameraVision
 from softarm.identification.result import IdentifiedPlant
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
-from softarm.units import MAX_PSI, METRES_PER_PSI
+from softarm.units import MAX_PSI
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
 
@@ -198,11 +198,7 @@ def build_sim_rig(
     # plant description (its regulators' time constant, as a datasheet states it).
     lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
     # Its play, alike: the band width the lag model puts between regulators and arm.
-    play = (
-        o.plant.hysteresis_psi * METRES_PER_PSI
-        if o.identified is None
-        else np.asarray(o.identified.play_m)
-    )
+    play = o.plant.play_m if o.identified is None else np.asarray(o.identified.play_m)
     if o.lag_control not in ("predictor", "bound"):
         raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
     predict = o.lag_control == "predictor"

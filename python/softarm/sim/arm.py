@@ -76,6 +76,12 @@ class PlantConfig:
         :class:`~softarm.errors.ParameterError` naming ``where.key``."""
         return plant_from_mapping(mapping, where=where)
 
+    @property
+    def play_m(self) -> float:
+        """The declared play band width in elongation (m): ``hysteresis_psi`` at the
+        nominal :data:`~softarm.units.METRES_PER_PSI` (what a lag model's play needs)."""
+        return self.hysteresis_psi * METRES_PER_PSI
+
 
 def perturbed_arm(nominal: SoftArm, rng: np.random.Generator, config: PlantConfig) -> SoftArm:
     """A copy of ``nominal`` with every section's geometry perturbed (see PlantConfig)."""
