@@ -180,6 +180,8 @@ HARVEST_BAD = [
     ("period = 'fast'", "harvest.period must be a finite number, got 'fast'"),
     ("period = true", "harvest.period must be a finite number"),
     ("settle_steps = 2.5", "harvest.settle_steps must be an integer >= 1"),
+    ("reapproaches = -1", "harvest.reapproaches must be an integer >= 0, got -1"),
+    ("reapproaches = true", "harvest.reapproaches must be an integer >= 0"),
     ("approach = [1, 1, 0]", "harvest.approach must be a unit vector"),
     ("approach = [0, 1]", "harvest.approach must be a unit vector"),
     ("approach_cone_deg = 90", "harvest.approach_cone_deg must be in [0, 90)"),

@@ -44,6 +44,11 @@ class HarvestConfig:
         stall_time: saturated for this long (s) without ``stall_progress`` (m) of
             improvement → UNREACHABLE.
         stall_progress: see ``stall_time``.
+        reapproaches: how many times a berry the arm could not reach along its planned
+            axis (saturated on the joint limits short of the grasp workspace) is tried
+            again along another axis of the cone, after backing out home: the plan is
+            the model's, and the true arm, a few % off it, may need a channel past its
+            limit for one axis and not for another. 0: the first such stall faults.
         ripeness_threshold: below it a grasped berry is unripe and released.
         home_speed: elongation rate (m/s) of the plan's feedforward and the open-loop
             moves to the ready pose: 0.045 m/s is 94.5 psi/s, inside the safety layer's
@@ -70,6 +75,7 @@ class HarvestConfig:
     home_timeout: float = 10.0
     stall_time: float = 3.0
     stall_progress: float = 0.002
+    reapproaches: int = 1
     ripeness_threshold: float = 0.5
     home_speed: float = 0.045
     home_elongation: float = 0.0167
@@ -99,9 +105,10 @@ class HarvestConfig:
             and abs(float(np.linalg.norm(a)) - 1.0) <= 1e-9
         ):
             raise ParameterError(f"approach must be a unit vector (3 numbers), got {a!r}")
-        n = self.settle_steps
-        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
-            raise ParameterError(f"settle_steps must be an integer >= 1, got {n!r}")
+        for name, least in (("settle_steps", 1), ("reapproaches", 0)):
+            n = getattr(self, name)
+            if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < least:
+                raise ParameterError(f"{name} must be an integer >= {least}, got {n!r}")
 
     @property
     def approach_axis(self) -> np.ndarray:

@@ -38,3 +38,27 @@ def test_a_grasp_on_the_joint_limits_is_tried_before_giving_up() -> None:
     for q_way in waypoints:
         assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
         start = q_way
+
+
+def test_an_avoided_axis_is_not_planned_again_and_the_next_plan_is_as_clear() -> None:
+    planner, q, current, bush = _scene(limit_room=0.001)
+    berry = bush.berries[0].position
+    first = planner.plan(q, berry, current)
+    assert first is not None
+    second = planner.plan(q, berry, current, avoid=[first[1]])
+    assert second is not None
+    waypoints, axis = second
+    assert float(axis @ first[1]) < np.cos(np.radians(1.0))  # another axis of the cone
+    assert np.degrees(np.arccos(np.clip(axis @ np.array([0.0, 1.0, 0.0]), -1, 1))) <= 20.0 + 1e-9
+    start = q
+    for q_way in waypoints:
+        assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
+        start = q_way
+
+
+def test_avoiding_every_axis_of_the_cone_leaves_no_plan() -> None:
+    from softarm.geometry import cone_axes
+
+    planner, q, current, bush = _scene(limit_room=0.001)
+    every = cone_axes(planner.cfg.approach_axis, planner.cfg.approach_cone_deg)
+    assert planner.plan(q, bush.berries[0].position, current, avoid=list(every)) is None

@@ -109,7 +109,7 @@ class _Planner:
     def __init__(self, waypoints, axis) -> None:
         self.waypoints, self.axis, self.calls = waypoints, axis, 0
 
-    def plan(self, q, berry, current):
+    def plan(self, q, berry, current, avoid=()):
         self.calls += 1
         return None if self.waypoints is None else (self.waypoints, self.axis)
 

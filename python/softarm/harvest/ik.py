@@ -15,6 +15,8 @@ along the final approach to the berry and at the grasp.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import numpy.typing as npt
 
@@ -81,7 +83,11 @@ class ModelIK:
         self.limit_room = limit_room
 
     def plan(
-        self, q: FloatArray, berry: FloatArray, current: FloatArray
+        self,
+        q: FloatArray,
+        berry: FloatArray,
+        current: FloatArray,
+        avoid: Sequence[FloatArray] = (),
     ) -> tuple[list[FloatArray], FloatArray] | None:
         """``(waypoints, axis)`` for the squarest reachable approach whose ramp is clear:
         straight to the pre-grasp pose if possible, else via a pose ``via`` further back
@@ -90,7 +96,14 @@ class ModelIK:
         and ramps ``ramp_margin`` from the canes; then grasps ``limit_room`` from the
         limits; then a via half as far back; then grasps on the limits. Every pass keeps
         the same cane margins. A berry with no such plan is UNREACHABLE: brushing a cane
-        open loop is not worth one berry."""
+        open loop is not worth one berry. The axes in ``avoid`` (within 1°) are skipped:
+        the true arm could not reach the berry along them."""
+        tried = np.asarray(avoid, dtype=np.float64).reshape(-1, 3)
+        axes = [
+            a
+            for a in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg)
+            if not np.any(tried @ a > np.cos(np.radians(1.0)))
+        ]
         passes = [  # (joint-limit room at the grasp, gap along the ramps, via points)
             (3 * self.limit_room, self.ramp_margin, (None, self.via)),
             (self.limit_room, self.ramp_margin, (None, self.via)),
@@ -103,7 +116,7 @@ class ModelIK:
         ]
         for room, ramp, vias in passes:
             for via in vias:
-                for axis in cone_axes(self.cfg.approach_axis, self.cfg.approach_cone_deg):
+                for axis in axes:
                     path = self._path(q, berry, current, axis, via, room, ramp)
                     if path is not None:
                         return path, axis

@@ -15,6 +15,7 @@ The vision's vocabulary (``BerryTarget``, ``BerryFix``, ``Observation``) is defi
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Protocol
 
 import numpy as np
@@ -88,12 +89,17 @@ class PlacementPlanner(Protocol):
     """Plans initial placement on the controller's model before the loop closes."""
 
     def plan(
-        self, q: FloatArray, berry: FloatArray, current: FloatArray
+        self,
+        q: FloatArray,
+        berry: FloatArray,
+        current: FloatArray,
+        avoid: Sequence[FloatArray] = (),
     ) -> tuple[list[FloatArray], FloatArray] | None:
         """``(waypoints, approach_axis)``: elongations (m) to ramp through, the last one
         putting the gripper at the pre-grasp pose of the berry at ``berry`` (base frame),
         and the unit axis it approaches along; None when nothing in the allowed cone is
-        reachable (clear of known obstacles)."""
+        reachable (clear of known obstacles). The axes in ``avoid`` (tried already, and
+        the true arm could not reach the berry along them) are not used again."""
         ...
 
 

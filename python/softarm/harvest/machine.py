@@ -130,7 +130,6 @@ class HarvestMachine:
         start = self.clock.now()
         watch = BerryWatch(self.vision, self.clock, berry, self.log, self.config.marker_timeout)
         self.axis = self.config.approach_axis
-        waypoints: tuple[FloatArray, ...] = ()
         servo = self.servo
         self._transition(S.IDLE, berry, "new berry")
         try:
@@ -138,10 +137,7 @@ class HarvestMachine:
             self.q = servo.ramp(watch, self.state, self.q, self.home)
             servo.wait_visible(watch, self.state, self.q)
             self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
-            placed = servo.place(watch, self.state, self.q, self.axis, self.planner)
-            self.q, self.axis, waypoints = placed.q, placed.axis, placed.waypoints
-            self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
-            self.q = servo.fine(watch, self.state, self.q, self.axis).q
+            waypoints = self._reach(watch, berry)
             self._record_grasp_errors(berry, result)
             if not grasp:
                 self._transition(S.DONE, berry, "positioned; no grasp requested")
@@ -171,6 +167,45 @@ class HarvestMachine:
             self.log.event("crash", berry=berry.tag_id, error=repr(exc))
             raise
         return self._finish(result, watch, start)
+
+    def _reach(self, watch: BerryWatch, berry: BerryTarget) -> tuple[FloatArray, ...]:
+        """INITIAL_PLACEMENT then FINE_POSITIONING (the grasp point onto the berry);
+        returns the placement plan's waypoints, the way back out.
+
+        A plan is the model's: the true arm, a few % off it, may need a channel past its
+        joint limit to reach the berry along the planned axis, and then the loop saturates
+        short of it. Such a stall (not a lost marker, not a timeout) backs the arm out
+        home the way it came and plans again along another axis of the cone, up to
+        ``reapproaches`` times; then it is the berry's fault (UNREACHABLE)."""
+        tried: list[FloatArray] = []
+        while True:
+            waypoints: tuple[FloatArray, ...] = ()
+            self.axis = self.config.approach_axis
+            if self.planner is not None:
+                waypoints, self.axis = self.servo.plan(watch, self.q, self.planner, tried)
+            try:
+                placed = self.servo.place(watch, self.state, self.q, self.axis, waypoints)
+                self.q = placed.q
+                self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
+                self.q = self.servo.fine(watch, self.state, self.q, self.axis).q
+                return waypoints
+            except Fault as fault:
+                if (
+                    fault.stalled_at is None
+                    or not waypoints
+                    or len(tried) >= self.config.reapproaches
+                ):
+                    raise
+                tried.append(self.axis)
+                self.q = fault.stalled_at
+                self._transition(S.RETURN_HOME, berry, f"re-approach: {fault}")
+                self.q = self.servo.go_home(
+                    watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
+                )
+                self.servo.wait_visible(watch, self.state, self.q)
+                self._transition(
+                    S.INITIAL_PLACEMENT, berry, f"re-approach {len(tried)}: another axis"
+                )
 
     def _finish(self, result: BerryResult, watch: BerryWatch, start: float) -> BerryResult:
         """Record what the stages observed, the final state and the time into ``result``."""

@@ -13,11 +13,16 @@ __all__ = ["Ending", "Fault", "StageOutcome"]
 
 
 class Fault(Exception):
-    """Raised inside a stage to enter the safe state for ``reason``."""
+    """Raised inside a stage to enter the safe state for ``reason``. ``stalled_at``: the
+    commanded elongations of a closed loop that saturated without progress (the machine
+    may back out from there and re-approach); None for every other fault."""
 
-    def __init__(self, reason: FaultReason, detail: str) -> None:
+    def __init__(
+        self, reason: FaultReason, detail: str, stalled_at: FloatArray | None = None
+    ) -> None:
         super().__init__(detail)
         self.reason = reason
+        self.stalled_at = stalled_at
 
 
 class Ending(StrEnum):

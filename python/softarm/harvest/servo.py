@@ -4,6 +4,7 @@ position, go home. Each step reads the cameras, checks them, logs, and commands 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -58,39 +59,47 @@ class Servo:
                 return
             self._hold(q)
 
+    def plan(
+        self,
+        watch: BerryWatch,
+        q: FloatArray,
+        planner: PlacementPlanner,
+        avoid: Sequence[FloatArray] = (),
+    ) -> tuple[tuple[FloatArray, ...], FloatArray]:
+        """INITIAL_PLACEMENT, first: solve the pre-grasp pose (and the approach axis,
+        inside the allowed cone, none of ``avoid``) on the model, holding ``q`` until the
+        cube and the berry are seen. Returns the plan's waypoints and its axis; no plan
+        is UNREACHABLE."""
+        seen = watch.observe()
+        while seen.pose is None or seen.fix is None:
+            self._hold(q)
+            seen = watch.observe()
+        plan = planner.plan(q, seen.fix.position, seen.pose, avoid)
+        if plan is None:
+            raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
+        planned, axis = plan
+        self.log.event("plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position)
+        return tuple(planned), axis
+
     def place(
         self,
         watch: BerryWatch,
         stage: HarvestState,
         q: FloatArray,
         axis: FloatArray,
-        planner: PlacementPlanner | None,
+        waypoints: tuple[FloatArray, ...] = (),
     ) -> StageOutcome:
         """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose,
         approaching along ``axis``.
 
-        With a ``planner`` the pose (and the approach axis, inside the allowed cone) is
-        first solved on the model; the plan's waypoints are then followed in closed loop
-        (:meth:`follow`, the canes repelling inside the resolver) and the loop closes on
-        the berry (eq. 22) to remove the model's error. The outcome carries the axis and
-        the waypoints used.
-        """
+        A plan's ``waypoints`` (:meth:`plan`) are first followed in closed loop
+        (:meth:`follow`, the canes repelling inside the resolver), then the loop closes
+        on the berry (eq. 22) to remove the model's error. The outcome carries the axis
+        and the waypoints used."""
         c = self.cfg
         start = self.clock.now()
-        waypoints: tuple[FloatArray, ...] = ()
-        if planner is not None:
-            seen = watch.observe()
-            while seen.pose is None or seen.fix is None:
-                self._hold(q)
-                seen = watch.observe()
-            plan = planner.plan(q, seen.fix.position, seen.pose)
-            if plan is None:
-                raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
-            planned, axis = plan
-            waypoints = tuple(planned)
-            self.log.event("plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position)
-            for q_way in planned:
-                q = self.follow(watch, stage, q, q_way, start + c.placement_timeout)
+        for q_way in waypoints:
+            q = self.follow(watch, stage, q, q_way, start + c.placement_timeout)
         out = self._servo(
             watch, stage, q, axis, c.grasp_offset + c.standoff, c.placement_tolerance,
             c.placement_timeout, None, record_errors=True, placed_on_limit=True,
@@ -353,6 +362,7 @@ class Servo:
                     FaultReason.UNREACHABLE,
                     f"{stage.value}: saturated at error {err:.4f} m, "
                     f"pointing {np.degrees(ang):.1f} deg",
+                    stalled_at=q,
                 )
             watch.log_step(stage, seen, q_next, goal, (err, ang), saturated)
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.

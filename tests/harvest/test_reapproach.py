@@ -1,0 +1,120 @@
+"""Re-approach: a berry the arm saturated short of along its planned axis is backed out
+from and planned again along another axis of the cone (HarvestConfig.reapproaches)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from softarm.harvest import BerryTarget, FaultReason, HarvestConfig, HarvestState
+from softarm.harvest.states import FAULTS_THAT_STOP
+
+from .fakes import BERRIES, FakeController, make_rig
+
+S = HarvestState
+SQUARE = np.array([0.0, 1.0, 0.0])
+TILTED = np.array([0.0, np.cos(np.radians(2.0)), np.sin(np.radians(2.0))])
+
+
+class AxisBoundController(FakeController):
+    """The fake arm, except that along the ``blocked`` approach axes (the target's z axis)
+    it stays where it is, saturated: as a true arm that needs a channel past its limit to
+    face the berry that way."""
+
+    def __init__(self, blocked: list[np.ndarray], only_at: np.ndarray | None = None) -> None:
+        super().__init__()
+        self.blocked, self.only_at = blocked, only_at
+
+    def step(self, q, target, current):
+        near = self.only_at is None or _grasp_goal_near(target, self.only_at)
+        if near and any(float(target[:3, 2] @ a) > np.cos(np.radians(0.5)) for a in self.blocked):
+            return np.array(q, dtype=np.float64), True
+        return super().step(q, target, current)
+
+
+def _grasp_goal_near(target: np.ndarray, berry: np.ndarray) -> bool:
+    """Whether ``target`` puts the grasp point (3 cm ahead) on ``berry``: fine positioning."""
+    return bool(np.linalg.norm(target[:3, 3] + 0.03 * target[:3, 2] - berry) < 1e-3)
+
+
+class AxisPlanner:
+    """Plans one waypoint along the first of ``axes`` not avoided; records ``avoid``."""
+
+    def __init__(self, axes: list[np.ndarray]) -> None:
+        self.axes, self.avoided = axes, []
+
+    def plan(self, q, berry, current, avoid=()):
+        self.avoided.append([np.asarray(a) for a in avoid])
+        for axis in self.axes:
+            if not any(float(axis @ a) > np.cos(np.radians(1.0)) for a in avoid):
+                return [np.full(3, 0.01)], axis
+        return None
+
+
+def _rig(
+    blocked: list[np.ndarray],
+    config: HarvestConfig | None = None,
+    only_at: np.ndarray | None = None,
+):
+    rig = make_rig(config=config)
+    planner = AxisPlanner([SQUARE, TILTED])
+    rig.machine.planner = planner
+    rig.machine.servo.controller = AxisBoundController(blocked, only_at)
+    return rig, planner
+
+
+def test_a_stall_on_the_planned_axis_backs_out_home_and_reapproaches_along_another() -> None:
+    rig, planner = _rig([SQUARE])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and result.fault is None
+    assert rig.transitions(1) == [
+        S.IDLE, S.INITIAL_PLACEMENT, S.RETURN_HOME, S.INITIAL_PLACEMENT,
+        S.FINE_POSITIONING, S.GRASP, S.RETURN_HOME, S.DONE,
+    ]  # fmt: skip
+    assert len(planner.avoided) == 2 and not planner.avoided[0]
+    assert np.allclose(planner.avoided[1], [SQUARE])
+    assert np.allclose(rig.machine.axis, TILTED)
+    assert [v.reason for v in rig.bank.vent_log] == ["startup"]  # backed out, never vented
+    why = [r["why"] for r in rig.machine.log.records if r["kind"] == "transition"]
+    assert any(w.startswith("re-approach: initial_placement: saturated") for w in why)
+
+
+def test_a_stall_in_fine_positioning_reapproaches_from_home() -> None:
+    rig, planner = _rig([SQUARE], only_at=BERRIES[1])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested
+    assert rig.transitions(1) == [
+        S.IDLE, S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.RETURN_HOME, S.INITIAL_PLACEMENT,
+        S.FINE_POSITIONING, S.GRASP, S.RETURN_HOME, S.DONE,
+    ]  # fmt: skip
+    assert np.allclose(planner.avoided[1], [SQUARE])
+    assert result.position_error_mm <= 1.0  # the errors of the attempt that grasped
+
+
+def test_with_no_reapproaches_the_first_stall_is_unreachable() -> None:
+    config = HarvestConfig(marker_timeout=0.5, stall_time=1.0, reapproaches=0)
+    rig, planner = _rig([SQUARE], config)
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.UNREACHABLE
+    assert rig.transitions(1) == [S.IDLE, S.INITIAL_PLACEMENT, S.FAULT]
+    assert len(planner.avoided) == 1 and rig.vented()
+
+
+def test_a_stall_on_every_planned_axis_faults_unreachable_after_the_reapproaches() -> None:
+    rig, planner = _rig([SQUARE, TILTED])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.UNREACHABLE
+    assert FaultReason.UNREACHABLE not in FAULTS_THAT_STOP  # the run goes on
+    assert rig.transitions(1) == [
+        S.IDLE, S.INITIAL_PLACEMENT, S.RETURN_HOME, S.INITIAL_PLACEMENT, S.FAULT,
+    ]  # fmt: skip
+    assert len(planner.avoided) == 2 and rig.vented()
+
+
+def test_no_axis_left_to_try_is_unreachable() -> None:
+    rig, planner = _rig([SQUARE])
+    planner.axes = [SQUARE]  # the cone holds nothing else
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.UNREACHABLE
+    fault = next(r for r in rig.machine.log.records if r["kind"] == "fault")
+    assert fault["detail"] == "no pre-grasp pose in the approach cone"
+    assert rig.vented()
