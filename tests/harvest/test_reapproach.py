@@ -95,7 +95,7 @@ def test_with_no_reapproaches_the_first_stall_is_unreachable() -> None:
     rig, planner = _rig([SQUARE], config)
     result = rig.machine.run_berry(BerryTarget(1))
     assert result.fault is FaultReason.UNREACHABLE
-    assert rig.transitions(1) == [S.IDLE, S.INITIAL_PLACEMENT, S.FAULT]
+    assert rig.transitions(1) == [S.IDLE, S.INITIAL_PLACEMENT, S.RETURN_HOME, S.FAULT]
     assert len(planner.avoided) == 1 and rig.vented()
 
 
@@ -105,7 +105,8 @@ def test_a_stall_on_every_planned_axis_faults_unreachable_after_the_reapproaches
     assert result.fault is FaultReason.UNREACHABLE
     assert FaultReason.UNREACHABLE not in FAULTS_THAT_STOP  # the run goes on
     assert rig.transitions(1) == [
-        S.IDLE, S.INITIAL_PLACEMENT, S.RETURN_HOME, S.INITIAL_PLACEMENT, S.FAULT,
+        S.IDLE, S.INITIAL_PLACEMENT, S.RETURN_HOME, S.INITIAL_PLACEMENT, S.RETURN_HOME,
+        S.FAULT,
     ]  # fmt: skip
     assert len(planner.avoided) == 2 and rig.vented()
 

@@ -174,9 +174,10 @@ class HarvestMachine:
 
         A plan is the model's: the true arm, a few % off it, may need a channel past its
         joint limit to reach the berry along the planned axis, and then the loop saturates
-        short of it. Such a stall (not a lost marker, not a timeout) backs the arm out
-        home the way it came and plans again along another axis of the cone, up to
-        ``reapproaches`` times; then it is the berry's fault (UNREACHABLE)."""
+        short of it. Such a stall backs the arm out home the way it came and plans again
+        along another axis of the cone, up to ``reapproaches`` times. A last stall, or a
+        time-out, also backs out before the fault: vented in the bush, the arm would
+        relax to its rest shape through the canes."""
         tried: list[FloatArray] = []
         while True:
             waypoints: tuple[FloatArray, ...] = ()
@@ -190,18 +191,26 @@ class HarvestMachine:
                 self.q = self.servo.fine(watch, self.state, self.q, self.axis).q
                 return waypoints
             except Fault as fault:
-                if (
-                    fault.stalled_at is None
-                    or not waypoints
-                    or len(tried) >= self.config.reapproaches
-                ):
+                if fault.retreat_from is None:
+                    raise
+                again = (
+                    fault.reason is FaultReason.UNREACHABLE
+                    and self.planner is not None
+                    and len(tried) < self.config.reapproaches
+                )
+                self.q = fault.retreat_from
+                why = "re-approach" if again else "backing out before the fault"
+                self._transition(S.RETURN_HOME, berry, f"{why}: {fault}")
+                try:
+                    self.q = self.servo.go_home(
+                        watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
+                    )
+                except Fault as failed:
+                    self.log.event("retreat_failed", t=self.clock.now(), detail=str(failed))
+                    raise fault from failed
+                if not again:
                     raise
                 tried.append(self.axis)
-                self.q = fault.stalled_at
-                self._transition(S.RETURN_HOME, berry, f"re-approach: {fault}")
-                self.q = self.servo.go_home(
-                    watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
-                )
                 self.servo.wait_visible(watch, self.state, self.q)
                 self._transition(
                     S.INITIAL_PLACEMENT, berry, f"re-approach {len(tried)}: another axis"

@@ -13,16 +13,17 @@ __all__ = ["Ending", "Fault", "StageOutcome"]
 
 
 class Fault(Exception):
-    """Raised inside a stage to enter the safe state for ``reason``. ``stalled_at``: the
-    commanded elongations of a closed loop that saturated without progress (the machine
-    may back out from there and re-approach); None for every other fault."""
+    """Raised inside a stage to enter the safe state for ``reason``. ``retreat_from``: the
+    commanded elongations at which a closed loop gave up on the berry, the arm sound (a
+    stall on the joint limits, a time-out): the machine backs out the way it came from
+    there before it vents, and after a stall may re-approach. None: vent where it is."""
 
     def __init__(
-        self, reason: FaultReason, detail: str, stalled_at: FloatArray | None = None
+        self, reason: FaultReason, detail: str, retreat_from: FloatArray | None = None
     ) -> None:
         super().__init__(detail)
         self.reason = reason
-        self.stalled_at = stalled_at
+        self.retreat_from = retreat_from
 
 
 class Ending(StrEnum):

@@ -216,6 +216,7 @@ class Servo:
                 raise Fault(
                     FaultReason.TIMEOUT,
                     f"{stage.value}: waypoint not reached, error {err:.4f} m",
+                    retreat_from=q,
                 )
             goal = model_pose(nominal)
             step_fn = getattr(self.controller, "follow_step", self.controller.step)
@@ -337,6 +338,7 @@ class Servo:
                 raise Fault(
                     FaultReason.TIMEOUT,
                     f"{stage.value}: error {err:.4f} m after {elapsed:.1f} s",
+                    retreat_from=q,
                 )
             q_next, saturated = self.controller.step(q, goal, seen.pose)
             q_next = np.asarray(q_next, dtype=np.float64)
@@ -362,7 +364,7 @@ class Servo:
                     FaultReason.UNREACHABLE,
                     f"{stage.value}: saturated at error {err:.4f} m, "
                     f"pointing {np.degrees(ang):.1f} deg",
-                    stalled_at=q,
+                    retreat_from=q,
                 )
             watch.log_step(stage, seen, q_next, goal, (err, ang), saturated)
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.
