@@ -35,7 +35,8 @@ class HarvestConfig:
             (section IV-E reports 0.75 ± 0.36 mm; 0.5 mm here, as the measured error
             stops the loop and the true one lands around it).
         grasp_workspace: error (m) the gripper still grasps at (±1 cm, section III-D);
-            used only when fine positioning runs out of time.
+            used only when fine positioning runs out of time or stalls on a joint limit
+            (see ``reapproaches``).
         settle_steps: consecutive steps within tolerance before moving on (noise).
         marker_timeout: how long (s) the cube or the berry may stay unseen (beyond the
             locator's own hold of the last target) before MARKER_LOST.
@@ -48,7 +49,10 @@ class HarvestConfig:
             axis (saturated on the joint limits short of the grasp workspace) is tried
             again along another axis of the cone, after backing out home: the plan is
             the model's, and the true arm, a few % off it, may need a channel past its
-            limit for one axis and not for another. 0: the first such stall faults.
+            limit for one axis and not for another. In fine positioning a stall counts
+            when it is farther than ``stall_progress`` from the berry; nearer, or on the
+            last attempt within ``grasp_workspace``, the gripper grasps. 0: no second
+            attempt.
         ripeness_threshold: below it a grasped berry is unripe and released.
         home_speed: elongation rate (m/s) of the plan's feedforward and the open-loop
             moves to the ready pose: 0.045 m/s is 94.5 psi/s, inside the safety layer's

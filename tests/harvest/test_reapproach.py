@@ -20,13 +20,17 @@ class AxisBoundController(FakeController):
     it stays where it is, saturated: as a true arm that needs a channel past its limit to
     face the berry that way."""
 
-    def __init__(self, blocked: list[np.ndarray], only_at: np.ndarray | None = None) -> None:
+    def __init__(
+        self, blocked: list[np.ndarray], only_at: np.ndarray | None = None, short: float = 0.0
+    ) -> None:
         super().__init__()
-        self.blocked, self.only_at = blocked, only_at
+        self.blocked, self.only_at, self.short = blocked, only_at, short
 
     def step(self, q, target, current):
         near = self.only_at is None or _grasp_goal_near(target, self.only_at)
-        if near and any(float(target[:3, 2] @ a) > np.cos(np.radians(0.5)) for a in self.blocked):
+        left = float(np.linalg.norm(target[:3, 3] - current[:3, 3]))
+        blocked = any(float(target[:3, 2] @ a) > np.cos(np.radians(0.5)) for a in self.blocked)
+        if near and blocked and (self.short == 0 or left <= self.short):  # held short of it
             return np.array(q, dtype=np.float64), True
         return super().step(q, target, current)
 
@@ -54,11 +58,12 @@ def _rig(
     blocked: list[np.ndarray],
     config: HarvestConfig | None = None,
     only_at: np.ndarray | None = None,
+    short: float = 0.0,
 ):
     rig = make_rig(config=config)
     planner = AxisPlanner([SQUARE, TILTED])
     rig.machine.planner = planner
-    rig.machine.servo.controller = AxisBoundController(blocked, only_at)
+    rig.machine.servo.controller = AxisBoundController(blocked, only_at, short)
     return rig, planner
 
 
@@ -88,6 +93,30 @@ def test_a_stall_in_fine_positioning_reapproaches_from_home() -> None:
     ]  # fmt: skip
     assert np.allclose(planner.avoided[1], [SQUARE])
     assert result.position_error_mm <= 1.0  # the errors of the attempt that grasped
+
+
+def test_a_stall_inside_the_gripper_workspace_reapproaches_while_it_can() -> None:
+    # Stuck 5 mm short of the berry (inside the gripper's 1 cm, outside stall_progress):
+    # another axis first; the grasp on the limit only on the last attempt.
+    rig, planner = _rig([SQUARE], only_at=BERRIES[1], short=0.005)
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and len(planner.avoided) == 2
+    assert result.position_error_mm <= 1.0
+    assert not any(r["kind"] == "limit_grasp" for r in rig.machine.log.records)
+
+    config = HarvestConfig(marker_timeout=0.5, stall_time=1.0, reapproaches=0)
+    rig, planner = _rig([SQUARE], config, only_at=BERRIES[1], short=0.005)
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and len(planner.avoided) == 1
+    assert 2.0 < result.position_error_mm <= 5.0
+    assert any(r["kind"] == "limit_grasp" for r in rig.machine.log.records)
+
+
+def test_a_stall_within_stall_progress_grasps_without_a_reapproach() -> None:
+    rig, planner = _rig([SQUARE], only_at=BERRIES[1], short=0.0015)
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and len(planner.avoided) == 1
+    assert any(r["kind"] == "limit_grasp" for r in rig.machine.log.records)
 
 
 def test_with_no_reapproaches_the_first_stall_is_unreachable() -> None:

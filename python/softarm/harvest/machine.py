@@ -16,7 +16,11 @@ Per berry::
 
 Every transition is logged (and fsync'd) with its reason. A fault vents every channel at
 once, logs the reason, and ends the berry in FAULT; :data:`~softarm.harvest.states.
-FAULTS_THAT_STOP` also end the run, the others go on with the next berry.
+FAULTS_THAT_STOP` also end the run, the others go on with the next berry. A closed loop
+that gives up on the berry with the arm sound (saturated on the joint limits short of it,
+or out of time) first backs out home the way it came (RETURN_HOME), so that the vent does
+not relax the arm through the canes; after a stall it re-approaches along another axis
+(``HarvestConfig.reapproaches``) before it faults.
 """
 
 from __future__ import annotations
@@ -174,8 +178,9 @@ class HarvestMachine:
 
         A plan is the model's: the true arm, a few % off it, may need a channel past its
         joint limit to reach the berry along the planned axis, and then the loop saturates
-        short of it. Such a stall backs the arm out home the way it came and plans again
-        along another axis of the cone, up to ``reapproaches`` times. A last stall, or a
+        short of it. Such a stall (in fine positioning, one farther than
+        ``stall_progress`` from the berry) backs the arm out home the way it came and
+        plans again along another axis of the cone, up to ``reapproaches`` times. A last stall, or a
         time-out, also backs out before the fault: vented in the bush, the arm would
         relax to its rest shape through the canes."""
         tried: list[FloatArray] = []
@@ -188,7 +193,8 @@ class HarvestMachine:
                 placed = self.servo.place(watch, self.state, self.q, self.axis, waypoints)
                 self.q = placed.q
                 self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
-                self.q = self.servo.fine(watch, self.state, self.q, self.axis).q
+                more = self.planner is not None and len(tried) < self.config.reapproaches
+                self.q = self.servo.fine(watch, self.state, self.q, self.axis, more).q
                 return waypoints
             except Fault as fault:
                 if fault.retreat_from is None:
