@@ -49,10 +49,10 @@ class HarvestConfig:
             axis (saturated on the joint limits short of the grasp workspace) is tried
             again along another axis of the cone, after backing out home: the plan is
             the model's, and the true arm, a few % off it, may need a channel past its
-            limit for one axis and not for another. In fine positioning a stall counts
-            when it is farther than ``stall_progress`` from the berry; nearer, or on the
-            last attempt within ``grasp_workspace``, the gripper grasps. 0: no second
-            attempt.
+            limit for one axis and not for another. In fine positioning a stall, or the
+            end of ``fine_budget``, counts when it is farther than ``stall_progress``
+            from the berry; nearer, or on the last attempt within ``grasp_workspace``,
+            the gripper grasps. 0: no second attempt.
         ripeness_threshold: below it a grasped berry is unripe and released.
         home_speed: elongation rate (m/s) of the plan's feedforward and the open-loop
             moves to the ready pose: 0.045 m/s is 94.5 psi/s, inside the safety layer's

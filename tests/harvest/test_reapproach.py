@@ -21,17 +21,22 @@ class AxisBoundController(FakeController):
     face the berry that way."""
 
     def __init__(
-        self, blocked: list[np.ndarray], only_at: np.ndarray | None = None, short: float = 0.0
+        self,
+        blocked: list[np.ndarray],
+        only_at: np.ndarray | None = None,
+        short: float = 0.0,
+        saturated: bool = True,
     ) -> None:
         super().__init__()
         self.blocked, self.only_at, self.short = blocked, only_at, short
+        self.saturated = saturated
 
     def step(self, q, target, current):
         near = self.only_at is None or _grasp_goal_near(target, self.only_at)
         left = float(np.linalg.norm(target[:3, 3] - current[:3, 3]))
         blocked = any(float(target[:3, 2] @ a) > np.cos(np.radians(0.5)) for a in self.blocked)
         if near and blocked and (self.short == 0 or left <= self.short):  # held short of it
-            return np.array(q, dtype=np.float64), True
+            return np.array(q, dtype=np.float64), self.saturated
         return super().step(q, target, current)
 
 
@@ -110,6 +115,26 @@ def test_a_stall_inside_the_gripper_workspace_reapproaches_while_it_can() -> Non
     assert result.harvested and len(planner.avoided) == 1
     assert 2.0 < result.position_error_mm <= 5.0
     assert any(r["kind"] == "limit_grasp" for r in rig.machine.log.records)
+
+
+def test_the_end_of_the_fine_budget_far_from_the_berry_reapproaches_while_it_can() -> None:
+    # Held 5 mm short without saturating (a slow creep): at the budget, another axis.
+    config = HarvestConfig(marker_timeout=0.5, stall_time=1.0, fine_budget=2.0)
+    rig, planner = _rig([SQUARE], config, only_at=BERRIES[1], short=0.005)
+    rig.machine.servo.controller.saturated = False
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and len(planner.avoided) == 2
+    assert result.position_error_mm <= 1.0
+    why = [r["why"] for r in rig.machine.log.records if r["kind"] == "transition"]
+    assert any("after the 2 s budget" in w for w in why)
+
+    config = HarvestConfig(marker_timeout=0.5, stall_time=1.0, fine_budget=2.0, reapproaches=0)
+    rig, planner = _rig([SQUARE], config, only_at=BERRIES[1], short=0.005)
+    rig.machine.servo.controller.saturated = False
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and len(planner.avoided) == 1
+    assert 2.0 < result.position_error_mm <= 5.0
+    assert any(r["kind"] == "fine_budget" for r in rig.machine.log.records)
 
 
 def test_a_stall_within_stall_progress_grasps_without_a_reapproach() -> None:

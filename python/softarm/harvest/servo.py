@@ -116,15 +116,16 @@ class Servo:
     ) -> StageOutcome:
         """FINE_POSITIONING: grasp point onto the berry (eye-in-hand, eq. 21).
 
-        Saturated on a joint limit without progress, it grasps inside the gripper's ±1 cm
-        (III-D); when the machine can still ``reapproach`` along another axis, only
-        within ``stall_progress``, the stall rule's own resolution: farther out the stall
-        is UNREACHABLE here, and the machine tries the other axis."""
+        Saturated on a joint limit without progress, or past ``fine_budget``, it grasps
+        inside the gripper's ±1 cm (III-D); when the machine can still ``reapproach``
+        along another axis, only within ``stall_progress``, the stall rule's own
+        resolution: farther out it is UNREACHABLE here, and the machine tries the other
+        axis."""
         c = self.cfg
         return self._servo(
             watch, stage, q, axis, c.grasp_offset, c.fine_tolerance, c.fine_timeout,
             c.fine_budget, record_errors=True, placed_on_limit=False,
-            limit_grasp_within=c.stall_progress if reapproach else c.grasp_workspace,
+            grasp_within=c.stall_progress if reapproach else c.grasp_workspace,
         )  # fmt: skip
 
     def go_home(
@@ -301,15 +302,18 @@ class Servo:
         record_errors: bool,
         placed_on_limit: bool,
         frozen: FloatArray | None = None,
-        limit_grasp_within: float = 0.0,
+        grasp_within: float = 0.0,
     ) -> StageOutcome:
         """Drive the end effector to ``distance`` short of the berry along the approach
         ``axis`` until the error stays below ``tol``; see :class:`HarvestConfig`. With
         ``frozen`` the berry position is that fixed point, not the cameras' (the berry is
         in the fingers on the way back). With ``record_errors`` every step keeps its errors
         at the grasp in ``watch``; with ``placed_on_limit`` a saturated arm within ``tol``
-        hands over (:attr:`Ending.PLACEMENT_LIMIT`) instead of faulting; with a ``budget``
-        one within ``limit_grasp_within`` grasps (:attr:`Ending.LIMIT_GRASP`)."""
+        hands over (:attr:`Ending.PLACEMENT_LIMIT`) instead of faulting. With a ``budget``
+        the gripper grasps within ``grasp_within`` when the arm stalls on a limit
+        (:attr:`Ending.LIMIT_GRASP`) or the budget runs out (:attr:`Ending.BUDGET`); past
+        the budget, farther out but inside ``grasp_workspace``, it is UNREACHABLE (the
+        machine re-approaches)."""
         c = self.cfg
         start = self.clock.now()
         watch.excuse_berry(start)  # the open-loop ramp needed no berry
@@ -344,6 +348,12 @@ class Servo:
                 watch.log_step(stage, seen, q, goal, (err, ang), False)
                 return StageOutcome(q, Ending.SETTLED, axis)
             if budget is not None and elapsed > budget and err <= c.grasp_workspace:
+                if err > grasp_within:  # another axis is left to try
+                    raise Fault(
+                        FaultReason.UNREACHABLE,
+                        f"{stage.value}: error {err:.4f} m after the {budget:.0f} s budget",
+                        retreat_from=q,
+                    )
                 self.log.event("fine_budget", t=seen.t, error=err)
                 watch.log_step(stage, seen, q, goal, (err, ang), False)
                 return StageOutcome(q, Ending.BUDGET, axis)
@@ -364,7 +374,7 @@ class Servo:
                 saturated_since is not None
                 and min(seen.t - saturated_since, seen.t - best_t) > c.stall_time
             ):
-                if budget is not None and err <= limit_grasp_within:
+                if budget is not None and err <= grasp_within:
                     # On a joint limit but inside the gripper's ±1 cm: grasp (III-D).
                     self.log.event("limit_grasp", t=seen.t, error=err)
                     return StageOutcome(q, Ending.LIMIT_GRASP, axis)
