@@ -33,11 +33,7 @@ def test_a_grasp_on_the_joint_limits_is_tried_before_giving_up() -> None:
     assert plan is not None
     waypoints, axis = plan
     assert np.degrees(np.arccos(np.clip(axis @ np.array([0.0, 1.0, 0.0]), -1, 1))) <= 20.0 + 1e-9
-    # The canes keep the ramps' margin on every waypoint's ramp.
-    start = q
-    for q_way in waypoints:
-        assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
-        start = q_way
+    _assert_ramps_clear(planner, q, waypoints)
 
 
 def test_an_avoided_axis_is_not_planned_again_and_the_next_plan_is_as_clear() -> None:
@@ -50,10 +46,7 @@ def test_an_avoided_axis_is_not_planned_again_and_the_next_plan_is_as_clear() ->
     waypoints, axis = second
     assert float(axis @ first[1]) < np.cos(np.radians(1.0))  # another axis of the cone
     assert np.degrees(np.arccos(np.clip(axis @ np.array([0.0, 1.0, 0.0]), -1, 1))) <= 20.0 + 1e-9
-    start = q
-    for q_way in waypoints:
-        assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
-        start = q_way
+    _assert_ramps_clear(planner, q, waypoints)
 
 
 def test_avoiding_every_axis_of_the_cone_leaves_no_plan() -> None:
@@ -62,3 +55,11 @@ def test_avoiding_every_axis_of_the_cone_leaves_no_plan() -> None:
     planner, q, current, bush = _scene(limit_room=0.001)
     every = cone_axes(planner.cfg.approach_axis, planner.cfg.approach_cone_deg)
     assert planner.plan(q, bush.berries[0].position, current, avoid=list(every)) is None
+
+
+def _assert_ramps_clear(planner: ModelIK, q: np.ndarray, waypoints: list[np.ndarray]) -> None:
+    """The canes keep the ramps' margin on every waypoint's ramp, from ``q`` on."""
+    start = q
+    for q_way in waypoints:
+        assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
+        start = q_way

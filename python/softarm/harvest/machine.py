@@ -189,21 +189,17 @@ class HarvestMachine:
             self.axis = self.config.approach_axis
             if self.planner is not None:
                 waypoints, self.axis = self.servo.plan(watch, self.q, self.planner, tried)
+            more = self.planner is not None and len(tried) < self.config.reapproaches
             try:
                 placed = self.servo.place(watch, self.state, self.q, self.axis, waypoints)
                 self.q = placed.q
                 self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
-                more = self.planner is not None and len(tried) < self.config.reapproaches
                 self.q = self.servo.fine(watch, self.state, self.q, self.axis, more).q
                 return waypoints
             except Fault as fault:
                 if fault.retreat_from is None:
                     raise
-                again = (
-                    fault.reason is FaultReason.UNREACHABLE
-                    and self.planner is not None
-                    and len(tried) < self.config.reapproaches
-                )
+                again = more and fault.reason is FaultReason.UNREACHABLE
                 self.q = fault.retreat_from
                 why = "re-approach" if again else "backing out before the fault"
                 self._transition(S.RETURN_HOME, berry, f"{why}: {fault}")
