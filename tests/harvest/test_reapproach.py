@@ -18,31 +18,37 @@ TILTED = np.array([0.0, np.cos(np.radians(2.0)), np.sin(np.radians(2.0))])
 class AxisBoundController(FakeController):
     """The fake arm, except that along the ``blocked`` approach axes (the target's z axis)
     it stays where it is, saturated: as a true arm that needs a channel past its limit to
-    face the berry that way."""
+    face the berry that way. With ``only_at`` a berry, only in fine positioning on it;
+    with ``short`` (m), only that far from the target; each one for all the blocked axes
+    or a list with one per axis."""
 
     def __init__(
         self,
         blocked: list[np.ndarray],
-        only_at: np.ndarray | None = None,
-        short: float = 0.0,
+        only_at: np.ndarray | list[np.ndarray | None] | None = None,
+        short: float | list[float] = 0.0,
         saturated: bool = True,
     ) -> None:
         super().__init__()
-        self.blocked, self.only_at, self.short = blocked, only_at, short
+        self.blocked = blocked
+        self.only_at = only_at if isinstance(only_at, list) else [only_at] * len(blocked)
+        self.short = short if isinstance(short, list) else [short] * len(blocked)
         self.saturated = saturated
 
     def step(self, q, target, current):
-        near = self.only_at is None or _grasp_goal_near(target, self.only_at)
         left = float(np.linalg.norm(target[:3, 3] - current[:3, 3]))
-        blocked = any(float(target[:3, 2] @ a) > np.cos(np.radians(0.5)) for a in self.blocked)
-        if near and blocked and (self.short == 0 or left <= self.short):  # held short of it
-            return np.array(q, dtype=np.float64), self.saturated
+        for axis, at, short in zip(self.blocked, self.only_at, self.short, strict=True):
+            near = at is None or _grasp_goal_near(target, current, at)
+            blocked = float(target[:3, 2] @ axis) > np.cos(np.radians(0.5))
+            if near and blocked and (short == 0 or left <= short):  # held short of it
+                return np.array(q, dtype=np.float64), self.saturated
         return super().step(q, target, current)
 
 
-def _grasp_goal_near(target: np.ndarray, berry: np.ndarray) -> bool:
-    """Whether ``target`` puts the grasp point (3 cm ahead) on ``berry``: fine positioning."""
-    return bool(np.linalg.norm(target[:3, 3] + 0.03 * target[:3, 2] - berry) < 1e-3)
+def _grasp_goal_near(target: np.ndarray, current: np.ndarray, berry: np.ndarray) -> bool:
+    """Whether ``target`` puts the grasp point (3 cm ahead along the current z axis, as
+    ``tool_pose`` does) on ``berry``: fine positioning."""
+    return bool(np.linalg.norm(target[:3, 3] + 0.03 * current[:3, 2] - berry) < 1e-3)
 
 
 class AxisPlanner:
@@ -62,8 +68,8 @@ class AxisPlanner:
 def _rig(
     blocked: list[np.ndarray],
     config: HarvestConfig | None = None,
-    only_at: np.ndarray | None = None,
-    short: float = 0.0,
+    only_at: np.ndarray | list[np.ndarray | None] | None = None,
+    short: float | list[float] = 0.0,
 ):
     rig = make_rig(config=config)
     planner = AxisPlanner([SQUARE, TILTED])
@@ -173,3 +179,51 @@ def test_no_axis_left_to_try_is_unreachable() -> None:
     fault = next(r for r in rig.machine.log.records if r["kind"] == "fault")
     assert fault["detail"] == "no pre-grasp pose in the approach cone"
     assert rig.vented()
+
+
+def test_a_last_axis_that_ends_farther_out_comes_back_to_the_nearest_attempt() -> None:
+    # Square stalls 4 mm short in fine positioning, the tilted axis 8 mm: both inside the
+    # gripper's 1 cm. The arm comes back along the square plan (no new plan) and grasps.
+    rig, planner = _rig([SQUARE, TILTED], only_at=BERRIES[1], short=[0.004, 0.008])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and result.fault is None
+    assert rig.transitions(1) == [
+        S.IDLE, S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.RETURN_HOME,
+        S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.RETURN_HOME,
+        S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.GRASP, S.RETURN_HOME, S.DONE,
+    ]  # fmt: skip
+    assert len(planner.avoided) == 2  # the third attempt reuses the first plan
+    assert np.allclose(rig.machine.axis, SQUARE)
+    assert 2.0 < result.position_error_mm <= 5.0
+    why = [r["why"] for r in rig.machine.log.records if r["kind"] == "transition"]
+    assert any(w.startswith("back to the nearest attempt: fine_positioning") for w in why)
+    assert any(w.startswith("back to the axis that ended 3.") for w in why)
+    assert [v.reason for v in rig.bank.vent_log] == ["startup"]
+
+
+def test_a_last_axis_that_ends_nearer_grasps_there() -> None:
+    rig, planner = _rig([SQUARE, TILTED], only_at=BERRIES[1], short=[0.008, 0.004])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and len(planner.avoided) == 2
+    assert np.allclose(rig.machine.axis, TILTED)
+    assert 2.0 < result.position_error_mm <= 5.0
+    assert rig.transitions(1).count(S.INITIAL_PLACEMENT) == 2
+
+
+def test_a_last_axis_that_stalls_in_placement_comes_back_to_a_graspable_attempt() -> None:
+    # Before the memory of attempts this berry was UNREACHABLE: the square axis ended
+    # 4 mm off in fine positioning (graspable), the tilted one stalled in placement.
+    rig, planner = _rig([SQUARE, TILTED], only_at=[BERRIES[1], None], short=[0.004, 0.0])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and result.fault is None
+    assert np.allclose(rig.machine.axis, SQUARE) and len(planner.avoided) == 2
+    assert 2.0 < result.position_error_mm <= 5.0
+    assert rig.transitions(1).count(S.INITIAL_PLACEMENT) == 3
+
+
+def test_without_a_graspable_attempt_the_last_stall_is_unreachable() -> None:
+    # The square axis stalled 2 cm off (outside the gripper's reach): nothing to come back to.
+    rig, _ = _rig([SQUARE, TILTED], only_at=[BERRIES[1], None], short=[0.02, 0.0])
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.UNREACHABLE
+    assert rig.transitions(1).count(S.INITIAL_PLACEMENT) == 2 and rig.vented()

@@ -26,6 +26,7 @@ not relax the arm through the canes; after a stall it re-approaches along anothe
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -180,28 +181,55 @@ class HarvestMachine:
         joint limit to reach the berry along the planned axis, and then the loop saturates
         short of it. Such a stall (in fine positioning, one farther than
         ``stall_progress`` from the berry) backs the arm out home the way it came and
-        plans again along another axis of the cone, up to ``reapproaches`` times. A last stall, or a
-        time-out, also backs out before the fault: vented in the bush, the arm would
-        relax to its rest shape through the canes."""
+        plans again along another axis of the cone, up to ``reapproaches`` times. The
+        last new axis grasps only if it ends no farther from the berry than the nearest
+        earlier stall inside the gripper's reach; else the arm comes back to that one's
+        plan and grasps where it ends. A last stall, or a time-out, also backs out
+        before the fault: vented in the bush, the arm would relax to its rest shape
+        through the canes."""
+        c = self.config
         tried: list[FloatArray] = []
+        nearest: _Attempt | None = None  # the fine-positioning stall nearest the berry
+        back_to: _Attempt | None = None  # coming back to it
         while True:
             waypoints: tuple[FloatArray, ...] = ()
-            self.axis = self.config.approach_axis
-            if self.planner is not None:
+            self.axis = c.approach_axis
+            if back_to is not None:
+                waypoints, self.axis = back_to.waypoints, back_to.axis
+            elif self.planner is not None:
                 waypoints, self.axis = self.servo.plan(watch, self.q, self.planner, tried)
-            more = self.planner is not None and len(tried) < self.config.reapproaches
+            more = back_to is None and self.planner is not None and len(tried) < c.reapproaches
+            if more:
+                grasp_within = c.stall_progress  # the stall rule's resolution: try another
+            elif back_to is None and nearest is not None:
+                grasp_within = nearest.grasp_error  # no worse than the nearest attempt
+            else:
+                grasp_within = c.grasp_workspace
             try:
                 placed = self.servo.place(watch, self.state, self.q, self.axis, waypoints)
                 self.q = placed.q
                 self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
-                self.q = self.servo.fine(watch, self.state, self.q, self.axis, more).q
+                self.q = self.servo.fine(watch, self.state, self.q, self.axis, grasp_within).q
                 return waypoints
             except Fault as fault:
                 if fault.retreat_from is None:
                     raise
-                again = more and fault.reason is FaultReason.UNREACHABLE
+                stalled = fault.reason is FaultReason.UNREACHABLE
+                error = fault.grasp_error
+                if stalled and error is not None and error <= c.grasp_workspace:
+                    if nearest is None or error < nearest.grasp_error:
+                        nearest = _Attempt(error, self.axis, waypoints)
+                again = stalled and (more or (back_to is None and nearest is not None))
+                if again and not more:
+                    back_to = nearest
+                why = (
+                    "backing out before the fault"
+                    if not again
+                    else "re-approach"
+                    if more
+                    else "back to the nearest attempt"
+                )
                 self.q = fault.retreat_from
-                why = "re-approach" if again else "backing out before the fault"
                 self._transition(S.RETURN_HOME, berry, f"{why}: {fault}")
                 try:
                     self.q = self.servo.go_home(
@@ -212,10 +240,15 @@ class HarvestMachine:
                     raise fault from failed
                 if not again:
                     raise
-                tried.append(self.axis)
+                if back_to is None:
+                    tried.append(self.axis)
                 self.servo.wait_visible(watch, self.state, self.q)
                 self._transition(
-                    S.INITIAL_PLACEMENT, berry, f"re-approach {len(tried)}: another axis"
+                    S.INITIAL_PLACEMENT,
+                    berry,
+                    f"re-approach {len(tried)}: another axis"
+                    if back_to is None
+                    else f"back to the axis that ended {1e3 * back_to.grasp_error:.1f} mm off",
                 )
 
     def _finish(self, result: BerryResult, watch: BerryWatch, start: float) -> BerryResult:
@@ -279,3 +312,13 @@ class HarvestMachine:
             vented = False
         self.q = np.zeros_like(self.q)
         self.log.event("vent", t=self.clock.now(), reason=reason, ok=vented)
+
+
+@dataclass(frozen=True)
+class _Attempt:
+    """An approach that stalled in fine positioning ``grasp_error`` (m) from the berry,
+    inside the gripper's reach: its ``axis`` and placement ``waypoints``, to come back to."""
+
+    grasp_error: float
+    axis: FloatArray
+    waypoints: tuple[FloatArray, ...]

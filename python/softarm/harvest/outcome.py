@@ -16,14 +16,21 @@ class Fault(Exception):
     """Raised inside a stage to enter the safe state for ``reason``. ``retreat_from``: the
     commanded elongations at which a closed loop gave up on the berry, the arm sound (a
     stall on the joint limits, a time-out): the machine backs out the way it came from
-    there before it vents, and after a stall may re-approach. None: vent where it is."""
+    there before it vents, and after a stall may re-approach. None: vent where it is.
+    ``grasp_error``: in fine positioning, how far (m) the grasp point was from the berry
+    when the loop gave up (the machine may come back to its nearest attempt); else None."""
 
     def __init__(
-        self, reason: FaultReason, detail: str, retreat_from: FloatArray | None = None
+        self,
+        reason: FaultReason,
+        detail: str,
+        retreat_from: FloatArray | None = None,
+        grasp_error: float | None = None,
     ) -> None:
         super().__init__(detail)
         self.reason = reason
         self.retreat_from = retreat_from
+        self.grasp_error = grasp_error
 
 
 class Ending(StrEnum):

@@ -112,20 +112,19 @@ class Servo:
         stage: HarvestState,
         q: FloatArray,
         axis: FloatArray,
-        reapproach: bool = False,
+        grasp_within: float | None = None,
     ) -> StageOutcome:
         """FINE_POSITIONING: grasp point onto the berry (eye-in-hand, eq. 21).
 
         Saturated on a joint limit without progress, or past ``fine_budget``, it grasps
-        inside the gripper's ±1 cm (III-D); when the machine can still ``reapproach``
-        along another axis, only within ``stall_progress``, the stall rule's own
-        resolution: farther out it is UNREACHABLE here, and the machine tries the other
-        axis."""
+        inside the gripper's ±1 cm (III-D), or only within ``grasp_within`` (m) when the
+        machine has a better use for the arm (another axis to try, an earlier attempt
+        that ended nearer): farther out it is UNREACHABLE here, with the error."""
         c = self.cfg
         return self._servo(
             watch, stage, q, axis, c.grasp_offset, c.fine_tolerance, c.fine_timeout,
             c.fine_budget, record_errors=True, placed_on_limit=False,
-            grasp_within=c.stall_progress if reapproach else c.grasp_workspace,
+            grasp_within=c.grasp_workspace if grasp_within is None else grasp_within,
         )  # fmt: skip
 
     def go_home(
@@ -353,6 +352,7 @@ class Servo:
                         FaultReason.UNREACHABLE,
                         f"{stage.value}: error {err:.4f} m after the {budget:.0f} s budget",
                         retreat_from=q,
+                        grasp_error=err,
                     )
                 self.log.event("fine_budget", t=seen.t, error=err)
                 watch.log_step(stage, seen, q, goal, (err, ang), False)
@@ -388,6 +388,7 @@ class Servo:
                     f"{stage.value}: saturated at error {err:.4f} m, "
                     f"pointing {np.degrees(ang):.1f} deg",
                     retreat_from=q,
+                    grasp_error=err if budget is not None else None,
                 )
             watch.log_step(stage, seen, q_next, goal, (err, ang), saturated)
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.
