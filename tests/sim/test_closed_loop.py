@@ -113,3 +113,18 @@ def test_default_gains_converge_next_to_the_joint_limits_through_play() -> None:
     assert damped.reached and damped.ripple_mm < 0.3 and damped.outside == 0, damped
     undamped = run(Gains(loop_damping=0.02, loop_singular_threshold=0.05))
     assert not undamped.reached and undamped.ripple_mm > 0.8, undamped
+
+
+def test_a_corner_of_the_joint_limits_is_told_apart_from_a_loop_failure() -> None:
+    """The default loop's small gain settles, 18 cm off, in a corner of the joint limits
+    (seven channels on a limit) that ``Resolver.solve``'s larger steps cross: the same
+    gains closed on the exact model, lag-free, settle there too, so the lag experiment
+    counts it as a trap of the controller's own path (``on_model`` False), not as a
+    failure of the loop on the lagging plant. Seed 45, plant 7002 (diagnosed there)."""
+    cfg = PlantConfig(pressure_tau=0.3, hysteresis_psi=lag.HYSTERESIS_PSI)
+    case = lag.cases(cfg, targets=3, seed=45, plant_seed=7000)[2]
+    assert case.plant_seed == 7002
+    run = lag.run_one("default", SimulatedArm(config=cfg, seed=7002), case.target, case.q0, 30.0)
+    assert not run.reached and not run.on_model and run.final_mm > 100.0, run
+    quick = lag.run_one("today", SimulatedArm(config=cfg, seed=7002), case.target, case.q0, 30.0)
+    assert quick.on_model, quick  # alpha = 0.3 crosses the corner on the model
