@@ -219,3 +219,10 @@ def make_rig(log: HarvestLog | None = None, config: HarvestConfig | None = None)
         log=log,
     )
     return Rig(clock, plant, backend, bank, tracker, locator, gripper, ripeness, machine)
+
+
+def commanded_before_the_vent(rig) -> list[float]:
+    """The q of the last step logged before the fault's vent."""
+    records = rig.machine.log.records
+    at = next(i for i, r in enumerate(records) if r["kind"] == "vent")
+    return next(r["q"] for r in reversed(records[:at]) if r["kind"] == "step")

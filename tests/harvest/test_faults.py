@@ -8,7 +8,7 @@ import pytest
 from softarm.errors import HardwareError, HardwareUnavailableError
 from softarm.harvest import BerryTarget, FaultReason, HarvestLog, HarvestState, read_log
 
-from .fakes import make_rig
+from .fakes import commanded_before_the_vent, make_rig
 
 S = HarvestState
 
@@ -145,3 +145,29 @@ def test_a_dead_daq_that_cannot_vent_is_logged_as_such() -> None:
     assert failed and "could not vent" in failed[0]["error"]
     vent = next(r for r in rig.machine.log.records if r["kind"] == "vent")
     assert vent["ok"] is False  # the log says so: only the hardware e-stop can help now
+
+
+def test_a_cube_lost_in_the_bush_backs_out_open_loop_before_the_vent() -> None:
+    # The eye-to-hand camera stops in fine positioning: no pose to servo the back-out
+    # on, so the arm ramps home the planned way, open loop, and vents there.
+    rig = make_rig()
+    rig.tracker.blind = lambda t: t >= 0.8
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.MARKER_LOST
+    assert rig.transitions(1)[-3:] == [S.FINE_POSITIONING, S.RETURN_HOME, S.FAULT]
+    incomplete = [r for r in rig.machine.log.records if r["kind"] == "retreat_incomplete"]
+    assert len(incomplete) == 1 and "cube not seen" in incomplete[0]["detail"]
+    assert commanded_before_the_vent(rig) == rig.machine.home.tolist()
+    assert rig.vented() and "marker_lost" in rig.bank.vent_log[-1].reason
+
+
+def test_a_berry_lost_in_the_bush_backs_out_on_the_cube_before_the_vent() -> None:
+    rig = make_rig()
+    rig.locator.hidden = lambda t: t >= 0.7
+    rig.locator.max_age = 0.1
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.fault is FaultReason.MARKER_LOST
+    assert rig.transitions(1)[-3:] == [S.FINE_POSITIONING, S.RETURN_HOME, S.FAULT]
+    assert not any(r["kind"] == "retreat_incomplete" for r in rig.machine.log.records)
+    assert commanded_before_the_vent(rig) == rig.machine.home.tolist()
+    assert rig.vented()

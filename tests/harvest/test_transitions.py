@@ -10,7 +10,7 @@ from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest import BerryTarget, FaultReason, HarvestConfig, HarvestState
 from softarm.harvest.targets import grasp_point
 
-from .fakes import BERRIES, make_rig
+from .fakes import BERRIES, commanded_before_the_vent, make_rig
 
 S = HarvestState
 HAPPY = [S.IDLE, S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.GRASP, S.RETURN_HOME, S.DONE]
@@ -62,7 +62,7 @@ def test_unreachable_berry_faults_vents_and_the_run_goes_on() -> None:
     assert first.fault is FaultReason.UNREACHABLE and first.final_state is S.FAULT
     # Backed out home before the vent: the arm relaxes from the ready pose, not in the bush.
     assert rig.transitions(3) == [S.IDLE, S.INITIAL_PLACEMENT, S.RETURN_HOME, S.FAULT]
-    assert _commanded_before_the_vent(rig) == rig.machine.home.tolist()
+    assert commanded_before_the_vent(rig) == rig.machine.home.tolist()
     assert "unreachable" in rig.bank.vent_log[1].reason
     assert second.harvested and report.stopped is None
     assert report.success_rate == 0.5
@@ -73,13 +73,13 @@ def test_timeout_in_fine_positioning_faults_and_vents() -> None:
     result = rig.machine.run_berry(BerryTarget(1))
     assert result.fault is FaultReason.TIMEOUT
     assert rig.transitions(1)[-3:] == [S.FINE_POSITIONING, S.RETURN_HOME, S.FAULT]
-    assert _commanded_before_the_vent(rig) == rig.machine.home.tolist()
+    assert commanded_before_the_vent(rig) == rig.machine.home.tolist()
     assert rig.vented()
 
 
 def test_a_retreat_that_fails_vents_where_it_is_with_the_first_fault() -> None:
     config = HarvestConfig(
-        fine_timeout=0.3, fine_budget=0.2, grasp_workspace=1e-4, home_timeout=0.1
+        fine_timeout=0.3, fine_budget=0.2, grasp_workspace=1e-4, home_timeout=0.01
     )
     rig = make_rig(config=config)
     result = rig.machine.run_berry(BerryTarget(1))
@@ -87,15 +87,8 @@ def test_a_retreat_that_fails_vents_where_it_is_with_the_first_fault() -> None:
     fault = next(r for r in rig.machine.log.records if r["kind"] == "fault")
     assert fault["detail"].startswith("fine_positioning: error")
     assert any(r["kind"] == "retreat_failed" for r in rig.machine.log.records)
-    assert _commanded_before_the_vent(rig) != rig.machine.home.tolist()
+    assert commanded_before_the_vent(rig) != rig.machine.home.tolist()
     assert rig.vented()
-
-
-def _commanded_before_the_vent(rig) -> list[float]:
-    """The q of the last step logged before the fault's vent."""
-    records = rig.machine.log.records
-    at = next(i for i, r in enumerate(records) if r["kind"] == "vent")
-    return next(r["q"] for r in reversed(records[:at]) if r["kind"] == "step")
 
 
 def test_fine_budget_grasps_within_the_gripper_workspace() -> None:

@@ -16,6 +16,7 @@ from softarm.harvest.interfaces import (
     Clock,
     Controller,
     FloatArray,
+    Observation,
     PlacementPlanner,
     PressureActuator,
 )
@@ -157,11 +158,19 @@ class Servo:
                 frozen=berry,
             ).q
         except Fault as fault:
-            # Backing out is best effort: the berry is already in the fingers, and the
-            # ramp home is open loop anyway.
-            if fault.reason not in (FaultReason.TIMEOUT, FaultReason.UNREACHABLE):
+            # Backing out is best effort: the berry is already in the fingers (or the
+            # machine is backing out of a fault), and the ramp home is open loop anyway.
+            # With the cube lost it is the only way out: vented in the bush, the arm
+            # would relax to its rest shape through the canes.
+            if fault.reason not in (
+                FaultReason.TIMEOUT,
+                FaultReason.UNREACHABLE,
+                FaultReason.MARKER_LOST,
+            ):
                 raise
             self.log.event("retreat_incomplete", t=self.clock.now(), detail=str(fault))
+            if fault.retreat_from is not None:  # where the loop left the arm
+                q = fault.retreat_from
         # Leave by the planned way in (checked against the known canes), reversed. The
         # first is the plan's pre-grasp q, a few mm of elongation from where the back-out
         # left the arm: the ramp on from it need not wait for the arm to settle there.
@@ -200,7 +209,7 @@ class Servo:
         goal_final = model_pose(q_way)
         best, best_t = np.inf, self.clock.now()
         while True:
-            seen = watch.observe(need_fix=False)
+            seen = self._look(watch, q, need_fix=False)
             if seen.pose is None:
                 watch.log_step(stage, seen, q, None, None, False)
                 self._hold(q)
@@ -265,7 +274,7 @@ class Servo:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: ramp not done in time")
             q = q + np.clip(goal - q, -step, step)
             self.actuator.send(q)
-            seen = watch.observe(need_fix=False) if observe else watch.blind()
+            seen = self._look(watch, q, need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
         # An open-loop ramp ends where the arm is, not where it was told to be: on a
@@ -275,10 +284,20 @@ class Servo:
             if self.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: arm not settled in time")
             self.actuator.send(q)
-            seen = watch.observe(need_fix=False) if observe else watch.blind()
+            seen = self._look(watch, q, need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
         return q
+
+    def _look(self, watch: BerryWatch, q: FloatArray, need_fix: bool) -> Observation:
+        """``watch.observe``; a marker lost while the arm is out in the bush at ``q``
+        carries ``q`` as the place to back out from (open loop if the cube is gone)."""
+        try:
+            return watch.observe(need_fix=need_fix)
+        except Fault as fault:
+            if fault.reason is FaultReason.MARKER_LOST and fault.retreat_from is None:
+                fault.retreat_from = q
+            raise
 
     def _arrived(self) -> bool:
         """Whether the lag model (if any) has every actuator within ``arrival_tolerance``
@@ -320,7 +339,7 @@ class Servo:
         best, best_t, saturated_since = np.inf, start, None
         angle_tol = np.radians(c.angle_tolerance_deg)
         while True:
-            seen = watch.observe(need_fix=frozen is None)
+            seen = self._look(watch, q, need_fix=frozen is None)
             if frozen is not None:
                 seen = replace(seen, fix=BerryFix(frozen, "held", seen.t - start))
             elapsed = seen.t - start
