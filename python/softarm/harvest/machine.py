@@ -219,16 +219,12 @@ class HarvestMachine:
                 if stalled and error is not None and error <= c.grasp_workspace:
                     if nearest is None or error < nearest.grasp_error:
                         nearest = _Attempt(error, self.axis, waypoints)
-                again = stalled and (more or (back_to is None and nearest is not None))
-                if again and not more:
-                    back_to = nearest
-                why = (
-                    "backing out before the fault"
-                    if not again
-                    else "re-approach"
-                    if more
-                    else "back to the nearest attempt"
-                )
+                if stalled and more:
+                    again, why = True, "re-approach"
+                elif stalled and back_to is None and nearest is not None:
+                    again, why, back_to = True, "back to the nearest attempt", nearest
+                else:
+                    again, why = False, "backing out before the fault"
                 self.q = fault.retreat_from
                 self._transition(S.RETURN_HOME, berry, f"{why}: {fault}")
                 try:
