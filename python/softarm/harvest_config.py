@@ -58,6 +58,10 @@ class HarvestConfig:
             moves to the ready pose: 0.045 m/s is 94.5 psi/s, inside the safety layer's
             default 100 psi/s rate limit.
         home_elongation: every actuator's elongation (m) at the ready pose (straight arm).
+        transport_margin: gap (m) to the canes the model arm keeps on its way from where
+            the lag model has it to each command while following a placement plan; a
+            command that would leave less is not sent (the plan waits for the arm). The
+            planner's margin on the closed-loop approach, 1 cm.
         arrival_tolerance: an open-loop ramp ends once the lag model has every actuator
             within this (m) of the ramp's end (with a known lag; see docs/control.md §6).
     """
@@ -84,6 +88,7 @@ class HarvestConfig:
     home_speed: float = 0.045
     home_elongation: float = 0.0167
     arrival_tolerance: float = 0.001
+    transport_margin: float = 0.01
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
@@ -93,7 +98,7 @@ class HarvestConfig:
             value = _real(self, name)
             if not value > 0:
                 raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
-        for name in ("grasp_offset", "stall_progress", "home_elongation"):
+        for name in ("grasp_offset", "stall_progress", "home_elongation", "transport_margin"):
             value = _real(self, name)
             if not value >= 0:
                 raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")

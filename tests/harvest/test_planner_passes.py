@@ -63,3 +63,37 @@ def _assert_ramps_clear(planner: ModelIK, q: np.ndarray, waypoints: list[np.ndar
     for q_way in waypoints:
         assert planner.clearance.path_gap(start, q_way, 12) >= planner.ramp_margin
         start = q_way
+
+
+def test_a_detour_goes_round_a_cane_the_straight_ramps_pass_too_near() -> None:
+    # Seed 641's berry 12 (found UNREACHABLE by the sixth version): every pre-grasp pose
+    # with room to the limits has its straight ramp from the ready pose 14-22 mm from
+    # a cane on the model, under the 25 mm margin, and no via point on the approach line
+    # clears it; the last pass goes round through a configuration of the arm's own.
+    from softarm.geometry import cone_axes
+    from softarm.harvest import sim_rig
+    from softarm.harvest.ik import DETOUR
+    from softarm.harvest.targets import approach_pose
+
+    rig = sim_rig.build_sim_rig(sim_rig.SimRigOptions(n_berries=8, seed=641))
+    planner = rig.machine.planner
+    berry = next(b for b in rig.bush.berries if b.tag_id == 12).position
+    q = np.full(rig.model.n_actuators, planner.cfg.home_elongation)
+    current = rig.model.forward(q)
+    plan = planner.plan(q, berry, current)
+    assert plan is not None
+    waypoints, axis = plan
+    assert len(waypoints) == 2
+    _assert_ramps_clear(planner, q, waypoints)
+    # The pre-grasp pose is the last waypoint; the first is off the approach line, so it
+    # is the detour, not a via point.
+    c = planner.cfg
+    pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
+    assert np.linalg.norm(rig.model.forward(waypoints[1])[:3, 3] - pre[:3, 3]) < 2e-3
+    mid = rig.model.forward(waypoints[0])[:3, 3] - berry
+    assert np.linalg.norm(mid - (mid @ axis) * axis) > 0.01
+    # No straight ramp, nor via point, was clear along this axis.
+    for via in (None, planner.via, 0.5 * planner.via):
+        assert planner._path(q, berry, current, axis, via, 0.0, planner.ramp_margin) is None
+    assert planner._path(q, berry, current, axis, DETOUR, 0.001, planner.ramp_margin)
+    assert any(np.allclose(a, axis) for a in cone_axes(c.approach_axis, c.approach_cone_deg))

@@ -68,3 +68,23 @@ def test_slow_plant_hands_the_plan_over_to_the_loop_on_the_berry(tmp_path) -> No
     assert berry.true_position_error_mm <= 1.0
     kinds = [r["kind"] for r in read_log(tmp_path / "log.jsonl")]
     assert "waypoint_handover" in kinds and "waypoint_stalled" not in kinds
+
+
+def test_a_lagging_arm_does_not_cut_across_a_cane_on_its_way_to_the_first_berry(tmp_path) -> None:
+    # Seed 504 on a 1 s / 5 psi plant, not calibrated: the plan's first move used to
+    # touch a cane (6 steps, 3.9 mm deep). Each command was clear on the model, but the
+    # correction piled up while the arm trailed a whole lag behind, and the arm cut
+    # across from where it was to where the command had gone. The transport now holds a
+    # command whose way from the lag model's arm is not clear (`transport_held`).
+    options = SimRigOptions(
+        n_berries=8,
+        seed=504,
+        log_path=tmp_path / "log.jsonl",
+        plant=PlantConfig(pressure_tau=1.0, hysteresis_psi=5.0),
+    )
+    rig = build_sim_rig(options)
+    report = rig.run()
+    assert rig.watch.contacts == 0 and rig.watch.min_gap > 0.0
+    assert report.success_rate >= 7 / 8
+    kinds = [r["kind"] for r in read_log(tmp_path / "log.jsonl")]
+    assert "transport_held" in kinds

@@ -57,4 +57,9 @@ class Clearance:
 
     def path_gap(self, q0: FloatArray, q1: FloatArray, steps: int = 12) -> float:
         """Smallest gap along the straight line from ``q0`` to ``q1`` in actuator space."""
-        return min(self.gap(q0 + t * (q1 - q0)) for t in np.linspace(0.0, 1.0, steps))
+        return float(np.min(self.gaps_along(q0, q1, steps)))
+
+    def gaps_along(self, q0: FloatArray, q1: FloatArray, steps: int = 12) -> FloatArray:
+        """The gaps (m) at ``steps`` evenly spaced points of the straight line from ``q0``
+        to ``q1`` in actuator space, both ends included."""
+        return np.array([self.gap(q0 + t * (q1 - q0)) for t in np.linspace(0.0, 1.0, steps)])

@@ -13,6 +13,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import numpy.typing as npt
 
+from softarm.harvest.clearance import Clearance
+
 __all__ = ["ResolverController"]
 
 FloatArray = npt.NDArray[np.float64]
@@ -33,6 +35,9 @@ class ResolverController:
             flight (a Smith predictor). None: no prediction.
         transport: a resolver for :meth:`follow_step` (following a placement plan), or
             None to use ``resolver`` there too.
+        clearance: the model arm's gap to the same canes (a
+            :class:`~softarm.harvest.clearance.Clearance` on the model), for
+            :meth:`path_gap`; None: no known canes.
     """
 
     def __init__(
@@ -41,12 +46,14 @@ class ResolverController:
         obstacles: Sequence[object] = (),
         plant_q: Callable[[], FloatArray | None] | None = None,
         transport: object | None = None,
+        clearance: Clearance | None = None,
     ) -> None:
         self.resolver = resolver
         self.obstacles = list(obstacles)
         self.arm = resolver.arm  # type: ignore[attr-defined]
         self.plant_q = plant_q
         self.transport = transport
+        self.clearance = clearance
 
     def follow_step(
         self, q: FloatArray, target: FloatArray, current: FloatArray
@@ -76,3 +83,12 @@ class ResolverController:
         """The model's end-effector pose (4, 4) at ``q``: where a planned waypoint puts the
         gripper, the target the loop closes on while following a plan."""
         return np.asarray(self.arm.forward(q), dtype=np.float64)
+
+    def way_gaps(self, q0: FloatArray, q1: FloatArray, steps: int = 8) -> FloatArray | None:
+        """The model arm's gaps (m) to the canes at ``steps`` points of the straight line
+        from ``q0`` to ``q1`` in actuator space, ends included; None without known canes."""
+        if self.clearance is None:
+            return None
+        return self.clearance.gaps_along(
+            np.asarray(q0, dtype=np.float64), np.asarray(q1, dtype=np.float64), steps
+        )

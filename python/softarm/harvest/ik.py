@@ -30,6 +30,11 @@ __all__ = ["ModelIK", "cone_axes", "planning_resolver"]
 
 FloatArray = npt.NDArray[np.float64]
 
+#: The planner's last pass: a via configuration off the approach line (:meth:`ModelIK._detour`).
+DETOUR = -1.0
+#: How many candidate detours (clear themselves) have their two ramps checked, shortest first.
+DETOUR_CHECKS = 40
+
 
 def planning_resolver(model: SoftArm, joint_limit_gain: float = -1e-3) -> Resolver:
     """A hybrid resolver for planning on ``model``: the default gains with a joint-limit
@@ -113,6 +118,10 @@ class ModelIK:
             # Then a grasp on the joint limits: the loop may fall short by the model's
             # error there, but the canes keep the same margins (seed 500's berry 10).
             (0.0, self.ramp_margin, (None, self.via, 0.5 * self.via)),
+            # Last, a detour: the straight ramp to a pre-grasp pose passes too near a
+            # cane, so the arm goes round it through a configuration of its own (same
+            # margins; seed 641's berry 12).
+            (self.limit_room, self.ramp_margin, (DETOUR,)),
         ]
         for room, ramp, vias in passes:
             for via in vias:
@@ -143,6 +152,11 @@ class ModelIK:
                 continue
             if not self._clear(q_pre, q_grasp[0], 5, self.margin):
                 continue
+            if via == DETOUR:
+                q_mid = self._detour(q, q_pre, ramp)
+                if q_mid is not None:
+                    return [q_mid, q_pre]
+                continue
             if via is None:
                 if self._clear(q, q_pre, 12, ramp):
                     return [q_pre]
@@ -151,6 +165,25 @@ class ModelIK:
             for q_via in self.solve(q_pre, back, sample=False) + self.solve(q, back):
                 if self._clear(q, q_via, 12, ramp) and self._clear(q_via, q_pre, 6, ramp):
                     return [q_via, q_pre]
+        return None
+
+    def _detour(self, q: FloatArray, q_pre: FloatArray, ramp: float) -> FloatArray | None:
+        """A configuration through which both straight ramps, ``q`` → it → ``q_pre``,
+        keep ``ramp`` from the canes on the model: the shortest such way (in actuator
+        space) among ``samples`` random configurations of the joint box; None if none."""
+        lo, hi = self.arm.lower, self.arm.upper
+        mids = self.rng.uniform(lo, hi, size=(self.samples, lo.size))
+        length = np.linalg.norm(mids - q, axis=1) + np.linalg.norm(mids - q_pre, axis=1)
+        tried = 0
+        for k in np.argsort(length):
+            q_mid = mids[k]
+            if self.clearance is not None and self.clearance.gap(q_mid) < ramp:
+                continue
+            tried += 1
+            if self._clear(q, q_mid, 12, ramp) and self._clear(q_mid, q_pre, 12, ramp):
+                return np.asarray(q_mid, dtype=np.float64)
+            if tried >= DETOUR_CHECKS:
+                break
         return None
 
     def _room(self, q: FloatArray) -> float:

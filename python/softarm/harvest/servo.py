@@ -29,6 +29,22 @@ from softarm.harvest.targets import grasp_point, pointing_error, tool_pose
 __all__ = ["Fault", "Servo"]
 
 
+#: How far (m) the way to a command may dip below its nearer end where that end is already
+#: inside ``transport_margin`` of a cane (:meth:`Servo._clear_way`): a step of the loop
+#: is a few mm of elongation, along which the gap changes by about as much.
+WAY_SLACK = 0.001
+
+
+def straight_step(q: FloatArray, goal: FloatArray, step: float) -> FloatArray:
+    """The move (m) from ``q`` towards ``goal`` this period: along the straight line in
+    actuator space, the fastest channel at ``step``. The planner checks the canes along
+    that line; clipped channel by channel, the channels with the least to go would
+    arrive first and the arm would leave the line it was checked along."""
+    d = np.asarray(goal, dtype=np.float64) - q
+    most = float(np.max(np.abs(d), initial=0.0))
+    return d if most <= step else d * (step / most)
+
+
 class Servo:
     """Runs the stages of :class:`~softarm.harvest.machine.HarvestMachine`.
 
@@ -208,6 +224,7 @@ class Servo:
         nominal = np.asarray(q, dtype=np.float64).copy()  # the plan's point now
         goal_final = model_pose(q_way)
         best, best_t = np.inf, self.clock.now()
+        held = False
         while True:
             seen = self._look(watch, q, need_fix=False)
             if seen.pose is None:
@@ -241,19 +258,56 @@ class Servo:
             goal = model_pose(nominal)
             step_fn = getattr(self.controller, "follow_step", self.controller.step)
             q_fb, saturated = step_fn(q, goal, seen.pose)
-            advance = np.clip(q_way - nominal, -step, step)
-            nominal = nominal + advance
+            advance = straight_step(nominal, q_way, step)
             # Feedforward of the plan's motion on top of the closed-loop correction, kept
             # inside the limits the resolver's own command respects.
             q_next = np.clip(np.asarray(q_fb, dtype=np.float64) + advance, lower, upper)
             if not np.all(np.isfinite(q_next)):
                 raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
+            q_next = self._clear_way(q, (q_next, np.clip(q + advance, lower, upper)))
+            if q_next is q:  # held: the plan waits for the arm
+                if not held:
+                    self.log.event("transport_held", t=seen.t, error=err)
+                held = True
+            else:
+                held = False
+                nominal = nominal + advance
             watch.log_step(
                 stage, seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
             )
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.
             q = self.actuator.send(q_next)
             self.clock.sleep(c.period)
+
+    def _clear_way(self, q: FloatArray, candidates: Sequence[FloatArray]) -> FloatArray:
+        """The first of the ``candidates`` commands whose way keeps clear of the canes on
+        the model, else ``q`` (the last command, held).
+
+        The way is the straight line in actuator space from where the lag model has the
+        arm now (``q`` less the motion still in flight) to the candidate: regulators
+        with one first-order lag move the elongations straight towards a held command.
+        It is clear when it stays ``transport_margin`` from the canes or, where the arm
+        is already nearer than that (a berry by a cane; the model's gap there is a few
+        mm to a few cm off the true one), when it comes no more than ``WAY_SLACK``
+        nearer than the arm is: inside the margin the loop may close in on a cane only
+        slowly. A command is checked on its own, but the arm, a whole lag behind it,
+        cuts across from where it is to where the command has gone: on seed 504 without
+        calibration the placement loop's correction piled up while the arm trailed, and
+        the arm crossed a cane between two clear commands (docs/harvest.md). Holding
+        ``q`` keeps the arm on the line checked the period before."""
+        way_gaps = getattr(self.controller, "way_gaps", None)
+        if way_gaps is None:
+            return candidates[0]
+        flight = self.actuator.in_flight()
+        arm_q = q if flight is None else q - flight
+        for candidate in candidates:
+            gaps = way_gaps(arm_q, candidate)
+            if gaps is None:
+                return candidate
+            need = min(self.cfg.transport_margin, gaps[0] - WAY_SLACK)
+            if float(np.min(gaps)) >= need:
+                return candidate
+        return q
 
     def ramp(
         self,
@@ -272,7 +326,7 @@ class Servo:
         while np.any(q != goal):
             if self.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: ramp not done in time")
-            q = q + np.clip(goal - q, -step, step)
+            q = q + straight_step(q, goal, step)
             self.actuator.send(q)
             seen = self._look(watch, q, need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)

@@ -214,6 +214,9 @@ def build_sim_rig(
         lead=lead_gain(lag, cfg.period) if predict else 0.0,
         play_m=play if predict else 0.0,
     )
+    # The model arm's gap to the mapped canes: the planner checks its plans with it, the
+    # controller keeps the lagging arm's way to each command clear with it.
+    model_clearance = Clearance(model, canes, cfg.grasp_offset)
     if controller is None:
 
         def hybrid(gains: Gains) -> Resolver:
@@ -233,7 +236,11 @@ def build_sim_rig(
         resolver = hybrid(Gains().replace(hybrid_alpha=loop_alpha)) if predict else bounded
         transport = bounded if predict else None
         controller = ResolverController(
-            resolver, canes if o.avoid_canes else (), predicted, transport
+            resolver,
+            canes if o.avoid_canes else (),
+            predicted,
+            transport,
+            model_clearance if o.avoid_canes else None,
         )
     machine = HarvestMachine(
         clock,
@@ -251,7 +258,7 @@ def build_sim_rig(
             planning_resolver(model),
             cfg,
             seed=o.seed,
-            clearance=Clearance(model, canes, cfg.grasp_offset),
+            clearance=model_clearance,
         ),
     )
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)
