@@ -171,13 +171,17 @@ class ModelIK:
         """A configuration through which both straight ramps, ``q`` → it → ``q_pre``,
         keep ``ramp`` from the canes on the model: the shortest such way (in actuator
         space) among ``samples`` random configurations of the joint box; None if none."""
+        if self.clearance is None:
+            return None  # no canes: the straight ramp was clear
+        if min(self.clearance.gap(q), self.clearance.gap(q_pre)) < ramp:
+            return None  # no way in keeps the margin where it starts or ends
         lo, hi = self.arm.lower, self.arm.upper
         mids = self.rng.uniform(lo, hi, size=(self.samples, lo.size))
         length = np.linalg.norm(mids - q, axis=1) + np.linalg.norm(mids - q_pre, axis=1)
         tried = 0
         for k in np.argsort(length):
             q_mid = mids[k]
-            if self.clearance is not None and self.clearance.gap(q_mid) < ramp:
+            if self.clearance.gap(q_mid) < ramp:
                 continue
             tried += 1
             if self._clear(q, q_mid, 12, ramp) and self._clear(q_mid, q_pre, 12, ramp):
