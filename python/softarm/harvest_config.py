@@ -60,7 +60,8 @@ class HarvestConfig:
         home_elongation: every actuator's elongation (m) at the ready pose (straight arm).
         transport_margin: gap (m) to the canes the model arm keeps on its way from where
             the lag model has it to each command while following a placement plan; a
-            command that would leave less is not sent (the plan waits for the arm). The
+            command that would leave less is not sent (the plan waits for the arm); where
+            the arm is already nearer, the way may come only 1 mm nearer still. The
             planner's margin on the closed-loop approach, 1 cm.
         arrival_tolerance: an open-loop ramp ends once the lag model has every actuator
             within this (m) of the ramp's end (with a known lag; see docs/control.md §6).

@@ -36,8 +36,8 @@ class ResolverController:
         transport: a resolver for :meth:`follow_step` (following a placement plan), or
             None to use ``resolver`` there too.
         clearance: the model arm's gap to the same canes (a
-            :class:`~softarm.harvest.clearance.Clearance` on the model), for
-            :meth:`path_gap`; None: no known canes.
+            :class:`~softarm.harvest.clearance.Clearance` on the model, the planner's),
+            for :meth:`way_gaps`; None: no known canes.
     """
 
     def __init__(

@@ -29,9 +29,9 @@ from softarm.harvest.targets import grasp_point, pointing_error, tool_pose
 __all__ = ["Fault", "Servo"]
 
 
-#: How far (m) the way to a command may dip below its nearer end where that end is already
-#: inside ``transport_margin`` of a cane (:meth:`Servo._clear_way`): a step of the loop
-#: is a few mm of elongation, along which the gap changes by about as much.
+#: How much nearer (m) to a cane than the arm is the way to a command may come, where the
+#: arm is already inside ``transport_margin`` (:meth:`Servo._clear_way`): about what one
+#: period's step of the loop changes the gap by, so the loop is slowed there, not locked.
 WAY_SLACK = 0.001
 
 
