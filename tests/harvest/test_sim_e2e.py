@@ -56,17 +56,10 @@ def test_slow_plant_hands_the_plan_over_to_the_loop_on_the_berry(tmp_path) -> No
     # 1 s regulators and 5 psi of play: the plan's lag-bounded correction would take
     # seconds to remove the model's error; once the lag model has the arm at the plan's
     # end, the loop on the berry (predicted, full gain) takes over instead of stalling.
-    options = SimRigOptions(
-        n_berries=1,
-        seed=0,
-        log_path=tmp_path / "log.jsonl",
-        plant=PlantConfig(pressure_tau=1.0, hysteresis_psi=5.0),
-    )
-    rig = build_sim_rig(options)
-    (berry,) = rig.run().berries
+    _, report, kinds = _on_a_slow_plant(tmp_path, n_berries=1, seed=0)
+    (berry,) = report.berries
     assert berry.harvested and berry.true_position_error_mm is not None
     assert berry.true_position_error_mm <= 1.0
-    kinds = [r["kind"] for r in read_log(tmp_path / "log.jsonl")]
     assert "waypoint_handover" in kinds and "waypoint_stalled" not in kinds
 
 
@@ -76,15 +69,21 @@ def test_a_lagging_arm_does_not_cut_across_a_cane_on_its_way_to_the_first_berry(
     # correction piled up while the arm trailed a whole lag behind, and the arm cut
     # across from where it was to where the command had gone. The transport now holds a
     # command whose way from the lag model's arm is not clear (`transport_held`).
+    rig, report, kinds = _on_a_slow_plant(tmp_path, n_berries=8, seed=504)
+    assert rig.watch.contacts == 0 and rig.watch.min_gap > 0.0
+    assert report.success_rate >= 7 / 8
+    assert "transport_held" in kinds
+
+
+def _on_a_slow_plant(tmp_path, n_berries: int, seed: int):  # type: ignore[no-untyped-def]
+    """Harvest a bush on a 1 s / 5 psi plant (the nominal model, not calibrated):
+    ``(rig, report, the kinds of the log's records)``."""
     options = SimRigOptions(
-        n_berries=8,
-        seed=504,
+        n_berries=n_berries,
+        seed=seed,
         log_path=tmp_path / "log.jsonl",
         plant=PlantConfig(pressure_tau=1.0, hysteresis_psi=5.0),
     )
     rig = build_sim_rig(options)
     report = rig.run()
-    assert rig.watch.contacts == 0 and rig.watch.min_gap > 0.0
-    assert report.success_rate >= 7 / 8
-    kinds = [r["kind"] for r in read_log(tmp_path / "log.jsonl")]
-    assert "transport_held" in kinds
+    return rig, report, [r["kind"] for r in read_log(tmp_path / "log.jsonl")]
