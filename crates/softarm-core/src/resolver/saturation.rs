@@ -18,6 +18,37 @@ fn cap_scale(v: &[f64], max: f64) -> f64 {
     }
 }
 
+/// The factor that keeps the joint-limit term `v` from taking any free coordinate more
+/// than `fraction` of the way from `q` to the limit it moves towards (the fraction-to-
+/// the-boundary rule of interior-point methods; 1 when it already does). ∇H of eq. (14)
+/// is a barrier: next to a limit it is so steep that a step along it, even capped in
+/// length, overshoots into the far limits of other coordinates through the null-space
+/// projection, which then saturate in turn. Under a lag-bounded gain the tasks move
+/// little against it, and the arm ended with every coordinate on a limit, 18 cm from a
+/// target it reaches without the term (docs/control.md, section 3).
+fn boundary_scale(
+    v: &[f64],
+    q: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    free: &[bool],
+    fraction: f64,
+) -> f64 {
+    let mut scale = 1.0_f64;
+    for k in 0..v.len() {
+        if !free[k] || v[k] == 0.0 {
+            continue;
+        }
+        let room = if v[k] > 0.0 {
+            upper[k] - q[k]
+        } else {
+            q[k] - lower[k]
+        };
+        scale = scale.min((fraction * room.max(0.0) / v[k].abs()).max(0.0));
+    }
+    scale
+}
+
 /// Clamps saturation round `round` (of `rounds`): a fixed coordinate keeps its fixed
 /// increment; a free one whose command `q + Δq` leaves `[lower, upper]` is fixed at the
 /// limit for the next round (none after the last). The first round records the unclamped
@@ -90,7 +121,7 @@ impl<K: Kinematics> Resolver<K> {
                 Mode::Hybrid => self.hybrid_task(ws, q, &e_p, &e_w, errors.p_norm, scale),
                 Mode::Conventional => self.conventional_task(ws, &e_p, &e_w, pose_target, scale),
             }
-            self.cap_and_combine(ws);
+            self.cap_and_combine(ws, q);
             let (lower, upper) = (self.arm.lower(), self.arm.upper());
             let (clamped, newly_fixed) = fix_saturated(ws, q, lower, upper, round, rounds);
             saturated |= clamped;
@@ -128,11 +159,15 @@ impl<K: Kinematics> Resolver<K> {
 
     /// Step-length caps: the task part at `max_step`, each null-space part (joint limits,
     /// obstacles) at half of it, so that ∇H, large next to a limit, can never starve the
-    /// tasks nor the repulsion. Leaves the sum of the three capped parts in `ws.dq`.
-    fn cap_and_combine(&self, ws: &mut Workspace) {
+    /// tasks nor the repulsion; the joint-limit part also takes no free coordinate more
+    /// than half way to a limit ([`boundary_scale`]). Leaves the sum of the three capped
+    /// parts in `ws.dq`.
+    fn cap_and_combine(&self, ws: &mut Workspace, q: &[f64]) {
         let max = self.gains.max_step;
         let s_task = cap_scale(&ws.dq, max);
-        let s_null = cap_scale(&ws.null, 0.5 * max);
+        let (lower, upper) = (self.arm.lower(), self.arm.upper());
+        let s_null = cap_scale(&ws.null, 0.5 * max)
+            .min(boundary_scale(&ws.null, q, lower, upper, &ws.free, 0.5));
         let s_avoid = cap_scale(&ws.avoid, 0.5 * max);
         for ((d, v), a) in ws.dq.iter_mut().zip(&ws.null).zip(&ws.avoid) {
             *d = s_task * *d + s_null * v + s_avoid * a;
@@ -151,5 +186,45 @@ impl<K: Kinematics> Resolver<K> {
             }
         }
         (v, w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::boundary_scale;
+
+    const LOWER: [f64; 3] = [0.0, 0.0, 0.0];
+    const UPPER: [f64; 3] = [0.03, 0.03, 0.03];
+
+    #[test]
+    fn a_step_towards_a_limit_is_cut_to_half_the_room_left() {
+        let q = [0.001, 0.015, 0.015];
+        let v = [-0.004, 0.001, -0.001]; // 1 mm of room, 4 mm towards the lower limit
+        let s = boundary_scale(&v, &q, &LOWER, &UPPER, &[true; 3], 0.5);
+        assert!((s - 0.125).abs() < 1e-12, "{s}");
+        for k in 0..3 {
+            let x = q[k] + s * v[k];
+            let room = (q[k] - LOWER[k]).min(UPPER[k] - q[k]);
+            assert!(x - LOWER[k] >= 0.5 * room - 1e-15 || UPPER[k] - x >= 0.5 * room - 1e-15);
+            assert!(x > LOWER[k] && x < UPPER[k]);
+        }
+    }
+
+    #[test]
+    fn a_step_that_keeps_its_room_is_left_whole() {
+        let q = [0.001, 0.015, 0.029];
+        let v = [0.002, 0.001, -0.003]; // away from the near limits, far from the others
+        assert_eq!(boundary_scale(&v, &q, &LOWER, &UPPER, &[true; 3], 0.5), 1.0);
+    }
+
+    #[test]
+    fn fixed_coordinates_are_the_saturation_rounds_business() {
+        let q = [0.0, 0.015, 0.015];
+        let v = [-0.002, 0.001, 0.001]; // on the lower limit, pushed further out
+        assert_eq!(
+            boundary_scale(&v, &q, &LOWER, &UPPER, &[false, true, true], 0.5),
+            1.0
+        );
+        assert_eq!(boundary_scale(&v, &q, &LOWER, &UPPER, &[true; 3], 0.5), 0.0);
     }
 }
