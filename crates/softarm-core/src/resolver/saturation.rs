@@ -18,6 +18,10 @@ fn cap_scale(v: &[f64], max: f64) -> f64 {
     }
 }
 
+/// How far towards a limit (a fraction of the room left) one step of the joint-limit
+/// term may take a free coordinate ([`boundary_scale`]).
+const BOUNDARY_FRACTION: f64 = 0.5;
+
 /// The factor that keeps the joint-limit term `v` from taking any free coordinate more
 /// than `fraction` of the way from `q` to the limit it moves towards (the fraction-to-
 /// the-boundary rule of interior-point methods; 1 when it already does). ∇H of eq. (14)
@@ -166,8 +170,14 @@ impl<K: Kinematics> Resolver<K> {
         let max = self.gains.max_step;
         let s_task = cap_scale(&ws.dq, max);
         let (lower, upper) = (self.arm.lower(), self.arm.upper());
-        let s_null = cap_scale(&ws.null, 0.5 * max)
-            .min(boundary_scale(&ws.null, q, lower, upper, &ws.free, 0.5));
+        let s_null = cap_scale(&ws.null, 0.5 * max).min(boundary_scale(
+            &ws.null,
+            q,
+            lower,
+            upper,
+            &ws.free,
+            BOUNDARY_FRACTION,
+        ));
         let s_avoid = cap_scale(&ws.avoid, 0.5 * max);
         for ((d, v), a) in ws.dq.iter_mut().zip(&ws.null).zip(&ws.avoid) {
             *d = s_task * *d + s_null * v + s_avoid * a;
