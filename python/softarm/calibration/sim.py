@@ -47,9 +47,16 @@ class PlantDriver:
 
     def __post_init__(self) -> None:
         self.last: F64 | None = None
+        self.sent: F64 | None = None
 
     def send(self, q: F64) -> None:
-        self.plant.command_pressures(np.asarray(q) / METRES_PER_PSI)  # type: ignore[attr-defined]
+        self.sent = np.asarray(q, dtype=np.float64)
+        self.plant.command_pressures(self.sent / METRES_PER_PSI)  # type: ignore[attr-defined]
+
+    def vent(self) -> None:
+        """Command 0 psi on every channel that was driven (the regulators' vent)."""
+        if self.sent is not None:
+            self.plant.command_pressures(np.zeros_like(self.sent))  # type: ignore[attr-defined]
 
     def sleep(self, dt: float) -> None:
         self.plant.advance(dt)  # type: ignore[attr-defined]
@@ -93,9 +100,15 @@ def calibrate_plant(
     )
     drv = PlantDriver(plant, tracker)
     commands = excitation_set(nominal, n_poses, seed=seed)
-    c, p = collect(
-        commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose, average=average, **pace
-    )
+    try:
+        c, p = collect(
+            commands, drv.send, drv.sleep, drv.measure, on_pose=on_pose, average=average, **pace
+        )
+    except BaseException:
+        # Stopped (SIGTERM, Ctrl-C) or failed half way: leave the plant vented, as the
+        # hardware rig's close() leaves the arm.
+        drv.vent()
+        raise
     return calibrate(nominal, c, p, bias=bias), c, p
 
 

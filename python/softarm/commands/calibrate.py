@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
 
 if TYPE_CHECKING:
@@ -44,6 +45,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
+@drives_arm("calibrate")
 def run(args: argparse.Namespace) -> int:
     """Calibrate; exit status 0 on a converged fit, 1 if the solver did not converge, 2
     on bad input or absent hardware."""

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
 from softarm.commands._plant import add_plant_options, plant_options
-from softarm.commands._signals import Interrupted, raise_on_signals
+from softarm.commands._signals import drives_arm
 
 #: What the demo writes into --out.
 OUTPUTS = ("harvest.png", "harvest_report.json", "harvest_log.jsonl")
@@ -29,6 +28,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
+@drives_arm("demo")
 def run(args: argparse.Namespace) -> int:
     """Harvest, print a line per berry and the summary, save the figures."""
     from softarm.commands.harvest import configure_logging, run_sim
@@ -39,10 +39,6 @@ def run(args: argparse.Namespace) -> int:
     log = args.out / "harvest_log.jsonl"
     log.unlink(missing_ok=True)
     report, plot = args.out / "harvest_report.json", args.out / "harvest.png"
-    with raise_on_signals():
-        try:
-            run_sim(args.berries, args.seed, log, report, plot, args.quiet, **options)
-        except Interrupted as exc:
-            print(f"softarm demo: {exc}: arm vented; log {log}", file=sys.stderr)
-            return exc.exit_status
+    args.log = log  # named in the line a stop prints (drives_arm)
+    run_sim(args.berries, args.seed, log, report, plot, args.quiet, **options)
     return 0  # a demo, not a test: a faulted berry is reported, not an error

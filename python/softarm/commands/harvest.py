@@ -24,12 +24,11 @@ from softarm.commands._args import (
 )
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
-from softarm.commands._signals import Interrupted, raise_on_signals
+from softarm.commands._signals import drives_arm, vents_on_stop
 from softarm.errors import ConfigError, HardwareUnavailableError
 
 if TYPE_CHECKING:
     from softarm.config import Config
-    from softarm.harvest.log import HarvestLog
     from softarm.harvest.report import HarvestReport
     from softarm.harvest.sim_rig import SimRig
 
@@ -80,6 +79,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
+@drives_arm("harvest")
 def run(args: argparse.Namespace) -> int:
     """Run the harvest; exit status 0 when every berry ended DONE, 1 otherwise, 2 when
     the hardware is absent, 128 + the signal number when stopped by SIGINT/SIGTERM."""
@@ -90,20 +90,14 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     configure_logging(args.quiet)
-    with raise_on_signals():
-        try:
-            options = plant_options(args)
-            gains = _gains(args)
-            if args.sim:
-                return run_sim(
-                    args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
-                    gains=gains, view=args.view, record=args.record, **options,
-                )  # fmt: skip
-            return _run_hardware(args)
-        except Interrupted as exc:
-            where = f"; log {args.log}" if args.log else ""
-            print(f"softarm harvest: {exc}: arm vented{where}", file=sys.stderr)
-            return exc.exit_status
+    options = plant_options(args)
+    gains = _gains(args)
+    if args.sim:
+        return run_sim(
+            args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
+            gains=gains, view=args.view, record=args.record, **options,
+        )  # fmt: skip
+    return _run_hardware(args)
 
 
 def configure_logging(quiet: bool) -> None:
@@ -112,21 +106,6 @@ def configure_logging(quiet: bool) -> None:
     logging.basicConfig(
         level=logging.ERROR if quiet else logging.WARNING, format="  [%(name)s] %(message)s"
     )
-
-
-def stop(log: HarvestLog, vent: Any, exc: Interrupted) -> None:
-    """The arm vented and the stop recorded (and synced) in the run log."""
-    reason = f"stopped by {exc.name}"
-    try:
-        vent(reason)
-        vented = True
-    except Exception as err:  # a dead driver: still record why the run ended
-        log.event("vent_failed", error=repr(err))
-        vented = False
-    log.event(
-        "interrupted", signal=exc.name, reason=reason, vented=vented, exit_status=exc.exit_status
-    )
-    log.close()
 
 
 def run_sim(
@@ -154,10 +133,8 @@ def run_sim(
         apply_gains(rig, gains)  # the closed-loop resolver's (--gains)
     viewer = _viewer(rig, view, record)
     try:
-        report = _harvest(rig, berries, quiet)
-    except Interrupted as exc:
-        stop(rig.machine.log, rig.machine.actuator.vent, exc)
-        raise
+        with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
+            report = _harvest(rig, berries, quiet)
     finally:
         if viewer is not None:
             viewer.close()  # the recording complete, even after a stop
@@ -272,10 +249,8 @@ def _run_hardware(args: argparse.Namespace) -> int:
         return 2
     try:
         # On hardware the berries are the tags 10, 11, ... stuck to them (section IV-E).
-        report = rig.machine.run([BerryTarget(10 + i) for i in range(args.berries)])
-    except Interrupted as exc:
-        stop(log, rig.machine.actuator.vent, exc)
-        raise
+        with vents_on_stop(rig.machine.actuator.vent, log):
+            report = rig.machine.run([BerryTarget(10 + i) for i in range(args.berries)])
     finally:
         rig.close()  # vents and releases every device, whatever happened
         log.close()

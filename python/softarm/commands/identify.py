@@ -13,7 +13,7 @@ import logging
 import sys
 
 from softarm.commands._args import add_quiet, config_file, non_negative_int, output_file
-from softarm.commands._signals import Interrupted, raise_on_signals
+from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
 
 #: The longest excitation (s of arm time) the command runs.
@@ -60,6 +60,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
+@drives_arm("identify")
 def run(args: argparse.Namespace) -> int:
     """Identify and save; 0 on success, 2 on bad input or absent hardware."""
     from softarm.errors import ParameterError
@@ -69,12 +70,7 @@ def run(args: argparse.Namespace) -> int:
     logging.basicConfig(
         level=logging.ERROR if args.quiet else logging.WARNING, format="  [%(name)s] %(message)s"
     )
-    with raise_on_signals():
-        try:
-            plant = _run_sim(args) if args.sim else _run_hardware(args)
-        except Interrupted as exc:
-            print(f"softarm identify: {exc}; the arm was vented", file=sys.stderr)
-            return exc.exit_status
+    plant = _run_sim(args) if args.sim else _run_hardware(args)
     if plant is None:
         return 2
     plant.save(args.out)
