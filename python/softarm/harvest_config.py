@@ -41,6 +41,8 @@ class HarvestConfig:
         marker_timeout: how long (s) the cube or the berry may stay unseen (beyond the
             locator's own hold of the last target) before MARKER_LOST.
         placement_timeout, fine_timeout, home_timeout: time budgets (s) of the stages.
+        idle_timeout: time budget (s) of IDLE's ramp to the ready pose: every stage ends
+            in bounded time, even on an arm its lag model never sees arrive.
         fine_budget: time (s) after which fine positioning settles for ``grasp_workspace``.
         stall_time: saturated for this long (s) without ``stall_progress`` (m) of
             improvement → UNREACHABLE.
@@ -82,6 +84,7 @@ class HarvestConfig:
     fine_timeout: float = 20.0
     fine_budget: float = 12.0
     home_timeout: float = 10.0
+    idle_timeout: float = 10.0
     stall_time: float = 3.0
     stall_progress: float = 0.002
     reapproaches: int = 1
@@ -94,8 +97,8 @@ class HarvestConfig:
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
                      "grasp_workspace", "marker_timeout", "placement_timeout", "fine_timeout",
-                     "fine_budget", "home_timeout", "stall_time", "home_speed", "arrival_tolerance",
-                     "angle_tolerance_deg"):  # fmt: skip
+                     "fine_budget", "home_timeout", "idle_timeout", "stall_time", "home_speed",
+                     "arrival_tolerance", "angle_tolerance_deg"):  # fmt: skip
             value = _real(self, name)
             if not value > 0:
                 raise ParameterError(f"{name} must be finite and > 0, got {value!r}")

@@ -139,7 +139,8 @@ class HarvestMachine:
         self._transition(S.IDLE, berry, "new berry")
         try:
             self.vision.select(berry)
-            self.q = servo.ramp(watch, self.state, self.q, self.home)
+            idle_deadline = self.clock.now() + self.config.idle_timeout
+            self.q = servo.ramp(watch, self.state, self.q, self.home, idle_deadline)
             servo.wait_visible(watch, self.state, self.q)
             self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
             waypoints = self._reach(watch, berry)

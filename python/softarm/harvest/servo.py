@@ -4,12 +4,13 @@ position, go home. Each step reads the cameras, checks them, logs, and commands 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
 
-from softarm.errors import NonFiniteError
+from softarm.errors import NonFiniteError, ParameterError
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryFix,
@@ -315,13 +316,20 @@ class Servo:
         stage: HarvestState,
         q: FloatArray,
         goal: FloatArray,
-        deadline: float = np.inf,
+        deadline: float,
         observe: bool = False,
         settle: bool = True,
     ) -> FloatArray:
         """Move the elongations straight to ``goal`` at ``home_speed``, open loop; with
         ``observe`` the cameras are still read (and checked) at every step; with
-        ``settle`` (the default) return only once the lag model has the arm there."""
+        ``settle`` (the default) return only once the lag model has the arm there.
+
+        Every ramp is bounded in time: past ``deadline`` (clock time, finite) it is a
+        TIMEOUT fault. A goal the arm never reaches (a lag model that never settles, a
+        model with absurd offsets) must end the berry, not run the stage forever.
+        """
+        if not math.isfinite(deadline):
+            raise ParameterError(f"deadline = {deadline!r}: every ramp must end in finite time")
         step = self.cfg.home_speed * self.cfg.period
         while np.any(q != goal):
             if self.clock.now() > deadline:
