@@ -101,7 +101,7 @@ def test_id_json_round_trip(tmp_path: Path) -> None:
         ({"metres_per_psi": [4e-4]}, "metres_per_psi: has 1 values, tau_s has 2"),
         ({"hysteresis_psi": "1.5"}, "hysteresis_psi = '1.5': must be a non-empty list"),
         ({"dead_time_s": None}, "dead_time_s = None"),
-        ({"control_period_s": 0}, "control_period_s = 0: must be a finite number > 0"),
+        ({"control_period_s": 0}, "control_period_s = 0: must be a finite number in [0.001, 1]"),
         ({"gain": 1}, "unknown key 'gain'"),
     ],
 )

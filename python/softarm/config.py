@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from dataclasses import asdict, dataclass, field, fields
 from importlib import resources
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import Any
 
 from softarm._core import Gains
 from softarm.errors import ConfigError, ParameterError
+from softarm.files import parse_toml, read_text, write_text
 from softarm.hardware.limits import (
     BAUD,
     FULL_SCALE_PSI,
@@ -171,28 +171,12 @@ def load_config(path: str | Path) -> Config:
         ConfigError: the file is missing, not TOML, or a value is invalid (the message
             names the key path and the value).
     """
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ConfigError(f"cannot read config file {str(path)!r}: {exc}") from exc
-    # TOML is UTF-8, and a byte-order mark is not TOML: say so rather than fail to parse.
-    if data.startswith(b"\xef\xbb\xbf"):
-        raise ConfigError(f"{str(path)!r} starts with a UTF-8 byte-order mark; save it without")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"{str(path)!r} is not UTF-8 (byte offset {exc.start})") from exc
-    return parse_config(text, source=str(path))
+    return parse_config(read_text(path, "config file"), source=str(path))
 
 
 def parse_config(text: str, source: str = "<string>") -> Config:
     """Validate TOML text (see :func:`load_config`)."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source} is not valid TOML: {exc}") from exc
-    return _build(_Table(data, "", source))
+    return _build(_Table(parse_toml(text, source), "", source))
 
 
 def default_config() -> Config:
@@ -203,7 +187,7 @@ def default_config() -> Config:
 
 def save_config(config: Config, path: str | Path) -> None:
     """Write ``config`` as TOML that :func:`load_config` reads back to an equal Config."""
-    Path(path).write_text(dump_config(config), encoding="utf-8")
+    write_text(path, dump_config(config), "config file")
 
 
 # --- validation -------------------------------------------------------------------------

@@ -17,6 +17,7 @@ __all__ = [
     "InputError",
     "NonFiniteError",
     "OutOfRangeError",
+    "OutputError",
     "ParameterError",
     "PoseError",
     "SafetyError",
@@ -78,3 +79,8 @@ class SafetyError(HardwareError):
 
 class ConfigError(SoftarmError, ValueError):
     """A configuration file is missing, malformed or inconsistent."""
+
+
+class OutputError(SoftarmError, OSError):
+    """An output file cannot be written (missing folder, full disk, file-size limit); the
+    previous file of that name, if any, is left as it was."""

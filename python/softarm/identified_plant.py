@@ -13,27 +13,33 @@ identification that writes it and the harvest that reads it;
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softarm.errors import ConfigError
+from softarm.files import Range, load_json, number, numbers, write_text
 
 if TYPE_CHECKING:
     from softarm.config import Config
 
 __all__ = ["PER_CHANNEL_KEYS", "IdentifiedPlant", "identified_from_config", "load_identified"]
 
-#: The per-channel lists of ``id.json`` and the smallest value each may take.
-PER_CHANNEL_KEYS: dict[str, tuple[float, str]] = {
-    "tau_s": (0.0, "regulator time constant (s), > 0"),
-    "metres_per_psi": (0.0, "actuator elongation per psi (m/psi), > 0"),
-    "hysteresis_psi": (0.0, "width of the play band (psi), >= 0"),
-    "dead_time_s": (0.0, "pure delay from command to pressure (s), >= 0"),
+#: The per-channel lists of ``id.json`` and the range of each value. The ends are what a
+#: pneumatic actuator can physically show (the ``[plant]`` file's ranges where it has
+#: one): a time constant of 1e16 s is no regulator, and it made the lag model divide by
+#: zero (``1 - exp(-T/tau)`` is 0.0 in floating point).
+PER_CHANNEL_KEYS: dict[str, Range] = {
+    "tau_s": Range(0.0, 10.0, "s", "regulator time constant", lo_open=True),
+    "metres_per_psi": Range(
+        1e-6, 0.01, "m/psi", "actuator elongation per psi: 0.07 mm to 0.7 m over 70 psi"
+    ),
+    "hysteresis_psi": Range(0.0, 20.0, "psi", "width of the play band"),
+    "dead_time_s": Range(0.0, 10.0, "s", "pure delay from command to pressure"),
 }
-_STRICT = {"tau_s", "metres_per_psi"}  # > 0 rather than >= 0
+#: The control period the identification ran at: a real loop runs between 1 kHz and 1 Hz.
+CONTROL_PERIOD_S = Range(0.001, 1.0, "s", "control period")
 
 
 @dataclass(frozen=True)
@@ -58,7 +64,7 @@ class IdentifiedPlant:
     metadata: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        _validate(self.to_dict(), "IdentifiedPlant", ConfigError)
+        _validate(self.to_dict(), "IdentifiedPlant")
 
     @property
     def n_channels(self) -> int:
@@ -94,7 +100,7 @@ class IdentifiedPlant:
 
     def save(self, path: str | Path) -> None:
         """Write ``id.json``."""
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2) + "\n", encoding="utf-8")
+        write_text(path, json.dumps(self.to_dict(), indent=2) + "\n", "identified plant")
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any], *, where: str = "id.json") -> IdentifiedPlant:
@@ -111,7 +117,7 @@ class IdentifiedPlant:
         unknown = sorted(set(data) - allowed)
         if unknown:
             raise ConfigError(f"{where}: unknown key {unknown[0]!r}; expected {sorted(allowed)}")
-        _validate(data, where, ConfigError)
+        _validate(data, where)
         meta = data.get("metadata", {})
         if not isinstance(meta, Mapping):
             raise ConfigError(f"{where}.metadata: must be an object, got {meta!r}")
@@ -126,27 +132,17 @@ class IdentifiedPlant:
         )
 
 
-def _number(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _validate(data: Mapping[str, Any], where: str, error: type[Exception]) -> None:
+def _validate(data: Mapping[str, Any], where: str) -> None:
+    """Every per-channel list present, of one length, each value in its range."""
     n = None
-    for key, (lo, what) in PER_CHANNEL_KEYS.items():
+    for key, rng in PER_CHANNEL_KEYS.items():
         if key not in data:
-            raise error(f"{where}: {key} is required ({what}, one per channel)")
-        values = data[key]
-        if not isinstance(values, list | tuple) or not values:
-            raise error(f"{where}.{key} = {values!r}: must be a non-empty list ({what})")
+            raise ConfigError(f"{where}: {key} is required (one value per channel)")
+        values = numbers(data[key], rng, key, where)
         if n is not None and len(values) != n:
-            raise error(f"{where}.{key}: has {len(values)} values, tau_s has {n}")
+            raise ConfigError(f"{where}: {key}: has {len(values)} values, tau_s has {n}")
         n = len(values)
-        for i, v in enumerate(values):
-            if not _number(v) or v < lo or (key in _STRICT and v <= lo):
-                raise error(f"{where}.{key}[{i}] = {v!r}: must be a finite {what}")
-    period = data.get("control_period_s", 0.05)
-    if not _number(period) or period <= 0.0:
-        raise error(f"{where}.control_period_s = {period!r}: must be a finite number > 0")
+    number(data.get("control_period_s", 0.05), CONTROL_PERIOD_S, "control_period_s", where)
 
 
 def load_identified(path: str | Path) -> IdentifiedPlant:
@@ -156,14 +152,7 @@ def load_identified(path: str | Path) -> IdentifiedPlant:
         ConfigError: the file is missing, not JSON, or a value is invalid (one line naming
             the file and the key).
     """
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read identified plant {str(path)!r}: {exc}") from exc
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"{path}: not valid JSON: {exc}") from exc
-    return IdentifiedPlant.from_mapping(data, where=str(path))
+    return IdentifiedPlant.from_mapping(load_json(path, "identified plant"), where=str(path))
 
 
 def identified_from_config(config: Config, config_path: str | Path) -> IdentifiedPlant | None:

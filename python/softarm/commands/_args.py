@@ -10,7 +10,6 @@ its report must fail before the run, not after it (a failed check creates nothin
 from __future__ import annotations
 
 import argparse
-import codecs
 import math
 import os
 import tempfile
@@ -18,12 +17,15 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
+from softarm.errors import SoftarmError
+
 __all__ = [
     "DefaultsFormatter",
     "Parser",
     "RawDefaultsFormatter",
     "add_quiet",
     "config_file",
+    "data_file",
     "float_range",
     "image_file",
     "int_range",
@@ -85,7 +87,7 @@ class Parser(argparse.ArgumentParser):
             action.help = ""
         # Path options complete file or folder names in `softarm completion` scripts
         # (shtab reads ``action.complete``; the values are shtab.FILE and DIRECTORY).
-        if action.type in (output_file, image_file, config_file):
+        if action.type in (output_file, image_file, config_file, data_file):
             action.complete = _COMPLETE_FILE  # type: ignore[attr-defined]
         elif action.type is output_dir:
             action.complete = _COMPLETE_DIR  # type: ignore[attr-defined]
@@ -170,6 +172,10 @@ def output_file(text: str) -> Path:
         raise argparse.ArgumentTypeError(
             f"cannot write {text!r}: folder {str(parent)!r} does not exist"
         )
+    if path.exists() and not path.is_file():
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text!r}: not a regular file (a device or FIFO is not replaced)"
+        )
     if path.exists() and not os.access(path, os.W_OK):
         raise argparse.ArgumentTypeError(f"cannot write {text!r}: permission denied")
     why = _writable(parent)
@@ -219,28 +225,29 @@ def output_dir(text: str) -> Path:
 
 
 def config_file(text: str) -> Path:
-    """A ``type=`` for a TOML file the command will read: it must exist and be UTF-8
-    without a byte-order mark (TOML 1.0 requires UTF-8, and a BOM is not TOML)."""
-    path = Path(text)
+    """A ``type=`` for a configuration or data file the command will read: a regular file
+    of bounded size, UTF-8 without a byte-order mark (the checks of
+    :func:`softarm.files.read_text`; a FIFO or ``/dev/zero`` is refused, not read)."""
+    from softarm.files import read_text
+
     try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise argparse.ArgumentTypeError(f"{text!r} does not exist") from None
-    except IsADirectoryError:
-        raise argparse.ArgumentTypeError(f"{text!r} is a directory, not a file") from None
-    except OSError as exc:
-        raise argparse.ArgumentTypeError(f"cannot read {text!r}: {exc.strerror}") from None
-    if data.startswith(codecs.BOM_UTF8):
-        raise argparse.ArgumentTypeError(
-            f"{text!r} starts with a UTF-8 byte-order mark; save it as UTF-8 without BOM"
-        )
+        read_text(text, "file")
+    except SoftarmError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return Path(text)
+
+
+def data_file(text: str) -> Path:
+    """A ``type=`` for a data file read line by line (a run log, of any length): an
+    existing regular file (:func:`softarm.files.open_regular`); its lines are checked
+    as they are read."""
+    from softarm.files import open_regular
+
     try:
-        data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not UTF-8 (byte {data[exc.start]:#04x} at offset {exc.start})"
-        ) from None
-    return path
+        open_regular(text, "file").close()
+    except SoftarmError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return Path(text)
 
 
 def add_quiet(parser: argparse.ArgumentParser) -> None:

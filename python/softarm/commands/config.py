@@ -12,6 +12,7 @@ from importlib import resources
 
 from softarm.commands._args import RawDefaultsFormatter, config_file, output_file
 from softarm.errors import ConfigError
+from softarm.files import write_text
 
 #: Replaces the shipped file's [calibration] tables: every entry the hardware harvest
 #: needs, commented out with a placeholder of the right shape and where its value comes
@@ -86,7 +87,7 @@ def run_init(args: argparse.Namespace) -> int:
     """Write the template (refusing to overwrite without --force)."""
     if args.path.exists() and not args.force:
         raise ConfigError(f"{args.path} exists; pass --force to overwrite it")
-    args.path.write_text(template(), encoding="utf-8")
+    write_text(args.path, template(), "config file")
     print(f"wrote {args.path}: fill in [calibration], then `softarm config check {args.path}`")
     return 0
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from softarm.commands._args import config_file, int_range, non_negative_int, output_file
+from softarm.commands._args import data_file, int_range, non_negative_int, output_file
 from softarm.commands.harvest import MAX_BERRIES
 
 
@@ -19,7 +19,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "Without --record the rerun viewer is started. Needs the viz extra: "
         "pip install 'softarm[viz]'. Exit status 0, or 2 for a bad log or a missing extra.",
     )
-    p.add_argument("log", type=config_file, help="run log written by `softarm harvest --log`")
+    p.add_argument("log", type=data_file, help="run log written by `softarm harvest --log`")
     p.add_argument("--record", type=output_file, metavar="OUT.rrd", help="save the recording")
     p.add_argument(
         "--view",

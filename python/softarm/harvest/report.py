@@ -8,6 +8,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from softarm.files import write_text
 from softarm.harvest.log import _plain
 from softarm.harvest.states import FaultReason, HarvestState
 
@@ -86,4 +87,4 @@ class HarvestReport:
     def save(self, path: str | Path) -> None:
         """Write the report as indented JSON."""
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n")
+        write_text(path, json.dumps(self.to_dict(), indent=2, allow_nan=False) + "\n", "report")

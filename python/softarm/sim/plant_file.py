@@ -20,13 +20,13 @@ Example file::
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softarm.errors import ConfigError, ParameterError
+from softarm.files import load_toml
 
 if TYPE_CHECKING:
     from softarm.sim.arm import PlantConfig
@@ -179,14 +179,7 @@ def load_plant_file(path: str | Path) -> PlantConfig:
             key is unknown, mistyped or out of range (one line: file, key, value, range).
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read plant file {str(path)!r}: {exc}") from exc
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
+    data = load_toml(path, "plant file")
     if "plant" not in data:
         raise ConfigError(f"{path}: no [plant] table (keys: {', '.join(PLANT_KEYS)})")
     if not isinstance(data["plant"], dict):

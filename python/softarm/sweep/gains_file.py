@@ -7,7 +7,6 @@ hardware configuration file.
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -15,6 +14,7 @@ from typing import Any
 import softarm
 from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError
+from softarm.files import load_toml, write_text
 
 __all__ = ["GAIN_KEYS", "apply_gains", "gains_from", "load_gains", "write_gains"]
 
@@ -37,12 +37,7 @@ def gains_from(values: Mapping[str, Any]) -> softarm.Gains:
 def load_gains(path: str | Path) -> dict[str, Any]:
     """The ``[gains]`` table of a TOML file, validated (see :func:`gains_from`)."""
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text())
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read the gains file ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: not valid TOML ({exc})") from None
+    data = load_toml(p, "gains file")
     table = data.get("gains")
     if not isinstance(table, dict):
         raise ConfigError(f"{p}: a [gains] table is required")
@@ -73,7 +68,7 @@ def write_gains(path: str | Path, gains: softarm.Gains, header: str = "") -> Non
     lines += ["[gains]", *(f"{k} = {_toml_value(v)}" for k, v in gains.as_dict().items())]
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_text("\n".join(lines) + "\n")
+    write_text(p, "\n".join(lines) + "\n", "gains file")
 
 
 def apply_gains(rig: Any, values: Mapping[str, Any]) -> None:

@@ -13,13 +13,13 @@ import hashlib
 import itertools
 import json
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from softarm.errors import ConfigError, SoftarmError
+from softarm.files import load_toml
 
 __all__ = [
     "RIG_KEYS",
@@ -126,16 +126,7 @@ def load_spec(path: str | Path) -> SweepSpec:
         ConfigError: missing file, bad TOML, unknown key, empty list, wrong type or a value
             out of range; the one-line message names the key.
     """
-    p = Path(path)
-    try:
-        text = p.read_text()
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read the sweep spec ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: not valid TOML ({exc})") from None
-    return parse_spec(data, str(p))
+    return parse_spec(load_toml(path, "sweep spec"), str(path))
 
 
 def _is_number(v: Any) -> bool:
