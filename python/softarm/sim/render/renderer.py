@@ -1,0 +1,171 @@
+"""MuJoCo's offscreen renderer on a bush scene: colour, depth and per-geom segmentation
+from any camera of the scene, with the arm moved each frame.
+
+Rendering is MuJoCo's OpenGL rasteriser through EGL (``MUJOCO_GL=egl``; on machines
+without a GPU, Mesa's software rasteriser). No shadows: one directional light plus
+ambient. Lens distortion is applied afterwards (:mod:`softarm.sim.render.distortion`).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from scipy.spatial.transform import Rotation
+
+from softarm.checks import FloatArray
+from softarm.errors import SoftarmError
+from softarm.sim.render.labels import GeomLabels
+from softarm.sim.render.mjcf import (
+    ARM_SEGMENTS_PER_SECTION,
+    CameraSpec,
+    SceneSpec,
+    scene_xml,
+)
+from softarm.sim.render.mjcf import z_to as _z_to
+
+__all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
+
+
+class RenderUnavailableError(SoftarmError):
+    """The rendered world cannot run here: MuJoCo or an offscreen OpenGL is missing."""
+
+
+HOW_TO_ENABLE = (
+    "the rendered bush needs MuJoCo (pip install mujoco) and an offscreen OpenGL: set "
+    "MUJOCO_GL=egl with an EGL driver (Mesa's libegl1 on a machine without a GPU, the "
+    "NVIDIA driver on one with it) or MUJOCO_GL=osmesa; or use --world tags"
+)
+
+
+def require_mujoco() -> Any:
+    """The ``mujoco`` module with an offscreen backend selected (EGL unless the caller
+    chose one), or :class:`RenderUnavailableError` saying how to enable it."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        import mujoco
+    except (ImportError, OSError, AttributeError) as exc:  # missing or broken GL library
+        raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
+    return mujoco
+
+
+@dataclass(frozen=True)
+class RenderedFrame:
+    """One camera's image: ``colour`` (H, W, 3) BGR uint8 as OpenCV reads it, ``depth``
+    (H, W) float32 metres along the optical axis (NaN: nothing drawn), ``geoms`` (H, W)
+    int32 geom ids (-1: nothing); depth and geoms only when asked for."""
+
+    colour: npt.NDArray[np.uint8]
+    depth: npt.NDArray[np.float32] | None = None
+    geoms: npt.NDArray[np.int32] | None = None
+
+
+class BushRenderer:
+    """Renders the scene of ``spec``; :meth:`set_arm` moves the arm, :meth:`render`
+    draws one camera.
+
+    Raises:
+        RenderUnavailableError: no MuJoCo or no offscreen OpenGL (the message says how
+            to enable it).
+    """
+
+    def __init__(self, spec: SceneSpec) -> None:
+        mujoco = require_mujoco()
+        self._mj = mujoco
+        xml, assets = scene_xml(spec)
+        self.model = mujoco.MjModel.from_xml_string(xml, assets)
+        self.data = mujoco.MjData(self.model)
+        self.cameras = {c.name: c for c in [*spec.world_cameras, *spec.hand_cameras]}
+        self.labels = GeomLabels.from_model(self.model, mujoco)
+        self._renderers: dict[tuple[int, int], Any] = {}
+        self._mocap = {
+            self.model.body(i).name: self.model.body_mocapid[i]
+            for i in range(self.model.nbody)
+            if self.model.body_mocapid[i] >= 0
+        }
+        self._seg_geoms = [
+            mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, f"arm_seg{k}")
+            for k in range(spec.n_sections * ARM_SEGMENTS_PER_SECTION)
+        ]
+        self.n_sections = spec.n_sections
+        self._arm_set = False
+
+    def set_arm(self, sections: Sequence[FloatArray], T_base_ee: FloatArray) -> None:
+        """Draw the arm: ``sections`` are (ARM_SEGMENTS_PER_SECTION + 1, 3) points along
+        each section's centre line (base frame), ``T_base_ee`` the end effector; the
+        gripper, hand cameras and cube ride on the end effector."""
+        k = 0
+        for points in sections:
+            for a, b in zip(points[:-1], points[1:]):
+                self._place(f"arm_seg{k}", 0.5 * (a + b), _z_to(b - a))
+                self.model.geom_size[self._seg_geoms[k], 1] = max(
+                    0.5 * float(np.linalg.norm(b - a)), 1e-4
+                )
+                k += 1
+        ends = [s[0] for s in sections] + [sections[-1][-1]]
+        tangents = [s[1] - s[0] for s in sections] + [sections[-1][-1] - sections[-1][-2]]
+        for i, (p, t) in enumerate(zip(ends, tangents)):
+            self._place(f"arm_plate{i}", p, _z_to(t))
+        self._place("arm_ee", T_base_ee[:3, 3], T_base_ee[:3, :3])
+        self._arm_set = True
+
+    def set_cube(self, T_base_cube: FloatArray) -> None:
+        """Place the marker cube (it rides on the end effector: call after set_arm)."""
+        self._place("arm_cube", T_base_cube[:3, 3], T_base_cube[:3, :3])
+
+    def hide_arm(self) -> None:
+        """Move the arm out of sight (an empty bush, as at registration or a dataset)."""
+        for name in self._mocap:
+            self._place(name, np.array([0.0, -50.0, 0.0]), np.eye(3))
+        self._arm_set = False
+
+    def render(self, camera: str, depth: bool = False, geoms: bool = False) -> RenderedFrame:
+        """One image of ``camera`` (a name of the scene) as it is now."""
+        mj = self._mj
+        mj.mj_kinematics(self.model, self.data)
+        mj.mj_camlight(self.model, self.data)  # camera and light poses from the bodies
+        spec = self.cameras[camera]
+        r = self._renderer(spec)
+        r.update_scene(self.data, camera=camera)
+        rgb = r.render()
+        colour = np.ascontiguousarray(rgb[..., ::-1])
+        d = s = None
+        if depth:
+            r.enable_depth_rendering()
+            r.update_scene(self.data, camera=camera)
+            d = r.render().astype(np.float32)
+            r.disable_depth_rendering()
+        if geoms:
+            r.enable_segmentation_rendering()
+            r.update_scene(self.data, camera=camera)
+            seg = r.render()
+            r.disable_segmentation_rendering()
+            s = np.where(seg[..., 1] == int(mj.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
+            s = s.astype(np.int32)
+        if d is not None and s is not None:
+            d[s < 0] = np.nan
+        return RenderedFrame(colour, d, s)
+
+    def close(self) -> None:
+        """Free the OpenGL contexts."""
+        for r in self._renderers.values():
+            r.close()
+        self._renderers.clear()
+
+    def _renderer(self, spec: CameraSpec) -> Any:
+        w, h = spec.size
+        if (w, h) not in self._renderers:
+            self.model.vis.global_.offwidth = max(self.model.vis.global_.offwidth, w)
+            self.model.vis.global_.offheight = max(self.model.vis.global_.offheight, h)
+            self._renderers[(w, h)] = self._mj.Renderer(self.model, h, w)
+        return self._renderers[(w, h)]
+
+    def _place(self, body: str, pos: FloatArray, R: FloatArray) -> None:
+        i = self._mocap[body]
+        self.data.mocap_pos[i] = pos
+        x, y, z, w = Rotation.from_matrix(R).as_quat()
+        self.data.mocap_quat[i] = (w, x, y, z)

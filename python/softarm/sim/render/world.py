@@ -1,0 +1,176 @@
+"""The rendered bush world: a :class:`~softarm.sim.bush.Bush` drawn with leaves, clutter
+and the arm, seen by C1 (the ZED2: a stereo pair with a 12 cm baseline, 1280 × 720 per
+eye) and C2 (the eye-in-hand camera), with lens distortion, and the ground truth of every
+frame (instance masks and depth).
+
+C1's left eye is the eye-to-hand camera of the tag world (``SimCameras.T_base_c1``);
+the right eye sits ``baseline`` along its +x, as the ZED2's do.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from softarm._core import SoftArm
+from softarm.checks import FloatArray
+from softarm.sim.bush import PLUS_Y, Bush
+from softarm.sim.render.distortion import Distorter
+from softarm.sim.render.labels import GeomLabels
+from softarm.sim.render.look import BushLook
+from softarm.sim.render.mjcf import ARM_SEGMENTS_PER_SECTION, CameraSpec, SceneSpec
+from softarm.sim.render.renderer import BushRenderer, RenderedFrame
+from softarm.vision.camera_model import CameraModel
+
+__all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
+
+#: The ZED2's stereo baseline (m).
+ZED2_BASELINE = 0.12
+
+
+@dataclass(frozen=True)
+class StereoCamera:
+    """A calibrated stereo pair: both eyes' intrinsics, the left eye in the base frame
+    and the right eye in the left eye's frame (``T_left_right``)."""
+
+    left: CameraModel
+    right: CameraModel
+    T_base_left: FloatArray
+    T_left_right: FloatArray
+
+    @property
+    def baseline(self) -> float:
+        """Distance (m) between the two optical centres."""
+        return float(np.linalg.norm(self.T_left_right[:3, 3]))
+
+
+def arm_sections(arm: SoftArm, q: FloatArray) -> list[FloatArray]:
+    """(ARM_SEGMENTS_PER_SECTION + 1, 3) points along each section of the constant-
+    curvature ``arm`` at elongations ``q``, for drawing."""
+    s = np.linspace(0.0, 1.0, ARM_SEGMENTS_PER_SECTION + 1)
+    return [np.array([arm.point(q, k, u)[0] for u in s]) for k in range(arm.n_sections)]
+
+
+def polyline_sections(points: FloatArray, section_of: Sequence[int], n: int) -> list[FloatArray]:
+    """A centre line (N, 3) whose nodes belong to sections ``section_of`` (the Cosserat
+    rod's), resampled to ARM_SEGMENTS_PER_SECTION + 1 points per section by arc length."""
+    out = []
+    labels = np.asarray(section_of)
+    for k in range(n):
+        pts = points[labels == k]
+        if len(pts) < 2:
+            pts = np.vstack([pts, pts]) if len(pts) else np.zeros((2, 3))
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        t = np.linspace(0.0, arc[-1], ARM_SEGMENTS_PER_SECTION + 1)
+        out.append(np.column_stack([np.interp(t, arc, pts[:, i]) for i in range(3)]))
+    return out
+
+
+class RenderedBush:
+    """The bush of ``bush`` as MuJoCo draws it (see the module docstring).
+
+    Args:
+        bush: berries (ripe and unripe) and canes.
+        T_base_c1: the left eye of C1 in the base frame.
+        c1: the intrinsics of each eye of C1 (with distortion and image size).
+        c2: C2's intrinsics; ``T_ee_c2`` its pose on the end effector.
+        T_ee_cube: the marker cube on the end effector; ``cube_marker`` its tags' side.
+        T_base_tag, base_tag_id, base_tag: the base tag.
+        look: the appearance; None draws one from the bush's seed.
+        baseline: C1's stereo baseline (m).
+        n_sections: sections of the arm drawn.
+    """
+
+    def __init__(
+        self,
+        bush: Bush,
+        T_base_c1: FloatArray,
+        c1: CameraModel,
+        c2: CameraModel,
+        T_ee_c2: FloatArray,
+        T_ee_cube: FloatArray,
+        T_base_tag: FloatArray,
+        base_tag_id: int,
+        base_tag: float,
+        cube_marker: float = 0.08,
+        look: BushLook | None = None,
+        baseline: float = ZED2_BASELINE,
+        n_sections: int = 3,
+    ) -> None:
+        self.bush = bush
+        self.look = look or BushLook.random(bush.seed)
+        T_left_right = np.eye(4)
+        T_left_right[0, 3] = baseline
+        self.stereo = StereoCamera(c1, c1, T_base_c1, T_left_right)
+        self.c2 = c2
+        self.T_ee_cube = T_ee_cube
+        right = T_base_c1 @ T_left_right
+        spec = SceneSpec(
+            bush=bush,
+            look=self.look,
+            world_cameras=[_spec("c1_left", T_base_c1, c1), _spec("c1_right", right, c1)],
+            hand_cameras=[_spec("c2", T_ee_c2, c2)],
+            T_base_tag=T_base_tag,
+            base_tag_id=base_tag_id,
+            tag_length=base_tag,
+            cube_marker=cube_marker,
+            n_sections=n_sections,
+            keep_clear=_approach_lines(bush),
+        )
+        self.renderer = BushRenderer(spec)
+        self._distort = {"c1": Distorter(c1), "c2": Distorter(c2)}
+        self.renderer.hide_arm()
+
+    @property
+    def labels(self) -> GeomLabels:
+        """Which object each geom id of a frame's ``geoms`` belongs to."""
+        return self.renderer.labels
+
+    def set_arm(self, sections: Sequence[FloatArray], T_base_ee: FloatArray) -> None:
+        """Draw the arm along ``sections`` (see :func:`arm_sections`) with its end
+        effector, gripper, C2 and cube at ``T_base_ee``."""
+        self.renderer.set_arm(sections, T_base_ee)
+        self.renderer.set_cube(T_base_ee @ self.T_ee_cube)
+
+    def hide_arm(self) -> None:
+        """An empty view of the bush (no arm)."""
+        self.renderer.hide_arm()
+
+    def c1(self, truth: bool = False) -> tuple[RenderedFrame, RenderedFrame]:
+        """C1's (left, right) images; with ``truth`` also depth and geom ids."""
+        return self._frame("c1_left", "c1", truth), self._frame("c1_right", "c1", truth)
+
+    def c1_left(self, truth: bool = False) -> RenderedFrame:
+        """C1's left eye alone (the cube tracking needs one eye)."""
+        return self._frame("c1_left", "c1", truth)
+
+    def c2_frame(self, truth: bool = False) -> RenderedFrame:
+        """C2's image from where the arm is drawn."""
+        return self._frame("c2", "c2", truth)
+
+    def close(self) -> None:
+        """Free the renderer."""
+        self.renderer.close()
+
+    def _frame(self, camera: str, lens: str, truth: bool) -> RenderedFrame:
+        f = self.renderer.render(camera, depth=truth, geoms=truth)
+        d = self._distort[lens]
+        return RenderedFrame(
+            d.colour(f.colour),
+            None if f.depth is None else d.nearest(f.depth),
+            None if f.geoms is None else d.nearest(f.geoms),
+        )
+
+
+def _spec(name: str, pose: FloatArray, camera: CameraModel) -> CameraSpec:
+    K = camera.matrix
+    size = camera.image_size or (int(2 * K[0, 2] + 1), int(2 * K[1, 2] + 1))
+    return CameraSpec(name, pose, size, float(K[0, 0]), (float(K[0, 2]), float(K[1, 2])))
+
+
+def _approach_lines(bush: Bush) -> list[tuple[FloatArray, FloatArray]]:
+    """The last 8 cm before each berry along +Y: leaves stay out of them, as a gripper
+    on a real bush pushes a leaf in its way aside."""
+    return [(b.position - 0.08 * PLUS_Y, b.position) for b in bush.berries]
