@@ -10,6 +10,7 @@ import it from below (see ``docs/architecture.md``, "Layers"). The image check
 
 from __future__ import annotations
 
+import numbers
 from typing import Any
 
 import numpy as np
@@ -17,17 +18,54 @@ import numpy.typing as npt
 
 from softarm.errors import NonFiniteError, ParameterError, PoseError, ShapeError
 
-__all__ = ["FloatArray", "as_array", "as_pose", "positive"]
+__all__ = ["FloatArray", "as_array", "as_pose", "numeric_array", "positive"]
 
 FloatArray = npt.NDArray[np.float64]
 
+#: numpy kinds that are numbers: signed and unsigned integers, floats. Not text ("U",
+#: "S": numpy would parse "1" as 1.0), not complex ("c": the cast drops the imaginary
+#: part with only a warning), not bool.
+_NUMERIC_KINDS = "iuf"
+
+
+def _short(value: Any) -> str:
+    """``repr(value)`` cut to one short line for a message (a 400-digit int, a big list)."""
+    text = repr(value).replace("\n", " ")
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _real_objects(arr: npt.NDArray[Any], value: Any, name: str) -> FloatArray:
+    """An object array (Python ints too large for int64, mixed types) as float64: every
+    element a real number, none beyond the float range."""
+    for item in arr.flat:
+        if isinstance(item, bool | np.bool_) or not isinstance(item, numbers.Real):
+            raise ShapeError(f"{name} must be numeric, got {_short(value)}")
+    try:
+        return arr.astype(np.float64)
+    except OverflowError:
+        raise NonFiniteError(f"{name} has a number beyond the float range") from None
+
+
+def numeric_array(value: Any, name: str) -> FloatArray:
+    """``value`` as a float64 array, from numbers only: text, bytes, complex, bool,
+    dicts and ragged lists are a :class:`ShapeError` naming ``name``, an integer beyond
+    the float range (a 400-digit int) a :class:`NonFiniteError`. Shape and finiteness
+    are the caller's (:func:`as_array`)."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError, OverflowError, RecursionError):
+        raise ShapeError(f"{name} must be numeric, got {_short(value)}") from None
+    if arr.dtype.kind == "O":
+        return _real_objects(arr, value, name)
+    if arr.dtype.kind not in _NUMERIC_KINDS:
+        raise ShapeError(f"{name} must be numeric, got {_short(value)}")
+    return arr.astype(np.float64)
+
 
 def as_array(value: Any, shape: tuple[int | None, ...], name: str) -> FloatArray:
-    """Convert ``value`` to float64 and check its shape (None = any length) and finiteness."""
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ShapeError(f"{name} must be numeric, got {value!r}") from exc
+    """Convert ``value`` to float64 (:func:`numeric_array`) and check its shape (None =
+    any length) and finiteness."""
+    arr = numeric_array(value, name)
     if arr.ndim != len(shape) or any(
         want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
     ):

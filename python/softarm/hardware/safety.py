@@ -22,6 +22,7 @@ from types import TracebackType
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import numeric_array
 from softarm.errors import (
     HardwareError,
     NonFiniteError,
@@ -181,10 +182,12 @@ class SafePressureBank:
 
         Raises:
             SafetyError: the emergency stop is latched or the bank is closed.
-            ShapeError: ``psi`` does not have shape ``(channels,)``.
-            NonFiniteError: ``psi`` contains NaN or inf. Nothing is forwarded.
+            ShapeError: ``psi`` is not numbers (text, complex, a dict...) or does not
+                have shape ``(channels,)``.
+            NonFiniteError: ``psi`` contains NaN, inf or a number beyond the float
+                range. Nothing is forwarded.
         """
-        requested = np.array(psi, dtype=np.float64)
+        requested = numeric_array(psi, "psi")
         if requested.shape != (self._n,):
             raise ShapeError(f"psi must have shape ({self._n},), got {requested.shape}")
         if not np.all(np.isfinite(requested)):
