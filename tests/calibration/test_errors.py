@@ -89,7 +89,7 @@ def test_predict_rejects_bad_commands() -> None:
 
 
 def test_load_rejects_malformed_model(tmp_path) -> None:
-    with pytest.raises(ConfigError, match="no such model"):
+    with pytest.raises(ConfigError, match="no such file"):
         Calibration.load(tmp_path / "absent.toml")
     c, p = _data()
     text = calibrate(ARM, c, p).to_toml()

@@ -19,26 +19,25 @@ the residual statistics on the fit data::
 from __future__ import annotations
 
 import json
-import math
-import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from softarm._core import Section, SoftArm
+from softarm._core import SoftArm
 from softarm.calibration.metrics import PoseErrorStats
-from softarm.errors import ConfigError, NonFiniteError, ShapeError, SoftarmError
+from softarm.calibration.model_file import FORMAT, SECTION_KEYS, model_fields
+from softarm.errors import NonFiniteError, ShapeError
+from softarm.files import load_toml, write_text
 from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["Calibration", "GainMap", "load_calibration", "load_model"]
 
 F64 = npt.NDArray[np.float64]
 
-FORMAT = 1
-_SECTION_KEYS = ("radius", "rest_length", "lower", "upper", "offset", "twist")
+_SECTION_KEYS = tuple(SECTION_KEYS)
 
 
 @dataclass
@@ -131,68 +130,19 @@ class Calibration:
 
     def save(self, path: str | Path) -> None:
         """Write ``model.toml``."""
-        Path(path).write_text(self.to_toml())
+        write_text(path, self.to_toml(), "model file")
 
     @classmethod
     def load(cls, path: str | Path) -> Calibration:
-        """Read a ``model.toml``; :class:`~softarm.errors.ConfigError` naming the key
-        when it is missing or malformed."""
-        p = Path(path)
-        try:
-            data = tomllib.loads(p.read_text())
-        except FileNotFoundError:
-            raise ConfigError(f"{p}: no such model file") from None
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-            raise ConfigError(f"{p}: cannot read the model: {exc}") from None
-        return cls.from_dict(data, str(p))
+        """Read a ``model.toml``; :class:`~softarm.errors.ConfigError` naming the file and
+        the key when it cannot be read, is not TOML, or a value is malformed or out of
+        its range (:mod:`softarm.calibration.model_file`)."""
+        return cls.from_dict(load_toml(path, "model file"), str(path))
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], source: str = "<model>") -> Calibration:
         """A Calibration from the parsed TOML of :meth:`to_toml`."""
-        if data.get("format") != FORMAT:
-            raise ConfigError(f"{source}: format = {data.get('format')!r}, expected {FORMAT}")
-        raw = data.get("arm", {}).get("sections")
-        if not isinstance(raw, list) or not raw:
-            raise ConfigError(f"{source}: arm.sections: missing or empty")
-        sections = []
-        for i, s in enumerate(raw):
-            key = f"{source}: arm.sections[{i}]"
-            if not isinstance(s, dict) or set(s) != set(_SECTION_KEYS):
-                raise ConfigError(f"{key}: expected exactly the keys {', '.join(_SECTION_KEYS)}")
-            vals = {k: s[k] for k in _SECTION_KEYS}
-            if not all(isinstance(v, int | float) and math.isfinite(v) for v in vals.values()):
-                raise ConfigError(f"{key}: every value must be a finite number")
-            try:
-                sections.append(Section(**vals))
-            except SoftarmError as exc:
-                raise ConfigError(f"{key}: {exc}") from None
-        arm = SoftArm(sections)
-        gain = np.asarray(data.get("actuators", {}).get("gain", []), dtype=object)
-        if gain.shape != (arm.n_actuators,) or not all(
-            isinstance(g, int | float) and math.isfinite(g) and g > 0 for g in gain
-        ):
-            raise ConfigError(
-                f"{source}: actuators.gain: expected {arm.n_actuators} positive finite numbers"
-            )
-        offset = np.asarray(data["actuators"].get("offset", [0.0] * arm.n_actuators), dtype=object)
-        if offset.shape != (arm.n_actuators,) or not all(
-            isinstance(o, int | float) and math.isfinite(o) for o in offset
-        ):
-            raise ConfigError(
-                f"{source}: actuators.offset: expected {arm.n_actuators} finite numbers"
-            )
-        fit_d = data.get("fit", {})
-        names = [f.name for f in fields(PoseErrorStats)]
-        if set(fit_d) != set(names):
-            raise ConfigError(f"{source}: fit: expected exactly the keys {', '.join(names)}")
-        return cls(
-            arm=arm,
-            actuator_gain=gain.astype(np.float64),
-            actuator_offset=offset.astype(np.float64),
-            fit=PoseErrorStats(**fit_d),
-            parameters={str(k): float(v) for k, v in data.get("parameters", {}).items()},
-            converged=bool(data.get("converged", True)),
-        )
+        return cls(**model_fields(data, source))
 
 
 class GainMap:
