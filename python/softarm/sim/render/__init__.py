@@ -13,7 +13,7 @@ from softarm.sim.render.renderer import (
     RenderUnavailableError,
     require_mujoco,
 )
-from softarm.sim.render.world import ZED2_BASELINE, RenderedBush, StereoCamera, arm_sections
+from softarm.sim.render.world import ZED2_BASELINE, RenderedBush, arm_sections
 
 __all__ = [
     "KINDS",
@@ -24,7 +24,6 @@ __all__ = [
     "RenderUnavailableError",
     "RenderedBush",
     "RenderedFrame",
-    "StereoCamera",
     "arm_sections",
     "require_mujoco",
 ]

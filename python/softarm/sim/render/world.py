@@ -10,8 +10,6 @@ the right eye sits ``baseline`` along its +x, as the ZED2's do.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-
 import numpy as np
 
 from softarm._core import SoftArm
@@ -21,6 +19,7 @@ from softarm.sim.render.distortion import Distorter
 from softarm.sim.render.labels import GeomLabels
 from softarm.sim.render.look import BushLook
 from softarm.sim.render.mjcf import ARM_SEGMENTS_PER_SECTION, CameraSpec, SceneSpec
+from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
 from softarm.vision.camera_model import CameraModel
 
@@ -28,22 +27,6 @@ __all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
 
 #: The ZED2's stereo baseline (m).
 ZED2_BASELINE = 0.12
-
-
-@dataclass(frozen=True)
-class StereoCamera:
-    """A calibrated stereo pair: both eyes' intrinsics, the left eye in the base frame
-    and the right eye in the left eye's frame (``T_left_right``)."""
-
-    left: CameraModel
-    right: CameraModel
-    T_base_left: FloatArray
-    T_left_right: FloatArray
-
-    @property
-    def baseline(self) -> float:
-        """Distance (m) between the two optical centres."""
-        return float(np.linalg.norm(self.T_left_right[:3, 3]))
 
 
 def arm_sections(arm: SoftArm, q: FloatArray) -> list[FloatArray]:
