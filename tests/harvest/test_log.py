@@ -6,6 +6,7 @@ import json
 
 import pytest
 
+from softarm.errors import InputError
 from softarm.harvest import BerryTarget, HarvestLog, read_log
 
 from .fakes import make_rig
@@ -46,7 +47,7 @@ def test_read_log_skips_only_a_truncated_last_line(tmp_path) -> None:
     path.write_text('{"kind": "step", "t": 0.0}\n{"kind": "step", "t": 0.05}\n{"kind": "st')
     assert [r["t"] for r in read_log(path)] == [0.0, 0.05]
     path.write_text('{"kind": "step"}\n{"kind": \n{"kind": "step"}\n')
-    with pytest.raises(json.JSONDecodeError):
+    with pytest.raises(InputError, match=r"cut\.jsonl: line 2 is not a JSON record"):
         list(read_log(path))
 
 

@@ -123,7 +123,7 @@ def test_a_line_that_is_not_json_is_named(tmp_path, capsys) -> None:
     log = tmp_path / "bad.jsonl"
     log.write_text('{"kind": "ripeness", "value": 1.0}\nnot json\n{"kind": "x"}\n')
     assert main(["replay", str(log), "--record", str(tmp_path / "o.rrd")]) == 2
-    assert "record 2 is not JSON" in capsys.readouterr().err
+    assert "line 2 is not a JSON record" in capsys.readouterr().err
 
 
 def test_view_without_a_display_fails_before_the_run(tmp_path, monkeypatch, capsys) -> None:

@@ -3,6 +3,11 @@
 Every control step appends one line and flushes it; every state transition and fault is
 also ``fsync``'d, so after a crash (or a power cut on the robot) the file parses line by
 line up to the last record written, and no transition is lost.
+
+A power cut can still leave the last line cut off. A run that appends to such a file
+first ends that line and writes a :data:`CUT_MARK` record, so its own records start on
+a fresh line and :func:`read_log` knows the line above the mark was cut, not corrupt:
+both runs stay readable.
 """
 
 from __future__ import annotations
@@ -17,7 +22,16 @@ from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["HarvestLog", "read_log"]
+from softarm.errors import ConfigError, InputError
+from softarm.files import check_document, check_target, open_regular, output_error
+
+__all__ = ["CUT_MARK", "HarvestLog", "read_log"]
+
+#: The kind of the record an appending run writes after a cut-off last line.
+CUT_MARK = "previous_line_cut"
+#: Longest line :func:`read_log` reads (1 MiB; a step record is a few hundred bytes): a
+#: file without newlines must not be read whole into memory.
+MAX_LINE_BYTES = 2**20
 
 
 #: Significant digits of the floats in logs and reports: 10 nm on an elongation of a few
@@ -54,8 +68,23 @@ class HarvestLog:
         self.records: list[dict[str, Any]] = []
         self._file: IO[str] | None = None
         if self.path is not None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._file = self.path.open("a", encoding="utf-8")
+            self._file = self._open(self.path)
+
+    @staticmethod
+    def _open(path: Path) -> IO[str]:
+        """``path`` opened for appending; a cut-off last line is ended and marked first."""
+        try:
+            target = check_target(path, "log")
+            target.parent.mkdir(parents=True, exist_ok=True)
+            cut = _ends_cut(target)
+            file = target.open("a", encoding="utf-8")
+            if cut:
+                file.write("\n" + json.dumps({"kind": CUT_MARK}) + "\n")
+                file.flush()
+                os.fsync(file.fileno())
+        except OSError as exc:
+            raise output_error(path, "log", exc) from None
+        return file
 
     def step(self, **fields: Any) -> None:
         """One control step: written and flushed."""
@@ -70,17 +99,24 @@ class HarvestLog:
         self.records.append(rec)
         if self._file is None:
             return
-        self._file.write(json.dumps(rec, allow_nan=False) + "\n")
-        self._file.flush()
-        if sync:
-            os.fsync(self._file.fileno())
+        try:
+            self._file.write(json.dumps(rec, allow_nan=False) + "\n")
+            self._file.flush()
+            if sync:
+                os.fsync(self._file.fileno())
+        except OSError as exc:
+            raise output_error(self.path or "", "log", exc) from None
 
     def close(self) -> None:
         """Sync and close the file. Calling it twice is harmless."""
         if self._file is not None and not self._file.closed:
-            self._file.flush()
-            os.fsync(self._file.fileno())
-            self._file.close()
+            try:
+                self._file.flush()
+                os.fsync(self._file.fileno())
+            except OSError as exc:
+                raise output_error(self.path or "", "log", exc) from None
+            finally:
+                self._file.close()
 
     def __enter__(self) -> HarvestLog:
         return self
@@ -94,16 +130,65 @@ class HarvestLog:
         self.close()
 
 
+def _ends_cut(path: Path) -> bool:
+    """Whether ``path`` exists, is not empty and its last byte is not a newline."""
+    try:
+        with path.open("rb") as f:
+            if f.seek(0, os.SEEK_END) == 0:
+                return False
+            f.seek(-1, os.SEEK_END)
+            return f.read(1) != b"\n"
+    except FileNotFoundError:
+        return False
+
+
+def _lines(path: str | Path) -> Iterator[tuple[int, bytes]]:
+    """(number, bytes) of each line of the regular file ``path``, without reading more
+    than :data:`MAX_LINE_BYTES` for one line."""
+    with open_regular(path, "log", InputError) as f:
+        number = 0
+        while line := f.readline(MAX_LINE_BYTES + 1):
+            number += 1
+            if len(line) > MAX_LINE_BYTES:
+                raise InputError(f"{path}: line {number} is longer than {MAX_LINE_BYTES} bytes")
+            yield number, line
+
+
 def read_log(path: str | Path) -> Iterator[dict[str, Any]]:
-    """Records of a log file, in order. A truncated last line (a crash mid-write) is
-    skipped; any other malformed line raises ``json.JSONDecodeError``."""
-    lines = Path(path).read_text(encoding="utf-8").split("\n")
-    for i, line in enumerate(lines):
-        if not line:
-            continue
-        try:
-            yield json.loads(line)
-        except json.JSONDecodeError:
-            if i == len(lines) - 1:  # no newline after it: the write was cut short
-                return
-            raise
+    """Records of a log file, in order.
+
+    A cut-off line (a crash mid-write) is skipped where it is the last line, or where the
+    run appended after it marked it (:data:`CUT_MARK`). Any other malformed line is an
+    :class:`~softarm.errors.InputError` naming the file and the line.
+    """
+    pending: InputError | None = None  # a bad line, kept until the next line tells
+    ends_with_newline = True
+    for number, line in _lines(path):
+        record = _parse(path, number, line)
+        marks_cut = isinstance(record, dict) and record.get("kind") == CUT_MARK
+        if pending is not None and not marks_cut:
+            raise pending
+        pending = record if isinstance(record, InputError) else None
+        if pending is None and line.strip():
+            yield record
+        ends_with_newline = line.endswith(b"\n")
+    if pending is not None and ends_with_newline:  # complete, so not cut: corrupt
+        raise pending
+
+
+def _parse(path: str | Path, number: int, line: bytes) -> Any:
+    """The JSON value of ``line`` (None for a blank one), or the InputError refusing it
+    (not UTF-8, not JSON, too deep, an integer past 64 bits)."""
+    if not line.strip():
+        return None
+    where = f"{path}: line {number}"
+    try:
+        value = json.loads(line.decode("utf-8"))
+        check_document(value, where)
+    except json.JSONDecodeError as exc:
+        return InputError(f"{where} is not a JSON record ({exc.msg})")
+    except ConfigError as exc:
+        return InputError(str(exc))
+    except (UnicodeDecodeError, RecursionError, ValueError) as exc:
+        return InputError(f"{where} is not a JSON record ({type(exc).__name__})")
+    return value
