@@ -9,8 +9,9 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.errors import VisionError
+from softarm.errors import InputError, VisionError
 from softarm.vision._checks import as_gray, positive
+from softarm.vision._opencv import opencv_errors
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.dictionaries import get_dictionary
 
@@ -32,17 +33,19 @@ def calibrate_chessboard(
     Views where the board is not found are skipped; at least 3 must remain. ``flags`` are
     ``cv2.calibrateCamera`` flags (default: k3 fixed at 0, see :data:`DEFAULT_FLAGS`)."""
     size = positive(square, "square")
-    cols, rows = int(pattern[0]), int(pattern[1])
+    # findChessboardCorners needs more than 2 inner corners each way.
+    cols, rows = grid_size(pattern, "pattern", least=3)
     grid = np.zeros((cols * rows, 3), np.float32)
     grid[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * size
     obj, img, shape = [], [], None
     for k, image in enumerate(images):
         gray = as_gray(image, f"images[{k}]")
         shape = _same_shape(shape, gray, k)
-        found, corners = cv2.findChessboardCorners(gray, (cols, rows))
-        if not found:
-            continue
-        corners = cv2.cornerSubPix(gray, corners, (5, 5), (-1, -1), _SUBPIX)
+        with opencv_errors(f"chessboard in images[{k}]"):
+            found, corners = cv2.findChessboardCorners(gray, (cols, rows))
+            if not found:
+                continue
+            corners = cv2.cornerSubPix(gray, corners, (5, 5), (-1, -1), _SUBPIX)
         obj.append(grid)
         img.append(corners)
     return _calibrate(obj, img, shape, flags)
@@ -58,12 +61,13 @@ def calibrate_charuco(
 ) -> tuple[CameraModel, float]:
     """Calibrate from views of a ChArUco board of ``squares`` = (columns, rows) squares.
     Views with fewer than 6 ChArUco corners are skipped; at least 3 must remain."""
-    board = cv2.aruco.CharucoBoard(
-        (int(squares[0]), int(squares[1])),
-        positive(square_length, "square_length"),
-        positive(marker_length, "marker_length"),
-        get_dictionary(dictionary),
-    )
+    with opencv_errors("ChArUco board"):
+        board = cv2.aruco.CharucoBoard(
+            grid_size(squares, "squares", least=2),
+            positive(square_length, "square_length"),
+            positive(marker_length, "marker_length"),
+            get_dictionary(dictionary),
+        )
     detector = cv2.aruco.CharucoDetector(board)
     obj, img, shape = [], [], None
     for k, image in enumerate(images):
@@ -77,6 +81,28 @@ def calibrate_charuco(
         obj.append(np.asarray(o, dtype=np.float32))
         img.append(np.asarray(i, dtype=np.float32))
     return _calibrate(obj, img, shape, flags)
+
+
+#: The largest board side (corners or squares) accepted: far beyond any printed board,
+#: small enough that the object grid stays a few MB.
+MAX_GRID = 200
+
+
+def grid_size(value: Any, name: str, least: int) -> tuple[int, int]:
+    """``value`` as (columns, rows): two integers in [``least``, :data:`MAX_GRID`]."""
+    ok = (
+        isinstance(value, tuple | list)
+        and len(value) == 2
+        and all(isinstance(v, int | np.integer) and not isinstance(v, bool) for v in value)
+        and all(least <= v <= MAX_GRID for v in value)
+    )
+    if not ok:
+        raise InputError(
+            f"{name} must be two integers (columns, rows) in [{least}, {MAX_GRID}], got {value!r}"[
+                :200
+            ]
+        )
+    return int(value[0]), int(value[1])
 
 
 def _same_shape(shape: tuple[int, int] | None, gray: npt.NDArray[Any], k: int) -> tuple[int, int]:
@@ -94,5 +120,6 @@ def _calibrate(
     if shape is None or len(obj) < _MIN_VIEWS:
         raise VisionError(f"calibration needs >= {_MIN_VIEWS} usable views, got {len(obj)}")
     h, w = shape
-    rms, mat, dist, _, _ = cv2.calibrateCamera(obj, img, (w, h), None, None, flags=flags)
+    with opencv_errors("calibrateCamera: views or flags"):
+        rms, mat, dist, _, _ = cv2.calibrateCamera(obj, img, (w, h), None, None, flags=flags)
     return CameraModel(np.asarray(mat, dtype=np.float64), np.ravel(dist), (w, h)), float(rms)

@@ -20,8 +20,10 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import numeric_array
 from softarm.errors import VisionError
-from softarm.vision._checks import FloatArray, as_gray, positive
+from softarm.vision._checks import FloatArray, as_array, as_gray, positive
+from softarm.vision._opencv import opencv_errors
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 from softarm.vision.dictionaries import get_dictionary
@@ -56,7 +58,7 @@ class Detection:
         refine: Callable[[], FloatArray] | None = None,
     ) -> None:
         self._marker_id = int(marker_id)
-        self._corners = np.asarray(corners, dtype=np.float64)
+        self._corners = numeric_array(corners, "corners")
         self._refine = refine
 
     @property
@@ -201,31 +203,70 @@ class MarkerDetector:
         return detector
 
 
+#: The smallest area a marker's corners may enclose, as a fraction of the squared
+#: perimeter (a square has 1/16): below it the four points are (nearly) on one line and
+#: no pose follows from them.
+MIN_AREA_RATIO = 1e-6
+
+
+def marker_corners(corners: npt.ArrayLike, name: str = "corners") -> FloatArray:
+    """``corners`` as a (4, 2) float array of a convex quadrilateral, as a detector
+    returns them. Raises :class:`~softarm.errors.ShapeError` (not four points),
+    :class:`~softarm.errors.NonFiniteError` (NaN) or :class:`VisionError` (collinear,
+    crossed or turning both ways)."""
+    c = as_array(corners, (4, 2), name)
+    edges = np.roll(c, -1, axis=0) - c
+    turns = (
+        edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1]
+        - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
+    )
+    area = 0.5 * abs(float(np.sum(c[:, 0] * np.roll(c[:, 1], -1) - np.roll(c[:, 0], -1) * c[:, 1])))
+    perimeter = float(np.sum(np.hypot(edges[:, 0], edges[:, 1])))
+    if not area > MIN_AREA_RATIO * perimeter**2:
+        raise VisionError(f"{name} enclose no area (collinear points): {c.tolist()}")
+    if not (np.all(turns > 0) or np.all(turns < 0)):
+        raise VisionError(f"{name} are not a convex quadrilateral: {c.tolist()}")
+    return c
+
+
 def square_marker_poses(
     corners: npt.ArrayLike, camera: CameraModel, marker_length: float
 ) -> list[MarkerPose]:
-    """Both IPPE-square solutions for one marker, best (lowest RMS reprojection) first."""
+    """Both IPPE-square solutions for one marker, best (lowest RMS reprojection) first.
+    Corners that are not a marker's (:func:`marker_corners`) and a camera model OpenCV
+    cannot solve with are a typed error; a non-finite solution is left out."""
     length = positive(marker_length, "marker_length")
-    img = np.asarray(corners, dtype=np.float64).reshape(4, 1, 2)
+    img = marker_corners(corners).reshape(4, 1, 2)
     obj = marker_object_points(length).reshape(4, 1, 3)
+    with opencv_errors("marker pose: corners or camera model"):
+        out = _ippe(obj, img, camera)
+        if not out or min(p.rms for p in out) > FALLBACK_RMS_PX:
+            # IPPE degenerates for an exactly fronto-parallel square (it returns the pose
+            # turned 180° about the normal); SQPNP has no such case.
+            out += _sqpnp(obj, img, camera)
+    finite = [p for p in out if np.isfinite(p.rms) and np.all(np.isfinite(p.T_camera_marker))]
+    return sorted(finite, key=lambda p: p.rms)
+
+
+def _ippe(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[MarkerPose]:
     n, rvecs, tvecs, errs = cv2.solvePnPGeneric(
         obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_IPPE_SQUARE
     )
-    out = [
+    return [
         MarkerPose(pose_from_rvec_tvec(rvecs[k], tvecs[k]), float(np.ravel(errs)[k]))
         for k in range(int(n))
     ]
-    if not out or min(p.rms for p in out) > FALLBACK_RMS_PX:
-        # IPPE degenerates for an exactly fronto-parallel square (it returns the pose
-        # turned 180° about the normal); SQPNP has no such case.
-        ok, rvec, tvec = cv2.solvePnP(
-            obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_SQPNP
-        )
-        if ok:
-            proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
-            rms = float(np.sqrt(np.mean(np.sum((proj - img).reshape(-1, 2) ** 2, axis=1))))
-            out.append(MarkerPose(pose_from_rvec_tvec(rvec, tvec), rms))
-    return sorted(out, key=lambda p: p.rms)
+
+
+def _sqpnp(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[MarkerPose]:
+    ok, rvec, tvec = cv2.solvePnP(
+        obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_SQPNP
+    )
+    if not ok:
+        return []
+    proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
+    rms = float(np.sqrt(np.mean(np.sum((proj - img).reshape(-1, 2) ** 2, axis=1))))
+    return [MarkerPose(pose_from_rvec_tvec(rvec, tvec), rms)]
 
 
 def estimate_marker_poses(
