@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from softarm.commands._args import config_file, int_range, non_negative_int, output_file
 from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
 
@@ -31,11 +32,17 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     mode = p.add_mutually_exclusive_group(required=True)
     mode.add_argument("--sim", action="store_true", help="the simulated plant")
-    mode.add_argument("--config", type=Path, help="hardware configuration (TOML)")
-    p.add_argument("--plant", type=Path, help="simulated plant parameters ([plant] TOML)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the simulated plant (as harvest)")
-    p.add_argument("--poses", type=int, default=80, help="excitation poses, 22..100 (default 80)")
-    p.add_argument("--out", type=Path, default=Path("model.toml"), help="fitted model file")
+    # Every argument, the output included, is checked while the command line is parsed,
+    # before a pose is measured: a fit must not be lost to a bad --out after it has run.
+    mode.add_argument("--config", type=config_file, help="hardware configuration (TOML)")
+    p.add_argument("--plant", type=config_file, help="simulated plant parameters ([plant] TOML)")
+    p.add_argument(
+        "--seed", type=non_negative_int, default=0, help="seed of the simulated plant (as harvest)"
+    )
+    p.add_argument(
+        "--poses", type=int_range(22, 100), default=80, help="excitation poses (21 parameters)"
+    )
+    p.add_argument("--out", type=output_file, default=Path("model.toml"), help="fitted model file")
     p.add_argument(
         "--bias",
         action="store_true",
@@ -53,8 +60,6 @@ def run(args: argparse.Namespace) -> int:
 
     if args.plant is not None and not args.sim:
         raise ParameterError("--plant: only with --sim")
-    if not 22 <= args.poses <= 100:
-        raise ParameterError(f"--poses = {args.poses}: must be in 22..100 (21 parameters)")
     start = time.monotonic()
 
     def progress(k: int, _pose: object) -> None:
