@@ -30,6 +30,7 @@ import cv2
 import numpy as np
 
 from softarm.errors import ConfigError
+from softarm.files import atomic_path, parse_json, write_text
 
 if TYPE_CHECKING:
     from softarm.vision.camera_model import CameraModel
@@ -61,51 +62,62 @@ def read_camera_file(path: str | Path, text: str) -> tuple[str, dict[str, Any]]:
     """(format, fields) of a camera file whose contents are ``text``; ``fields`` has
     ``matrix``, ``distortion`` and ``image_size`` for the OpenCV and ROS formats and is
     the parsed JSON object for softarm's own format."""
-    import json
-
     body = text.lstrip("\ufeff \t\r\n")
     if body.startswith("{"):
-        try:
-            data = json.loads(body)
-        except json.JSONDecodeError as exc:
-            raise ConfigError(f"camera file {str(path)!r} is not valid JSON: {exc}") from exc
+        data = parse_json(body, f"camera file {str(path)!r}")
         if isinstance(data, dict) and "format" in data:
             return "json", data
         # OpenCV FileStorage writes JSON too: {"camera_matrix": {"type_id": "opencv-matrix"...
     fs = _open(path, body)
     try:
-        if not fs.root().isMap():
-            raise ConfigError(f"camera file {str(path)!r} is not a map of named fields")
-        node = _first(fs, ("camera_matrix", "cameraMatrix"))
-        if node is None:
-            raise ConfigError(
-                f"camera file {str(path)!r} has no camera_matrix: not a softarm JSON, "
-                "OpenCV FileStorage or ROS camera_info file"
-            )
-        if node.isMap() and node.getNode("dt").isNone():
-            return "ros", _read_ros(fs, path)
-        return "opencv", _read_opencv(fs, path)
+        return _read_fields(fs, path)
+    except cv2.error as exc:  # a node of the wrong kind (a scalar where a matrix goes)
+        raise ConfigError(f"camera file {str(path)!r}: {_cv_reason(exc)}") from None
     finally:
         fs.release()
+
+
+def _cv_reason(exc: BaseException) -> str:
+    """The last line of an OpenCV error: the reason, without the source location."""
+    text = str(exc).strip()
+    last = text.splitlines()[-1] if text else type(exc).__name__
+    return last.split(" error: ", 1)[-1]
+
+
+def _read_fields(fs: Any, path: str | Path) -> tuple[str, dict[str, Any]]:
+    """(format, fields) of an opened OpenCV or ROS camera file."""
+    if not fs.root().isMap():
+        raise ConfigError(f"camera file {str(path)!r} is not a map of named fields")
+    node = _first(fs, ("camera_matrix", "cameraMatrix"))
+    if node is None:
+        raise ConfigError(
+            f"camera file {str(path)!r} has no camera_matrix: not a softarm JSON, "
+            "OpenCV FileStorage or ROS camera_info file"
+        )
+    if node.isMap() and node.getNode("dt").isNone():
+        return "ros", _read_ros(fs, path)
+    return "opencv", _read_opencv(fs, path)
 
 
 def write_opencv(model: CameraModel, path: str | Path) -> None:
     """Write ``model`` as OpenCV's calibration sample does (YAML for .yml/.yaml, XML for
     .xml, JSON for .json: FileStorage picks by extension)."""
-    try:
-        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
-    except cv2.error as exc:
-        raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
-    if not fs.isOpened():
-        raise ConfigError(f"cannot write camera file {str(path)!r}")
-    try:
-        if model.image_size is not None:
-            fs.write("image_width", int(model.image_size[0]))
-            fs.write("image_height", int(model.image_size[1]))
-        fs.write("camera_matrix", np.asarray(model.matrix, dtype=np.float64))
-        fs.write("distortion_coefficients", model.distortion.reshape(-1, 1).astype(np.float64))
-    finally:
-        fs.release()
+    with atomic_path(path, "camera file") as tmp:  # the temporary name keeps the suffix
+        try:
+            fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE)
+        except cv2.error as exc:
+            raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
+        if not fs.isOpened():
+            raise ConfigError(f"cannot write camera file {str(path)!r}")
+        try:
+            if model.image_size is not None:
+                fs.write("image_width", int(model.image_size[0]))
+                fs.write("image_height", int(model.image_size[1]))
+            fs.write("camera_matrix", np.asarray(model.matrix, dtype=np.float64))
+            dist = model.distortion.reshape(-1, 1).astype(np.float64)
+            fs.write("distortion_coefficients", dist)
+        finally:
+            fs.release()
 
 
 def write_ros(model: CameraModel, path: str | Path, camera_name: str = "camera") -> None:
@@ -136,10 +148,7 @@ def write_ros(model: CameraModel, path: str | Path, camera_name: str = "camera")
         *_ros_matrix("rectification_matrix", np.eye(3)),
         *_ros_matrix("projection_matrix", proj),
     ]
-    try:
-        Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
+    write_text(path, "\n".join(lines) + "\n", "camera file")
 
 
 def _ros_matrix(name: str, mat: np.ndarray) -> list[str]:
@@ -169,23 +178,48 @@ def _first(fs: Any, names: tuple[str, ...]) -> Any:
     return None
 
 
+#: Largest image side and matrix dimension read from a camera file (pixels, rows).
+MAX_PIXELS = 100_000
+
+
+def _whole(node: Any, name: str, path: str | Path, lo: int, hi: int) -> int:
+    """A node holding a whole number in [lo, hi] (an integral real is accepted: some
+    writers put 640.0). NaN, 1.5, a string or a map are one ConfigError naming it."""
+    value = node.real() if (node.isInt() or node.isReal()) else None
+    if value is None or not (value == value and float(value).is_integer() and lo <= value <= hi):
+        raise ConfigError(
+            f"camera file {str(path)!r}: {name} must be a whole number in [{lo}, {hi}]"
+        )
+    return int(value)
+
+
 def _size(fs: Any, path: str | Path) -> tuple[int, int] | None:
     w, h = fs.getNode("image_width"), fs.getNode("image_height")
     if w.isNone() and h.isNone():
         return None
-    if w.isNone() or h.isNone() or not (w.isInt() or w.isReal()) or not (h.isInt() or h.isReal()):
+    return (
+        _whole(w, "image_width", path, 1, MAX_PIXELS),
+        _whole(h, "image_height", path, 1, MAX_PIXELS),
+    )
+
+
+def _mat(node: Any, name: str, path: str | Path) -> Any:
+    """The matrix of an ``opencv-matrix`` node (None when empty); a node that is not one
+    (a scalar, wrong rows, an unknown dt) is a ConfigError naming ``name``."""
+    try:
+        return node.mat()
+    except cv2.error as exc:
         raise ConfigError(
-            f"camera file {str(path)!r}: image_width and image_height must be numbers"
-        )
-    return int(w.real()), int(h.real())
+            f"camera file {str(path)!r}: {name} is not a valid opencv-matrix ({_cv_reason(exc)})"
+        ) from None
 
 
 def _read_opencv(fs: Any, path: str | Path) -> dict[str, Any]:
-    mat = _first(fs, ("camera_matrix", "cameraMatrix")).mat()
+    mat = _mat(_first(fs, ("camera_matrix", "cameraMatrix")), "camera_matrix", path)
     if mat is None:
         raise ConfigError(f"camera file {str(path)!r}: camera_matrix is not an opencv-matrix")
     node = _first(fs, ("distortion_coefficients", "distCoeffs"))
-    dist = None if node is None else node.mat()
+    dist = None if node is None else _mat(node, "distortion_coefficients", path)
     return {
         "matrix": np.asarray(mat, dtype=np.float64),
         # An empty matrix reads back as None: no distortion.
@@ -219,13 +253,17 @@ def _ros_data(fs: Any, name: str, path: str | Path, shape: tuple[int, int] | Non
     data = node.getNode("data")
     if not node.isMap() or not data.isSeq():
         raise ConfigError(f"camera file {str(path)!r}: {name} must be a map with a data list")
-    try:
-        values = np.array([float(data.at(i).real()) for i in range(data.size())])
-    except (TypeError, ValueError) as exc:
-        raise ConfigError(f"camera file {str(path)!r}: {name}.data must be numbers") from exc
+    items = [data.at(i) for i in range(data.size())]
+    # A string element reads as real() = DBL_MAX: check each element's kind first.
+    bad = next((i for i, item in enumerate(items) if not (item.isInt() or item.isReal())), None)
+    if bad is not None:
+        raise ConfigError(f"camera file {str(path)!r}: {name}.data[{bad}] must be a number")
+    values = np.array([float(item.real()) for item in items])
     rows, cols = node.getNode("rows"), node.getNode("cols")
-    r = int(rows.real()) if not rows.isNone() else (shape[0] if shape else 1)
-    c = int(cols.real()) if not cols.isNone() else (shape[1] if shape else values.size)
+    r = _whole(rows, f"{name}.rows", path, 1, MAX_PIXELS) if not rows.isNone() else None
+    c = _whole(cols, f"{name}.cols", path, 1, MAX_PIXELS) if not cols.isNone() else None
+    r = r if r is not None else (shape[0] if shape else 1)
+    c = c if c is not None else (shape[1] if shape else values.size)
     if r * c != values.size or (shape is not None and (r, c) != shape):
         want = f"{shape[0]}x{shape[1]}" if shape else f"{r}x{c}"
         raise ConfigError(

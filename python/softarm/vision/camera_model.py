@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import ConfigError, ParameterError, ShapeError
+from softarm.files import read_text, write_text
 from softarm.vision._checks import FloatArray, as_array
 
 if TYPE_CHECKING:
@@ -33,6 +34,42 @@ if TYPE_CHECKING:
 
 FORMAT = "softarm.camera/1"
 _DIST_LENGTHS = (0, 4, 5, 8, 12, 14)
+#: Focal lengths in pixels: below 1 px the whole field of view falls inside one pixel
+#: (fx = 1e-300 made ``normalize`` return inf); above 1e7 px a lens would see less than
+#: a thousandth of a degree.
+FOCAL_PX = (1.0, 1e7)
+#: Largest principal point, skew and image side (pixels).
+MAX_PIXELS = 1e7
+
+
+def _check_intrinsics(mat: FloatArray) -> None:
+    """fx, fy within :data:`FOCAL_PX`; cx, cy and the skew within :data:`MAX_PIXELS`."""
+    lo, hi = FOCAL_PX
+    for name, value in (("fx", mat[0, 0]), ("fy", mat[1, 1])):
+        if not lo <= value <= hi:
+            raise ParameterError(f"matrix {name} = {value!r}: must be in [{lo:g}, {hi:g}] px")
+    for name, value in (("skew", mat[0, 1]), ("cx", mat[0, 2]), ("cy", mat[1, 2])):
+        if not abs(value) <= MAX_PIXELS:
+            raise ParameterError(f"matrix {name} = {value!r}: must be within +-{MAX_PIXELS:g} px")
+
+
+def _image_size(size: Any) -> tuple[int, int]:
+    """``(width, height)`` as two whole numbers in [1, MAX_PIXELS]; 1.9 is refused, not
+    truncated to 1."""
+    ok = isinstance(size, list | tuple | np.ndarray) and len(size) == 2
+    values = list(size) if ok else []
+    if not ok or not all(
+        isinstance(v, int | float | np.integer | np.floating)
+        and not isinstance(v, bool)
+        and float(v).is_integer()
+        and 1 <= v <= MAX_PIXELS
+        for v in values
+    ):
+        raise ParameterError(
+            f"image_size must be (width, height), whole numbers in [1, {MAX_PIXELS:g}], "
+            f"got {size!r}"
+        )
+    return int(values[0]), int(values[1])
 
 
 @dataclass(frozen=True)
@@ -57,6 +94,7 @@ class CameraModel:
             )
         if abs(mat[1, 0]) > 0:
             raise ParameterError(f"matrix[1, 0] must be 0, got {mat[1, 0]}")
+        _check_intrinsics(mat)
         raw = np.zeros(5) if self.distortion is None else self.distortion
         dist = as_array(np.ravel(np.asarray(raw, dtype=object)), (None,), "distortion")
         if dist.size not in _DIST_LENGTHS:
@@ -64,10 +102,7 @@ class CameraModel:
                 f"distortion must have one of {_DIST_LENGTHS} coefficients, got {dist.size}"
             )
         if self.image_size is not None:
-            size = tuple(int(v) for v in self.image_size)
-            if len(size) != 2 or min(size) <= 0:
-                raise ParameterError(f"image_size must be (width, height) > 0, got {size}")
-            object.__setattr__(self, "image_size", size)
+            object.__setattr__(self, "image_size", _image_size(self.image_size))
         mat.setflags(write=False)
         dist.setflags(write=False)
         object.__setattr__(self, "matrix", mat)
@@ -118,20 +153,18 @@ class CameraModel:
         }
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> CameraModel:
-        """Build from the dictionary of the documented file format."""
+    def from_dict(cls, data: dict[str, Any], source: str = "camera file") -> CameraModel:
+        """Build from the dictionary of the documented file format; ``source`` names the
+        file in errors."""
         if not isinstance(data, dict) or data.get("format") != FORMAT:
             fmt = data.get("format") if isinstance(data, dict) else data
-            raise ConfigError(f"camera file format must be {FORMAT!r}, got {fmt!r}")
+            raise ConfigError(f"{source}: format must be {FORMAT!r}, got {fmt!r}")
+        if "camera_matrix" not in data:
+            raise ConfigError(f"{source}: camera_matrix is required")
         try:
-            size = data.get("image_size")
-            return cls(
-                np.asarray(data["camera_matrix"], dtype=np.float64),
-                np.asarray(data.get("distortion", []), dtype=np.float64),
-                None if size is None else (int(size[0]), int(size[1])),
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise ConfigError(f"camera file is malformed: {exc}") from exc
+            return cls(data["camera_matrix"], data.get("distortion", []), data.get("image_size"))
+        except (TypeError, ValueError) as exc:  # the model's own InputErrors are ValueErrors
+            raise ConfigError(f"{source}: {exc}") from None
 
     def save(
         self, path: str | Path, format: str | None = None, *, camera_name: str = "camera"
@@ -149,10 +182,7 @@ class CameraModel:
 
         fmt = camera_files.format_for_path(path) if format is None else format
         if fmt == "json":
-            try:
-                Path(path).write_text(json.dumps(self.to_dict(), indent=2) + "\n", "utf-8")
-            except OSError as exc:
-                raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
+            write_text(path, json.dumps(self.to_dict(), indent=2) + "\n", "camera file")
         elif fmt == "opencv":
             camera_files.write_opencv(self, path)
         elif fmt == "ros":
@@ -171,13 +201,10 @@ class CameraModel:
         """
         from softarm.vision import camera_files
 
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ConfigError(f"cannot read camera file {str(path)!r}: {exc}") from exc
+        text = read_text(path, "camera file")
         fmt, fields = camera_files.read_camera_file(path, text)
         if fmt == "json":
-            return cls.from_dict(fields)
+            return cls.from_dict(fields, f"camera file {str(path)!r}")
         try:
             return cls(fields["matrix"], fields["distortion"], fields["image_size"])
         except (ValueError, TypeError) as exc:
