@@ -131,7 +131,7 @@ def _capsule(name: str, a: FloatArray, b: FloatArray, radius: float, rgba: str) 
     return (
         f'<geom name="{name}" type="capsule" size="{radius:.6g} {max(half, 1e-4):.6g}" '
         f'pos="{_v(0.5 * (a + b))}" quat="{_quat(z_to(b - a))}" rgba="{rgba}" '
-        f'contype="0" conaffinity="0"/>'
+        f'group="2" contype="0" conaffinity="0"/>'
     )
 
 
@@ -165,7 +165,7 @@ def _berry(berry: object, look: BushLook, rng: np.random.Generator) -> str:
     out = [
         f'<body name="berry{tag}" pos="{_v(pos)}">'
         f'<geom name="berry{tag}_0" type="ellipsoid" size="{_v(half * 0.9)}" '
-        f'rgba="{_rgba(core)}" {spec} contype="0" conaffinity="0"/>'
+        f'rgba="{_rgba(core)}" {spec} group="1" contype="0" conaffinity="0"/>'
     ]
     golden = np.pi * (3.0 - np.sqrt(5.0))
     for k in range(DRUPELETS):  # a Fibonacci lattice on the ellipsoid
@@ -176,7 +176,7 @@ def _berry(berry: object, look: BushLook, rng: np.random.Generator) -> str:
         out.append(
             f'<geom name="berry{tag}_{k + 1}" type="sphere" size="{half[0] * 0.34:.5g}" '
             f'pos="{_v(unit * half * 0.85)}" rgba="{_rgba(shade)}" {spec} '
-            f'contype="0" conaffinity="0"/>'
+            f'group="1" contype="0" conaffinity="0"/>'
         )
     out.append("</body>")
     return "".join(out)
@@ -196,9 +196,10 @@ def _leaves(spec: SceneSpec, rng: np.random.Generator) -> str:
             R = Rotation.random(random_state=int(rng.integers(2**31))).as_matrix()
             colour = spec.look.leaf_colour * rng.uniform(0.7, 1.2)
             out.append(
-                f'<geom name="leaf{k}" type="ellipsoid" size="{_v([length, 0.45 * length, 0.0015])}" '
+                f'<geom name="leaf{k}" type="ellipsoid" '
+                f'size="{_v([length, 0.45 * length, 0.0015])}" '
                 f'pos="{_v(centre)}" quat="{_quat(R)}" rgba="{_rgba(colour)}" '
-                f'contype="0" conaffinity="0"/>'
+                f'group="2" contype="0" conaffinity="0"/>'
             )
             k += 1
     return "".join(out)
@@ -221,7 +222,7 @@ def _clutter(look: BushLook, rng: np.random.Generator) -> str:
         R = Rotation.random(random_state=int(rng.integers(2**31))).as_matrix()
         out.append(
             f'<geom name="clutter{k}" {shape} pos="{_v(pos)}" quat="{_quat(R)}" '
-            f'rgba="{_rgba(dark)}" contype="0" conaffinity="0"/>'
+            f'rgba="{_rgba(dark)}" group="2" contype="0" conaffinity="0"/>'
         )
     return "".join(out)
 
@@ -254,18 +255,19 @@ def _arm(spec: SceneSpec) -> str:
     for k in range(spec.n_sections * ARM_SEGMENTS_PER_SECTION):
         out.append(
             f'<body name="arm_seg{k}" mocap="true"><geom name="arm_seg{k}" type="cylinder" '
-            f'size="{ARM_TUBE_RADIUS} 0.01" rgba="0.70 0.68 0.62 1" contype="0" conaffinity="0"/></body>'
+            f'size="{ARM_TUBE_RADIUS} 0.01" rgba="0.70 0.68 0.62 1" group="2" '
+            f'contype="0" conaffinity="0"/></body>'
         )
     for k in range(spec.n_sections + 1):
         out.append(
             f'<body name="arm_plate{k}" mocap="true"><geom name="arm_plate{k}" type="cylinder" '
-            f'size="0.045 0.004" rgba="{grey}" contype="0" conaffinity="0"/></body>'
+            f'size="0.045 0.004" rgba="{grey}" group="2" contype="0" conaffinity="0"/></body>'
         )
     fingers = "".join(
         f'<geom name="arm_finger{i}" type="box" size="0.004 0.006 0.022" '
         f'pos="{_v([0.024 * np.cos(a), 0.024 * np.sin(a), 0.022])}" '
         f'quat="{_quat(Rotation.from_euler("z", a).as_matrix())}" rgba="{dark}" '
-        f'contype="0" conaffinity="0"/>'
+        f'group="2" contype="0" conaffinity="0"/>'
         for i, a in enumerate(np.arange(3) * 2 * np.pi / 3 + np.pi / 2)
     )
     cams = "".join(_camera(c) for c in spec.hand_cameras)
@@ -298,7 +300,8 @@ def _quad(name: str, pose: FloatArray, side: float, material: str) -> str:
     ``material``'s texture upright."""
     return (
         f'<geom name="{name}" type="mesh" mesh="{_mesh_name(side)}" material="{material}" '
-        f'pos="{_v(pose[:3, 3])}" quat="{_quat(pose[:3, :3])}" contype="0" conaffinity="0"/>'
+        f'pos="{_v(pose[:3, 3])}" quat="{_quat(pose[:3, :3])}" group="2" '
+        f'contype="0" conaffinity="0"/>'
     )
 
 
@@ -333,7 +336,10 @@ def _tag_png(dictionary: str, marker_id: int, marker: float, face: float) -> byt
 def _tag_assets(spec: SceneSpec) -> dict[str, bytes]:
     ids = [*spec.cube_ids, spec.base_tag_id]
     lengths = [spec.cube_marker] * 4 + [spec.tag_length]
-    return {f"tag{i}.png": _tag_png(spec.dictionary, i, m, 1.25 * m) for i, m in zip(ids, lengths)}
+    return {
+        f"tag{i}.png": _tag_png(spec.dictionary, i, m, 1.25 * m)
+        for i, m in zip(ids, lengths, strict=True)
+    }
 
 
 def _tag_materials(spec: SceneSpec) -> str:

@@ -8,6 +8,7 @@ ambient. Lens distortion is applied afterwards (:mod:`softarm.sim.render.distort
 
 from __future__ import annotations
 
+import itertools
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -27,6 +28,9 @@ from softarm.sim.render.mjcf import (
     scene_xml,
 )
 from softarm.sim.render.mjcf import z_to as _z_to
+
+#: The geom group of everything that can hide a berry (leaves, canes, clutter, the arm).
+OCCLUDER_GROUP = 2
 
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
@@ -100,7 +104,7 @@ class BushRenderer:
         gripper, hand cameras and cube ride on the end effector."""
         k = 0
         for points in sections:
-            for a, b in zip(points[:-1], points[1:]):
+            for a, b in itertools.pairwise(points):
                 self._place(f"arm_seg{k}", 0.5 * (a + b), _z_to(b - a))
                 self.model.geom_size[self._seg_geoms[k], 1] = max(
                     0.5 * float(np.linalg.norm(b - a)), 1e-4
@@ -108,7 +112,7 @@ class BushRenderer:
                 k += 1
         ends = [s[0] for s in sections] + [sections[-1][-1]]
         tangents = [s[1] - s[0] for s in sections] + [sections[-1][-1] - sections[-1][-2]]
-        for i, (p, t) in enumerate(zip(ends, tangents)):
+        for i, (p, t) in enumerate(zip(ends, tangents, strict=True)):
             self._place(f"arm_plate{i}", p, _z_to(t))
         self._place("arm_ee", T_base_ee[:3, 3], T_base_ee[:3, :3])
         self._arm_set = True
@@ -123,25 +127,31 @@ class BushRenderer:
             self._place(name, np.array([0.0, -50.0, 0.0]), np.eye(3))
         self._arm_set = False
 
-    def render(self, camera: str, depth: bool = False, geoms: bool = False) -> RenderedFrame:
-        """One image of ``camera`` (a name of the scene) as it is now."""
+    def render(
+        self, camera: str, depth: bool = False, geoms: bool = False, occluders: bool = True
+    ) -> RenderedFrame:
+        """One image of ``camera`` (a name of the scene) as it is now; without
+        ``occluders`` only the background and the berries are drawn (the berries' whole
+        outlines, for their visible fraction)."""
         mj = self._mj
         mj.mj_kinematics(self.model, self.data)
         mj.mj_camlight(self.model, self.data)  # camera and light poses from the bodies
         spec = self.cameras[camera]
         r = self._renderer(spec)
-        r.update_scene(self.data, camera=camera)
+        option = mj.MjvOption()
+        option.geomgroup[OCCLUDER_GROUP] = int(occluders)
+        r.update_scene(self.data, camera=camera, scene_option=option)
         rgb = r.render()
         colour = np.ascontiguousarray(rgb[..., ::-1])
         d = s = None
         if depth:
             r.enable_depth_rendering()
-            r.update_scene(self.data, camera=camera)
+            r.update_scene(self.data, camera=camera, scene_option=option)
             d = r.render().astype(np.float32)
             r.disable_depth_rendering()
         if geoms:
             r.enable_segmentation_rendering()
-            r.update_scene(self.data, camera=camera)
+            r.update_scene(self.data, camera=camera, scene_option=option)
             seg = r.render()
             r.disable_segmentation_rendering()
             s = np.where(seg[..., 1] == int(mj.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)

@@ -10,6 +10,7 @@ the right eye sits ``baseline`` along its +x, as the ZED2's do.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 import numpy as np
 
 from softarm._core import SoftArm
@@ -133,6 +134,13 @@ class RenderedBush:
         """C2's image from where the arm is drawn."""
         return self._frame("c2", "c2", truth)
 
+    def berry_outlines(self) -> RenderedFrame:
+        """C1's left eye with only the berries drawn (geoms only): each berry's whole
+        outline, against which its visible share is measured."""
+        f = self.renderer.render("c1_left", geoms=True, occluders=False)
+        d = self._distort["c1"]
+        return RenderedFrame(f.colour, None, None if f.geoms is None else d.nearest(f.geoms))
+
     def close(self) -> None:
         """Free the renderer."""
         self.renderer.close()
@@ -157,3 +165,15 @@ def _approach_lines(bush: Bush) -> list[tuple[FloatArray, FloatArray]]:
     """The last 8 cm before each berry along +Y: leaves stay out of them, as a gripper
     on a real bush pushes a leaf in its way aside."""
     return [(b.position - 0.08 * PLUS_Y, b.position) for b in bush.berries]
+
+
+def world_for(
+    bush: Bush, cams: Any, base_tag_id: int, look: BushLook | None = None
+) -> RenderedBush:
+    """The rendered world of ``bush`` seen by the simulated rig's cameras ``cams`` (a
+    ``softarm.harvest.sim_vision.SimCameras``: C1's left eye where the tag world's
+    eye-to-hand camera is)."""
+    return RenderedBush(
+        bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2, cams.T_ee_cube,
+        cams.T_base_tag, base_tag_id, cams.base_tag, cams.cube_marker, look,
+    )  # fmt: skip

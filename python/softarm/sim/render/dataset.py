@@ -1,0 +1,370 @@
+"""Labelled images of random rendered bushes, for training a detector: each image is one
+random bush (4 to 12 berries, ripe and unripe) seen by C1's left or right eye or by C2
+in the palm, with the arm drawn at a random pose or hidden, written with its depth, its
+instance masks and a COCO record (boxes, polygons, ripeness, visible fraction, the
+camera's intrinsics, distortion and pose). Everything is deterministic in the seed.
+
+Files in the output folder (``NNNNNN`` is the image index):
+
+* ``images/NNNNNN.png``: colour, 8-bit BGR as rendered (lens distortion included);
+* ``depth/NNNNNN.png``: 16-bit depth along the optical axis in millimetres, 0 where
+  nothing was drawn (aligned with the colour image);
+* ``instances/NNNNNN.png``: 16-bit instance map, each annotation's ``instance`` value on
+  its pixels, 0 elsewhere (the exact masks; the COCO polygons trace them);
+* ``annotations.json``: COCO (``info``, ``images``, ``annotations``, ``categories``).
+
+See docs/dataset.md for the format and its caveats.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import SoftArm
+from softarm.checks import FloatArray
+from softarm.errors import ParameterError, SoftarmError
+from softarm.sim.bush import Berry, Bush
+from softarm.sim.render.coco import CATEGORIES, category_id, mask_bbox, mask_polygons
+from softarm.sim.render.renderer import RenderedFrame
+from softarm.sim.render.silhouette import silhouette_area
+from softarm.sim.render.world import RenderedBush, arm_sections
+from softarm.vision.camera_model import CameraModel
+
+__all__ = ["DatasetRig", "render_sample", "write_dataset"]
+
+#: Views an image is drawn from, and how often.
+VIEWS = ("c1_left", "c1_right", "c2")
+VIEW_ODDS = (0.45, 0.25, 0.30)
+#: How often a C1 image shows no arm.
+ARM_HIDDEN_ODDS = 0.35
+#: Berries per bush.
+BERRIES = (4, 12)
+#: A berry with fewer visible pixels than this is not annotated.
+MIN_PIXELS = 4
+#: Depth PNGs hold millimetres in 16 bits: at most 65.535 m.
+DEPTH_SCALE = 1000.0
+
+
+@dataclass(frozen=True)
+class DatasetRig:
+    """The cameras and markers the bushes are rendered with (base frame; see
+    :class:`~softarm.sim.render.RenderedBush`)."""
+
+    T_base_c1: FloatArray
+    c1: CameraModel
+    c2: CameraModel
+    T_ee_c2: FloatArray
+    T_ee_cube: FloatArray
+    T_base_tag: FloatArray
+    base_tag_id: int
+    base_tag: float
+
+    def world(self, bush: Bush) -> RenderedBush:
+        """``bush`` rendered with these cameras."""
+        return RenderedBush(
+            bush, self.T_base_c1, self.c1, self.c2, self.T_ee_c2, self.T_ee_cube,
+            self.T_base_tag, self.base_tag_id, self.base_tag,
+        )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _View:
+    """One image's camera: its name, intrinsics and pose in the base frame."""
+
+    name: str
+    camera: CameraModel
+    T_base_camera: FloatArray
+
+
+def _random_bush(arm: SoftArm, rig: DatasetRig, rng: np.random.Generator) -> Bush:
+    """4 to 12 berries, 20 to 60 % of them unripe (fewer berries if they do not fit)."""
+    n = int(rng.integers(BERRIES[0], BERRIES[1] + 1))
+    unripe = float(rng.uniform(0.2, 0.6))
+    seed = int(rng.integers(2**31))
+    for count in range(n, 0, -1):
+        try:
+            return Bush.generate(
+                arm, count, seed, view_point=rig.T_base_c1[:3, 3], unripe_fraction=unripe
+            )
+        except ParameterError:
+            continue
+    raise ParameterError(f"could not place a bush of seed {seed}")
+
+
+def _pose_arm(
+    world: RenderedBush, arm: SoftArm, view: str, rng: np.random.Generator
+) -> FloatArray | None:
+    """Draw the arm for ``view``; returns its end-effector pose, None when hidden. C2 looks
+    at a random berry from 1 to 10 % short of its grasp; C1 sees the arm at a random pose
+    or none."""
+    if view != "c2" and rng.uniform() < ARM_HIDDEN_ODDS:
+        world.hide_arm()
+        return None
+    if view == "c2":
+        berry = world.bush.berries[int(rng.integers(len(world.bush.berries)))]
+        q = berry.q * rng.uniform(0.90, 0.99)
+    else:
+        q = rng.uniform(np.asarray(arm.lower), np.asarray(arm.upper))
+    T_base_ee = arm.forward(q)
+    world.set_arm(arm_sections(arm, q), T_base_ee)
+    return T_base_ee
+
+
+def _view(world: RenderedBush, rig: DatasetRig, name: str, T_base_ee: FloatArray | None) -> _View:
+    stereo = world.stereo
+    if name == "c1_left":
+        return _View(name, stereo.left, stereo.T_base_left)
+    if name == "c1_right":
+        return _View(name, stereo.right, stereo.T_base_left @ stereo.T_left_right)
+    assert T_base_ee is not None  # C2 always has the arm drawn
+    return _View(name, world.c2, T_base_ee @ rig.T_ee_c2)
+
+
+def _render(world: RenderedBush, view: str) -> RenderedFrame:
+    if view == "c1_left":
+        return world.c1_left(truth=True)
+    if view == "c1_right":
+        return world.c1(truth=True)[1]
+    return world.c2_frame(truth=True)
+
+
+def _berry_attributes(
+    world: RenderedBush, berry: Berry, view: _View, pixels: int
+) -> dict[str, Any]:
+    renderer = world.renderer
+    labels = world.labels
+    geoms = np.flatnonzero((labels.kind == 1) & (labels.instance == berry.tag_id))
+    full = silhouette_area(renderer.model, renderer.data, geoms, view.T_base_camera, view.camera)
+    T_camera_base = np.linalg.inv(view.T_base_camera)
+    in_camera = T_camera_base[:3, :3] @ berry.position + T_camera_base[:3, 3]
+    return {
+        "berry_id": berry.tag_id,
+        "ripeness": float(berry.ripeness),
+        "visible_fraction": None if not full else round(min(1.0, pixels / full), 4),
+        "position_base_m": [float(v) for v in berry.position],
+        "position_camera_m": [float(v) for v in in_camera],
+    }
+
+
+def _cane_attributes(world: RenderedBush, index: int) -> dict[str, Any]:
+    model = world.renderer.model
+    radius = float(model.geom(f"cane{index}_0").size[0])
+    coeffs = world.bush.branches[index].coeffs
+    return {"cane_id": index, "radius_m": radius, "coeffs_base_m": coeffs.tolist()}
+
+
+def _annotation(
+    mask: npt.NDArray[np.bool_], category: str, attributes: dict[str, Any]
+) -> dict[str, Any]:
+    return {
+        "category_id": category_id(category),
+        "bbox": mask_bbox(mask),
+        "area": int(np.count_nonzero(mask)),
+        "segmentation": mask_polygons(mask),
+        "iscrowd": 0,
+        "attributes": attributes,
+    }
+
+
+def _annotate(
+    world: RenderedBush, frame: RenderedFrame, view: _View
+) -> list[tuple[npt.NDArray[np.bool_], dict[str, Any]]]:
+    """(mask, annotation) of every berry with at least MIN_PIXELS visible and every cane
+    in sight."""
+    assert frame.geoms is not None
+    out = []
+    for berry in world.bush.berries:
+        mask = world.labels.mask(frame.geoms, "berry", berry.tag_id)
+        pixels = int(np.count_nonzero(mask))
+        if pixels >= MIN_PIXELS:
+            category = "berry_ripe" if berry.ripeness >= 0.5 else "berry_unripe"
+            out.append(
+                (mask, _annotation(mask, category, _berry_attributes(world, berry, view, pixels)))
+            )
+    for index in range(len(world.bush.branches)):
+        mask = world.labels.mask(frame.geoms, "cane", index)
+        if mask.any():
+            out.append((mask, _annotation(mask, "cane", _cane_attributes(world, index))))
+    return out
+
+
+def _write_png(path: Path, image: npt.NDArray[Any]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(str(path), image):
+        raise SoftarmError(f"out: could not write {path}")
+
+
+def _depth_mm(depth: npt.NDArray[np.float32]) -> npt.NDArray[np.uint16]:
+    mm = np.nan_to_num(depth * DEPTH_SCALE, nan=0.0)
+    return np.clip(np.round(mm), 0, 65535).astype(np.uint16)
+
+
+def _image_record(
+    index: int, view: _View, frame: RenderedFrame, bush: Bush, arm_shown: bool
+) -> dict[str, Any]:
+    name = f"{index:06d}.png"
+    height, width = frame.colour.shape[:2]
+    return {
+        "id": index + 1,
+        "file_name": f"images/{name}",
+        "width": width,
+        "height": height,
+        "depth_file": f"depth/{name}",
+        "instance_file": f"instances/{name}",
+        "view": view.name,
+        "arm_shown": arm_shown,
+        "bush_seed": bush.seed,
+        "camera": {
+            "matrix": view.camera.matrix.tolist(),
+            "distortion": np.ravel(view.camera.distortion).tolist(),
+            "T_base_camera": view.T_base_camera.tolist(),
+        },
+    }
+
+
+def render_sample(out_dir: str | Path, seed: int, index: int, rig: DatasetRig) -> dict[str, Any]:
+    """Render image ``index`` of the set of ``seed``, write its files into ``out_dir`` and
+    return ``{"image": COCO image record, "annotations": [...]}`` (annotation ids are
+    given by :func:`write_dataset`)."""
+    rng = np.random.default_rng([seed, index])
+    arm = SoftArm.blackberry()
+    bush = _random_bush(arm, rig, rng)
+    view_name = str(rng.choice(VIEWS, p=VIEW_ODDS))
+    world = rig.world(bush)
+    try:
+        T_base_ee = _pose_arm(world, arm, view_name, rng)
+        frame = _render(world, view_name)
+        view = _view(world, rig, view_name, T_base_ee)
+        labelled = _annotate(world, frame, view)
+    finally:
+        world.close()
+    assert frame.depth is not None
+    instances = np.zeros(frame.colour.shape[:2], np.uint16)
+    for k, (mask, annotation) in enumerate(labelled, start=1):
+        instances[mask] = k
+        annotation["instance"] = k
+    out = Path(out_dir)
+    record = _image_record(index, view, frame, bush, T_base_ee is not None)
+    _write_png(out / record["file_name"], frame.colour)
+    _write_png(out / record["depth_file"], _depth_mm(frame.depth))
+    _write_png(out / record["instance_file"], instances)
+    for _, annotation in labelled:
+        annotation["image_id"] = record["id"]
+    return {"image": record, "annotations": [a for _, a in labelled]}
+
+
+def _ray_or_none() -> Any:
+    try:
+        import ray
+    except ImportError:
+        return None
+    return ray
+
+
+def _on_ray(
+    ray: Any,
+    out_dir: Path,
+    seed: int,
+    indices: range,
+    rig: DatasetRig,
+    workers: int,
+    on_image: Callable[[], None],
+) -> list[dict[str, Any]]:
+    """Render ``indices`` as Ray tasks on a private local Ray of ``workers`` CPUs."""
+    ours = not ray.is_initialized()
+    if ours:
+        ray.init(
+            address="local", num_cpus=workers, include_dashboard=False, log_to_driver=False,
+            logging_level=logging.ERROR,
+        )  # fmt: skip
+    try:
+        task = ray.remote(num_cpus=1)(render_sample)
+        rig_ref = ray.put(rig)
+        pending = {task.remote(str(out_dir), seed, i, rig_ref): i for i in indices}
+        results: dict[int, dict[str, Any]] = {}
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            results[pending.pop(ready[0])] = _ray_result(ray, ready[0])
+            on_image()
+        return [results[i] for i in indices]
+    finally:
+        if ours:
+            ray.shutdown()
+
+
+def _ray_result(ray: Any, ref: Any) -> dict[str, Any]:
+    """A task's result; a softarm error raised in the task is raised here as itself."""
+    try:
+        return ray.get(ref)  # type: ignore[no-any-return]
+    except ray.exceptions.RayTaskError as exc:
+        if isinstance(exc.cause, SoftarmError):
+            raise exc.cause from None
+        raise
+
+
+def _coco(samples: list[dict[str, Any]], seed: int, rig: DatasetRig) -> dict[str, Any]:
+    from softarm import __version__
+
+    annotations = [a for s in samples for a in s["annotations"]]
+    for k, annotation in enumerate(annotations, start=1):
+        annotation["id"] = k
+    return {
+        "info": {
+            "description": "softarm rendered blackberry bushes (softarm dataset)",
+            "version": __version__,
+            "softarm_version": __version__,
+            "seed": seed,
+            "images": len(samples),
+            "depth_unit_m": 1.0 / DEPTH_SCALE,
+        },
+        "images": [s["image"] for s in samples],
+        "annotations": annotations,
+        "categories": CATEGORIES,
+    }
+
+
+def write_dataset(
+    out_dir: str | Path,
+    images: int,
+    seed: int,
+    rig: DatasetRig,
+    workers: int | None = None,
+    on_image: Callable[[], None] = lambda: None,
+) -> dict[str, Any]:
+    """Render ``images`` labelled images of seed ``seed`` into ``out_dir`` and write
+    ``annotations.json``; returns the COCO document. The first image is rendered here
+    (a missing renderer is one clear :class:`RenderUnavailableError`), the others as Ray
+    tasks over ``workers`` cores (default: all) when Ray is installed and ``workers`` > 1,
+    else one after the other. ``on_image`` is called after each image."""
+    from softarm.files import write_text
+
+    if images < 1:
+        raise ParameterError(f"images must be >= 1, got {images}")
+    workers = os.cpu_count() or 1 if workers is None else workers
+    if workers < 1:
+        raise ParameterError(f"workers must be >= 1, got {workers}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    samples = [render_sample(out, seed, 0, rig)]
+    on_image()
+    rest = range(1, images)
+    ray = _ray_or_none() if workers > 1 and len(rest) > 1 else None
+    if ray is not None:
+        samples += _on_ray(ray, out, seed, rest, rig, workers, on_image)
+    else:
+        for i in rest:
+            samples.append(render_sample(out, seed, i, rig))
+            on_image()
+    coco = _coco(samples, seed, rig)
+    write_text(out / "annotations.json", json.dumps(coco, indent=1), "annotations.json")
+    return coco
