@@ -50,9 +50,7 @@ class BerryScore:
             "localised": int(e.size),
             "median_mm": float(np.median(e)) if e.size else float("nan"),
             "p95_mm": float(np.percentile(e, 95)) if e.size else float("nan"),
-            "distance_m": (min(self.distances_m), max(self.distances_m))
-            if self.distances_m
-            else (float("nan"), float("nan")),  # fmt: skip
+            "distance_m": _span(self.distances_m),
             "median_s": float(np.median(self.seconds)) if self.seconds else float("nan"),
         }
 

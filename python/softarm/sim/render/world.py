@@ -11,16 +11,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from typing import Any
+
 import numpy as np
 
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
+from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.bush import PLUS_Y, Bush
 from softarm.sim.render.distortion import Distorter
 from softarm.sim.render.labels import GeomLabels
 from softarm.sim.render.look import BushLook
 from softarm.sim.render.mjcf import ARM_SEGMENTS_PER_SECTION, CameraSpec, SceneSpec
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
 from softarm.vision.camera_model import CameraModel
 
