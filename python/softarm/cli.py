@@ -34,6 +34,7 @@ COMMANDS: dict[str, str] = {
     "calibrate": "softarm.commands.calibrate",
     "identify": "softarm.commands.identify",
     "replay": "softarm.commands.replay",
+    "dataset": "softarm.commands.dataset",
 }
 
 

@@ -271,6 +271,17 @@ def _ray_or_none() -> Any:
     return ray
 
 
+def ray_workers(images: int, workers: int | None) -> int:
+    """How many Ray workers :func:`write_dataset` uses for ``images`` (all cores when
+    ``workers`` is None); 0 when it renders in this process (Ray not installed, one
+    worker, or fewer than three images: Ray's start would cost more than it saves)."""
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if workers < 2 or images < 3 or _ray_or_none() is None:
+        return 0
+    return workers
+
+
 def _on_ray(
     ray: Any,
     out_dir: Path,
@@ -312,7 +323,7 @@ def _ray_result(ray: Any, ref: Any) -> dict[str, Any]:
         raise
 
 
-def _coco(samples: list[dict[str, Any]], seed: int, rig: DatasetRig) -> dict[str, Any]:
+def _coco(samples: list[dict[str, Any]], seed: int) -> dict[str, Any]:
     from softarm import __version__
 
     annotations = [a for s in samples for a in s["annotations"]]
@@ -350,21 +361,22 @@ def write_dataset(
 
     if images < 1:
         raise ParameterError(f"images must be >= 1, got {images}")
-    workers = os.cpu_count() or 1 if workers is None else workers
-    if workers < 1:
+    if workers is not None and workers < 1:
         raise ParameterError(f"workers must be >= 1, got {workers}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     samples = [render_sample(out, seed, 0, rig)]
     on_image()
     rest = range(1, images)
-    ray = _ray_or_none() if workers > 1 and len(rest) > 1 else None
-    if ray is not None:
-        samples += _on_ray(ray, out, seed, rest, rig, workers, on_image)
+    ray_cores = ray_workers(images, workers)
+    if ray_cores:
+        samples += _on_ray(_ray_or_none(), out, seed, rest, rig, ray_cores, on_image)
     else:
         for i in rest:
             samples.append(render_sample(out, seed, i, rig))
             on_image()
-    coco = _coco(samples, seed, rig)
-    write_text(out / "annotations.json", json.dumps(coco, indent=1), "annotations.json")
+    coco = _coco(samples, seed)
+    write_text(
+        out / "annotations.json", json.dumps(coco, separators=(",", ":")), "annotations.json"
+    )
     return coco

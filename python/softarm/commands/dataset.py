@@ -1,0 +1,77 @@
+"""``softarm dataset``: labelled images of random rendered bushes (COCO boxes and masks,
+ripeness, depth, intrinsics) for training a detector; on Ray when the sweep extra is
+installed."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from typing import TYPE_CHECKING
+
+from softarm.commands._args import add_quiet, float_range, int_range, output_dir, positive_int
+
+if TYPE_CHECKING:
+    from softarm.sim.render.dataset import DatasetRig
+
+#: Most cores a local Ray is asked for.
+MAX_WORKERS = 1024
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Register the ``dataset`` subcommand."""
+    p = sub.add_parser(
+        "dataset",
+        help="render labelled images of random bushes (COCO boxes, masks, ripeness, depth)",
+        description="Each image is one random rendered bush seen by C1 (left or right eye) or "
+        "C2, written to OUT/images, its depth (16-bit PNG, mm) to OUT/depth, its instance map "
+        "to OUT/instances and every berry and cane to OUT/annotations.json (COCO). Runs on Ray "
+        "across the cores when the sweep extra is installed, else one image after the other. "
+        "Needs MuJoCo with an offscreen OpenGL (MUJOCO_GL=egl). See docs/dataset.md.",
+    )
+    p.add_argument("--out", type=output_dir, required=True, help="output folder")
+    p.add_argument("--images", type=positive_int, required=True, help="how many images")
+    p.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="dataset seed")
+    p.add_argument("--workers", type=int_range(1, MAX_WORKERS), help="cores used (default: all)")
+    p.add_argument(
+        "--scale", type=float_range(0.0, 1.0), default=1.0,
+        help="image size and focal length factor (1: C1 1280x720, C2 640x480)",
+    )  # fmt: skip
+    add_quiet(p)
+    p.set_defaults(run=run)
+
+
+def default_rig(scale: float = 1.0) -> DatasetRig:
+    """The simulated harvest's cameras and markers, images scaled by ``scale``."""
+    from softarm.harvest.sim_rig import default_cameras
+    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.sim.render.dataset import DatasetRig
+
+    c = default_cameras(scale=scale)
+    return DatasetRig(
+        c.T_base_c1, c.model(1), c.model(2), c.T_ee_c2, c.T_ee_cube, c.T_base_tag,
+        BASE_TAG_ID, c.base_tag,
+    )  # fmt: skip
+
+
+def run(args: argparse.Namespace) -> int:
+    """Exit 0 once every image and annotations.json are written."""
+    from softarm.commands._progress import Progress
+    from softarm.sim.render.dataset import ray_workers, write_dataset
+
+    rig = default_rig(args.scale)
+    workers = ray_workers(args.images, args.workers)
+    start = time.perf_counter()
+    with Progress(args.images, "dataset", "image", args.quiet) as progress:
+        coco = write_dataset(
+            args.out, args.images, args.seed, rig, workers=args.workers, on_image=progress.advance
+        )
+    counts = {c["id"]: 0 for c in coco["categories"]}
+    for annotation in coco["annotations"]:
+        counts[annotation["category_id"]] += 1
+    named = ", ".join(f"{counts[c['id']]} {c['name']}" for c in coco["categories"])
+    where = f"on Ray ({workers} cores)" if workers else "in one process"
+    print(
+        f"dataset: {len(coco['images'])} images, {named} in "
+        f"{time.perf_counter() - start:.1f} s {where} -> {args.out / 'annotations.json'}"
+    )
+    return 0
