@@ -50,7 +50,8 @@ class Calibration:
         fit: residual statistics on the fit data (mm, deg).
         parameters: fitted deviations from the nominal arm by name (see ``ParameterMap``).
         parameter_std: their standard deviations from the fit's covariance.
-        converged: the solver's success flag; ``message`` its reason.
+        converged: the solver's success flag, False too when the excitation left
+            parameters undetermined; ``message`` its reason.
     """
 
     arm: SoftArm
@@ -63,6 +64,10 @@ class Calibration:
     #: (n,) elongation offsets (m): true elongation = gain x command + offset (zero
     #: unless fitted with ``bias=True``).
     actuator_offset: F64 = field(default_factory=lambda: np.zeros(0))
+    #: Indices (into the samples given) of the outlying samples the fit dropped.
+    outliers: tuple[int, ...] = ()
+    #: Parameters the excitation could not determine (set by the prior alone).
+    unidentifiable: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.actuator_offset.size == 0:
