@@ -7,6 +7,8 @@ export VIRTUAL_ENV := $(abspath $(VENV))
 export PATH := $(abspath $(VENV))/bin:$(PATH)
 # Non-interactive plotting everywhere (CI, headless machines).
 export MPLBACKEND ?= Agg
+# Offscreen OpenGL for the rendered bush (MuJoCo): EGL, Mesa's software rasteriser without a GPU.
+export MUJOCO_GL ?= egl
 
 .PHONY: help venv dev dev-all install docs test test-rust test-python demo lint fmt bench clean
 
@@ -36,8 +38,9 @@ install: venv
 test-rust:
 	cargo test --release -p softarm-core
 
-# The optional extras whose tests run in CI: Ray sweeps, the Cosserat rod, the rerun view.
-TEST_EXTRAS := test,sweep,cosserat,viz
+# The optional extras whose tests run in CI: Ray sweeps, the Cosserat rod, the rerun view,
+# the rendered bush.
+TEST_EXTRAS := test,sweep,cosserat,viz,render
 
 dev-all: venv
 	$(VENV)/bin/maturin develop --release --extras $(TEST_EXTRAS) -q

@@ -125,6 +125,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "harvest_config.py": (*_SIM_UP, "softarm.vision", "softarm.config"),
     "identified_plant.py": (*_SIM_UP, "softarm.vision"),
     "vision": _SIM_UP,
+    "perception": _SIM_UP,
     "sim": _FIT_UP,
     "calibration": _HARVEST_UP,
     "identification": _HARVEST_UP,

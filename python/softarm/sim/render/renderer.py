@@ -52,7 +52,7 @@ def require_mujoco() -> Any:
     os.environ.setdefault("MUJOCO_GL", "egl")
     try:
         import mujoco
-    except (ImportError, OSError, AttributeError) as exc:  # missing or broken GL library
+    except (ImportError, OSError, AttributeError, RuntimeError) as exc:  # no GL library
         raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
     return mujoco
 
@@ -171,7 +171,10 @@ class BushRenderer:
         if (w, h) not in self._renderers:
             self.model.vis.global_.offwidth = max(self.model.vis.global_.offwidth, w)
             self.model.vis.global_.offheight = max(self.model.vis.global_.offheight, h)
-            self._renderers[(w, h)] = self._mj.Renderer(self.model, h, w)
+            try:
+                self._renderers[(w, h)] = self._mj.Renderer(self.model, h, w)
+            except (OSError, AttributeError, RuntimeError) as exc:  # no GL context
+                raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
         return self._renderers[(w, h)]
 
     def _place(self, body: str, pos: FloatArray, R: FloatArray) -> None:

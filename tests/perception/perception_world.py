@@ -1,0 +1,34 @@
+"""Rendered bushes for the perception tests; a machine without
+MuJoCo or an offscreen OpenGL skips these tests with the renderer's own reason."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+import softarm
+from softarm.sim.bush import Bush
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+
+def rendered_world(seed: int, n_berries: int = 8):  # type: ignore[no-untyped-def]
+    """The rendered world of a fresh bush of ``seed`` seen by the simulated rig's cameras,
+    or a skip when this machine cannot render."""
+    from softarm.harvest.sim_rig import default_cameras
+    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.sim.render import RenderUnavailableError
+    from softarm.sim.render.world import world_for
+
+    cams = default_cameras()
+    bush = Bush.generate(
+        softarm.SoftArm.blackberry(), n_berries, seed, view_point=cams.T_base_c1[:3, 3],
+        unripe_fraction=0.4,
+    )  # fmt: skip
+    try:
+        world = world_for(bush, cams, BASE_TAG_ID)
+        world.c1_left()
+    except RenderUnavailableError as exc:
+        pytest.skip(str(exc))
+    return world
