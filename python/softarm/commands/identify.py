@@ -42,7 +42,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "regulator time constant and dead time (pressure readings) and elongation per psi "
         "and hysteresis (tracked poses, geometry fitted alongside). --sim runs on the "
         "simulated plant of `softarm harvest --sim --seed S`, --config on the hardware. "
-        "Exit status: 0 done, 2 a usage, configuration or hardware error, 130/143 stopped "
+        "Exit status: 0 done, 1 done but an estimate is more uncertain than its tolerance "
+        "(id.json marks it), 2 a usage, configuration or hardware error, 130/143 stopped "
         "by SIGINT/SIGTERM (the arm is vented).",
     )
     mode = p.add_mutually_exclusive_group(required=True)
@@ -62,7 +63,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 @drives_arm("identify")
 def run(args: argparse.Namespace) -> int:
-    """Identify and save; 0 on success, 2 on bad input or absent hardware."""
+    """Identify and save; 0 on success, 1 when an estimate is beyond its tolerance, 2 on
+    bad input or absent hardware."""
     from softarm.errors import ParameterError
 
     if args.plant is not None and not args.sim:
@@ -76,6 +78,14 @@ def run(args: argparse.Namespace) -> int:
     plant.save(args.out)
     _print(plant, args.quiet)
     print(f"saved {args.out}")
+    poor = plant.metadata.get("poor_estimates") or []
+    if poor:
+        print(
+            f"softarm identify: warning: {len(poor)} estimates beyond their tolerance "
+            f"(marked in {args.out}): {'; '.join(poor)}",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 

@@ -6,6 +6,7 @@ hysteresis from the tracked poses with the geometry fitted alongside
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from typing import Any
 
@@ -15,10 +16,13 @@ from softarm._core import SoftArm
 from softarm.errors import HardwareError
 from softarm.identification.kinematic import fit_kinematics
 from softarm.identification.lag import fit_lag, simulate_lag
+from softarm.identification.quality import poor_estimates
 from softarm.identification.record import Recording
 from softarm.identification.result import IdentifiedPlant
 
 __all__ = ["estimate"]
+
+_log = logging.getLogger(__name__)
 
 #: Fewer fitted holds than this cannot separate 30 parameters from tracker noise.
 MIN_HOLDS = 20
@@ -81,6 +85,11 @@ def estimate(
             for s in kin.arm.sections
         ],
     }  # fmt: skip
+    meta["poor_estimates"] = poor_estimates(
+        kin.metres_per_psi, kin.metres_per_psi_std, kin.hysteresis_psi_std
+    )
+    if meta["poor_estimates"]:
+        _log.warning("estimates beyond their tolerance: %s", "; ".join(meta["poor_estimates"]))
     meta.update(metadata or {})
     return IdentifiedPlant(
         tau_s=tuple(f.tau_s for f in lags),
