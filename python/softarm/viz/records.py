@@ -18,7 +18,8 @@ same code serves the live view (records drained as the machine writes them) and
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -201,14 +202,12 @@ class RecordLogger:
             raise InputError(f"a record must be an object with a string 'kind', got {record!r}")
         t = record.get("t")
         if t is not None:
-            if not isinstance(t, int | float) or not np.isfinite(t):
-                raise InputError(f"t must be a finite number of seconds, got {t!r}")
-            self.t = float(t)
+            self.t = _seconds(t)
         self.stream.set_time(TIMELINE, duration=self.t)
-        kind = record["kind"]
-        handler = getattr(self, f"_{kind}", None)
+        # An explicit table: a record's kind must not reach any other attribute.
+        handler = _HANDLERS.get(record["kind"])
         if handler is not None:
-            handler(record)
+            handler(self, record)
         else:
             self._text(record, "harvest/log")
         self.count += 1
@@ -218,6 +217,8 @@ class RecordLogger:
     def _step(self, r: Mapping[str, Any]) -> None:
         rr, log = self.rr, self.stream.log
         state = r.get("state")
+        if state is not None and not isinstance(state, str):
+            raise InputError(f"state must be a state name, got {state!r}")
         if state in STATE_INDEX:
             log("harvest/state_index", rr.Scalars(STATE_INDEX[state]))
         if self.model is not None and r.get("q") is not None:
@@ -251,12 +252,14 @@ class RecordLogger:
         level = "ERROR" if new == "fault" else "INFO"
         text = f"tag {r.get('berry')}: {r.get('old')} -> {new} ({r.get('why')})"
         self.stream.log("harvest/state", self.rr.TextLog(text, level=level))
-        if new in STATE_INDEX:
+        if isinstance(new, str) and new in STATE_INDEX:
             self.stream.log("harvest/state_index", self.rr.Scalars(STATE_INDEX[new]))
 
     def _plan(self, r: Mapping[str, Any]) -> None:
         rr = self.rr
         if self.model is not None and r.get("q"):
+            if not isinstance(r["q"], list):
+                raise InputError(f"plan q must be a list of configurations, got {r['q']!r}")
             tips = [
                 self.model.forward(as_vector(q, "plan q", self.model.n_actuators))[:3, 3]
                 for q in r["q"]
@@ -272,7 +275,8 @@ class RecordLogger:
     def _berry_result(self, r: Mapping[str, Any]) -> None:
         err = r.get("true_position_error_mm")
         if err is not None:
-            self.stream.log("errors/true_position_mm", self.rr.Scalars(float(err)))
+            mm = float(as_vector([err], "true_position_error_mm")[0])
+            self.stream.log("errors/true_position_mm", self.rr.Scalars(mm))
         what = "harvested" if r.get("harvested") else (r.get("fault") or "not harvested")
         text = f"tag {r.get('tag_id')}: {what}, {r.get('duration_s')} s, {r.get('steps')} steps"
         level = "INFO" if r.get("harvested") else "WARN"
@@ -299,3 +303,25 @@ class RecordLogger:
         fields = {k: v for k, v in r.items() if k not in ("kind", "t", *skip)}
         text = f"{r['kind']}: {json.dumps(fields, default=str)}"
         self.stream.log(path, self.rr.TextLog(text, level=_LEVELS.get(r["kind"], "INFO")))
+
+
+def _seconds(t: Any) -> float:
+    """A record's time ``t``: a finite number (a bool, a string or an integer too large
+    for a float is an InputError)."""
+    try:
+        ok = isinstance(t, int | float) and not isinstance(t, bool) and math.isfinite(t)
+    except OverflowError:
+        ok = False
+    if not ok:
+        raise InputError(f"t must be a finite number of seconds, got {str(t)[:40]!r}")
+    return float(t)
+
+
+#: The drawing of each record kind; any other kind is shown as text.
+_HANDLERS: dict[str, Callable[[RecordLogger, Mapping[str, Any]], None]] = {
+    "step": RecordLogger._step,
+    "transition": RecordLogger._transition,
+    "plan": RecordLogger._plan,
+    "ripeness": RecordLogger._ripeness,
+    "berry_result": RecordLogger._berry_result,
+}
