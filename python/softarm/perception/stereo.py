@@ -28,6 +28,10 @@ from softarm.vision.camera_model import CameraModel
 
 __all__ = ["locate_berries", "match_disparity"]
 
+#: The fruit's width (m): 1.5–2.5 cm across, with a margin either side.
+FRUIT_ACROSS = (0.013, 0.032)
+#: How much better (as a share of the cost) the best match must be than any other.
+UNIQUENESS = 0.15
 #: Depths (m) searched along the rows: the disparity range f B / z.
 DEPTH_RANGE = (0.4, 2.5)
 
@@ -52,7 +56,7 @@ def locate_berries(
     for det in detect_berries(L, rect_cam, settings=settings):
         d = match_disparity(gray_l, gray_r, det, (d_lo, d_hi))
         position = None
-        if d is not None:
+        if d is not None and _plausible(d, det.radius, rect.baseline):
             centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
             position = (stereo.T_base_left @ np.append(centre, 1.0))[:3]
         out.append(replace(det, position=position))
@@ -85,7 +89,7 @@ def match_disparity(
     strip = right[y0:y1, s0:s1]
     cost = cv2.matchTemplate(strip, template, cv2.TM_SQDIFF, mask=mask)[0]
     k = int(np.argmin(cost))
-    if k == 0 or k == cost.size - 1:
+    if k == 0 or k == cost.size - 1 or not _unique(cost, k):
         return None
     a, b, c = cost[k - 1], cost[k], cost[k + 1]
     curvature = a - 2 * b + c
@@ -94,6 +98,26 @@ def match_disparity(
     sub = 0.5 * (a - c) / curvature  # the parabola's vertex, in [-0.5, 0.5]
     x_right = s0 + k + sub
     return float(x0 - x_right)
+
+
+def _plausible(disparity: float, radius_px: float, baseline: float) -> bool:
+    """The stereo depth f B / d agrees with the depth the fruit's apparent size allows,
+    f D / (2 r) for a fruit D across in FRUIT_ACROSS (the focal lengths cancel: the
+    test is on B / d against D / 2r). A half-hidden fruit looks smaller, which only
+    moves its size-depth farther: the near bound holds for it too, and the far bound
+    allows a fruit seen at half its width. Diagnosed on bushes 203 and 208, where a
+    match on another dark fruit along the rows put a berry 0.3 m off."""
+    z_over_f = baseline / disparity
+    return FRUIT_ACROSS[0] / (2 * radius_px) <= z_over_f <= FRUIT_ACROSS[1] / radius_px
+
+
+def _unique(cost: npt.NDArray[np.float32], k: int) -> bool:
+    """The best match must beat every match more than two pixels from it by
+    UNIQUENESS (StereoSGBM's uniqueness ratio): another dark fruit on the same rows, or
+    a berry seen whole in one eye and half hidden in the other, can match almost as
+    well, and a wrong match is a gross error (tens of centimetres), not a small one."""
+    others = np.concatenate([cost[: max(k - 2, 0)], cost[k + 3 :]])
+    return others.size == 0 or float(cost[k]) < (1.0 - UNIQUENESS) * float(others.min())
 
 
 def to_camera(points_base: FloatArray, T_base_camera: FloatArray) -> FloatArray:
