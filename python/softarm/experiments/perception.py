@@ -39,3 +39,29 @@ def evaluate_berries(
         world.close()
         out.append((seed, score))
     return out
+
+
+def table(seeds: Iterable[int]) -> str:
+    """A Markdown table of :func:`evaluate_berries` over ``seeds``, one row per bush and
+    the pooled figures last."""
+    header = "| bush | precision | recall | ripe/unripe right | ripe ≥ ½ visible | localised "
+    rows = [header + "| median mm | p95 mm |", "|" + " --- |" * 8]
+    pooled = BerryScore()
+    for seed, score in evaluate_berries(seeds):
+        pooled.add(score)
+        rows.append(_row(str(seed), score.summary()))
+    rows.append(_row("**all**", pooled.summary()))
+    return "\n".join(rows)
+
+
+def _row(name: str, s: dict) -> str:
+    return (
+        f"| {name} | {s['precision']:.3f} | {s['recall']:.3f} | {s['ripeness_accuracy']:.3f} "
+        f"| {s['ripe_in_view']} | {s['localised']} | {s['median_mm']:.2f} | {s['p95_mm']:.2f} |"
+    )
+
+
+if __name__ == "__main__":  # python -m softarm.experiments.perception FIRST LAST
+    import sys
+
+    print(table(range(int(sys.argv[1]), int(sys.argv[2]) + 1)))

@@ -1,0 +1,50 @@
+"""Perception speed on one core: the stereo berry perception on one C1 frame pair
+(rectify both eyes, detect, match, triangulate; target ≤ 50 ms) and detection alone on
+a C2 frame (target ≤ 10 ms), on rendered bushes; the renderer's own stereo frame beside
+them (not part of the perception budget)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import cv2
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent.parent / "perception"))
+from perception_world import rendered_world  # noqa: E402
+
+from softarm.perception.berries import detect_berries  # noqa: E402
+from softarm.perception.stereo import locate_berries  # noqa: E402
+
+cv2.setNumThreads(1)  # one core, as the targets are stated
+
+
+@pytest.fixture(scope="module")
+def world():  # type: ignore[no-untyped-def]
+    w = rendered_world(310)
+    yield w
+    w.close()
+
+
+def test_stereo_berries_per_c1_frame(benchmark, world) -> None:  # type: ignore[no-untyped-def]
+    left, right = world.c1()
+    world.stereo.rectification  # built once per camera, not per frame
+    benchmark(locate_berries, left.colour, right.colour, world.stereo)
+
+
+def test_berries_per_c2_frame(benchmark, world) -> None:  # type: ignore[no-untyped-def]
+    berry = world.bush.berries[0]
+    import softarm
+    from softarm.sim.render.world import arm_sections
+
+    arm = softarm.SoftArm.blackberry()
+    q = berry.q * 0.97
+    world.set_arm(arm_sections(arm, q), arm.forward(q))
+    frame = world.c2_frame().colour
+    benchmark(detect_berries, frame, world.c2)
+
+
+def test_render_c1_stereo_pair(benchmark, world) -> None:  # type: ignore[no-untyped-def]
+    world.hide_arm()
+    benchmark.pedantic(world.c1, rounds=5, iterations=1)
