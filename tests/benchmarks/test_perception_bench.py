@@ -12,10 +12,10 @@ import cv2
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent.parent / "perception"))
-from perception_world import rendered_world  # noqa: E402
+from perception_world import rendered_world
 
-from softarm.perception.berries import detect_berries  # noqa: E402
-from softarm.perception.stereo import locate_berries  # noqa: E402
+from softarm.perception.berries import detect_berries
+from softarm.perception.stereo import locate_berries
 
 cv2.setNumThreads(1)  # one core, as the targets are stated
 
@@ -29,7 +29,7 @@ def world():  # type: ignore[no-untyped-def]
 
 def test_stereo_berries_per_c1_frame(benchmark, world) -> None:  # type: ignore[no-untyped-def]
     left, right = world.c1()
-    world.stereo.rectification  # built once per camera, not per frame
+    _ = world.stereo.rectification  # built once per camera, not per frame
     benchmark(locate_berries, left.colour, right.colour, world.stereo)
 
 
