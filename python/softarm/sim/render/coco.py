@@ -48,7 +48,7 @@ def mask_polygons(mask: npt.NDArray[np.bool_]) -> list[list[float]]:
     return [_polygon(c.reshape(-1, 2)) for c in contours]
 
 
-def _polygon(points: npt.NDArray[np.int32]) -> list[float]:
+def _polygon(points: npt.NDArray[Any]) -> list[float]:
     if len(points) >= 3:
         return [float(v) for v in points.ravel()]
     (x0, y0), (x1, y1) = points.min(axis=0) - 0.5, points.max(axis=0) + 0.5
