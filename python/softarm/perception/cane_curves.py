@@ -1,0 +1,175 @@
+"""Canes as cubic curves from 3D points: the planning paper's curve obstacle (eq. 10),
+p(u) = Σ_k c_k u^k for u in [0, 1], fitted by least squares with u the normalised arc
+length, and the points split into canes by sequential RANSAC (a line proposes a cane,
+the cubic through its inliers grows it along the cane, past gaps where leaves hide it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from softarm.checks import FloatArray
+
+__all__ = ["CurveSearch", "arc_length_cubic", "curve_points", "split_into_curves"]
+
+DEGREE = 3
+DENSE = 200  # samples of a curve when points are matched to it
+SCORED = 600  # points a proposed line is scored on
+MAX_MISSES = 8  # proposed lines in a row that grow into no cane before the search ends
+
+
+@dataclass(frozen=True)
+class CurveSearch:
+    """How canes are found among 3D points (metres).
+
+    line_tolerance: a point within this of a proposed line is its inlier.
+    curve_tolerance: a point within this of a grown cubic belongs to that cane.
+    min_support: fewest points a cane keeps; min_length: its shortest extent.
+    max_gap: the longest hole (a leaf in front) a cane is followed across.
+    proposals: random lines tried for each cane; seed: their generator's seed.
+    """
+
+    line_tolerance: float = 0.008
+    curve_tolerance: float = 0.006
+    min_support: int = 40
+    min_length: float = 0.04
+    max_gap: float = 0.06
+    proposals: int = 150
+    seed: int = 0
+
+
+def curve_points(coeffs: FloatArray, n: int = DENSE, u: FloatArray | None = None) -> FloatArray:
+    """(n, 3) points of the curve ``coeffs`` (3, d+1), ascending powers, at even u in
+    [0, 1] (or at the given ``u``)."""
+    u = np.linspace(0.0, 1.0, n) if u is None else np.asarray(u, dtype=np.float64)
+    return np.vander(u, coeffs.shape[1], increasing=True) @ coeffs.T
+
+
+def arc_length_cubic(points: FloatArray, iterations: int = 3) -> FloatArray:
+    """Coefficients (3, 4) of the cubic through ``points`` (n, 3) in u ∈ [0, 1], u the
+    normalised arc length (planning paper eq. 10): start from each point's place along
+    the principal axis, then alternately fit by least squares and re-place each point
+    at its closest curve point, measured in arc length."""
+    centred = points - points.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    t = centred @ axis
+    u = (t - t.min()) / max(float(np.ptp(t)), 1e-12)
+    coeffs = _least_squares(points, u)
+    for _ in range(iterations):
+        u = _arc_length_parameters(coeffs, points)
+        coeffs = _least_squares(points, u)
+    return coeffs
+
+
+def _least_squares(points: FloatArray, u: FloatArray) -> FloatArray:
+    vander = np.vander(u, DEGREE + 1, increasing=True)
+    return np.linalg.lstsq(vander, points, rcond=None)[0].T
+
+
+def _arc_length_parameters(coeffs: FloatArray, points: FloatArray) -> FloatArray:
+    """Each point's closest place on the curve as normalised arc length, the curve
+    trimmed to the span the points cover."""
+    dense = curve_points(coeffs, DENSE)
+    nearest = cKDTree(dense).query(points)[1]
+    lo, hi = nearest.min(), nearest.max()
+    steps = np.linalg.norm(np.diff(dense[lo : hi + 1], axis=0), axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(steps)])
+    return arc[nearest - lo] / max(float(arc[-1]), 1e-12)
+
+
+def split_into_curves(points: FloatArray, search: CurveSearch) -> list[FloatArray]:
+    """Index arrays into ``points`` (n, 3), one per cane found. A proposed line that
+    grows into no cane gives up its inliers (clutter, a leaf's edge), and the search
+    ends after ``MAX_MISSES`` such lines in a row."""
+    rng = np.random.default_rng(search.seed)
+    remaining = np.arange(len(points))
+    canes: list[FloatArray] = []
+    misses = 0
+    while len(remaining) >= search.min_support and misses < MAX_MISSES:
+        line = _best_line(points[remaining], search, rng)
+        if line is None:
+            break
+        members = _grow(points[remaining], line, search)
+        misses = 0 if members is not None else misses + 1
+        if members is not None:
+            canes.append(remaining[members])
+        remaining = np.delete(remaining, line if members is None else members)
+    return canes
+
+
+def _grow(points: FloatArray, line: FloatArray, search: CurveSearch) -> FloatArray | None:
+    """The cane grown from the inliers ``line`` of a proposed line: alternately fit the
+    cubic and take the points near it, in one run without long holes; None when it is
+    too short or has too few points."""
+    members = _longest_run(points, line, search.max_gap)
+    for _ in range(3):
+        if len(members) < search.min_support:
+            return None
+        coeffs = arc_length_cubic(points[members])
+        members = _near_curve(points, coeffs, search)
+        members = _longest_run(points, members, search.max_gap)
+    if len(members) < search.min_support or _extent(points[members]) < search.min_length:
+        return None
+    return members
+
+
+def _best_line(
+    points: FloatArray, search: CurveSearch, rng: np.random.Generator
+) -> FloatArray | None:
+    """Inlier indices of the random two-point line (points 2–10 cm apart) with most
+    points within ``line_tolerance``, scored on a subsample of the points."""
+    tree = cKDTree(points)
+    scored = points[rng.permutation(len(points))[:SCORED]]
+    best_direction, best_anchor, best_count = None, None, -1
+    for a in rng.integers(0, len(points), search.proposals):
+        near = np.asarray(tree.query_ball_point(points[a], 0.10), dtype=np.intp)
+        far = near[np.linalg.norm(points[near] - points[a], axis=1) > 0.02]
+        if far.size == 0:
+            continue
+        direction = points[far[rng.integers(0, far.size)]] - points[a]
+        direction /= np.linalg.norm(direction)
+        count = int(np.sum(_line_distance(scored, points[a], direction) < search.line_tolerance))
+        if count > best_count:
+            best_direction, best_anchor, best_count = direction, points[a], count
+    if best_direction is None:
+        return None
+    distance = _line_distance(points, best_anchor, best_direction)
+    return np.flatnonzero(distance < search.line_tolerance)
+
+
+def _line_distance(points: FloatArray, anchor: FloatArray, direction: FloatArray) -> FloatArray:
+    """Distance of each point to the line through ``anchor`` along unit ``direction``."""
+    offset = points - anchor
+    return np.linalg.norm(offset - np.outer(offset @ direction, direction), axis=1)
+
+
+def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> FloatArray:
+    """Indices of points within ``curve_tolerance`` of the curve extended by max_gap
+    at both ends (so that a cane grows past where its points stopped)."""
+    length = float(np.sum(np.linalg.norm(np.diff(curve_points(coeffs), axis=0), axis=1)))
+    reach = search.max_gap / max(length, 1e-9)
+    dense = curve_points(coeffs, DENSE, np.linspace(-reach, 1.0 + reach, DENSE))
+    distance = cKDTree(dense).query(points)[0]
+    return np.flatnonzero(distance < search.curve_tolerance)
+
+
+def _longest_run(points: FloatArray, members: FloatArray, max_gap: float) -> FloatArray:
+    """The members along the principal axis, cut at holes longer than ``max_gap``;
+    the run with most points."""
+    chosen = points[members]
+    axis = np.linalg.svd(chosen - chosen.mean(axis=0), full_matrices=False)[2][0]
+    order = np.argsort(chosen @ axis)
+    t = (chosen @ axis)[order]
+    cuts = np.flatnonzero(np.diff(t) > max_gap) + 1
+    runs = np.split(order, cuts)
+    return members[max(runs, key=len)]
+
+
+def _extent(points: FloatArray) -> float:
+    """Length of the points along their principal axis."""
+    centred = points - points.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    return float(np.ptp(centred @ axis))

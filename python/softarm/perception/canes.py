@@ -1,0 +1,197 @@
+"""Canes from C1: segmented in colour, lifted to 3D by stereo (or an aligned depth
+image), split into canes and each fitted as a ``softarm.PolynomialCurve``, the planning
+paper's curve obstacle (eq. 10), in the base frame, with its radius.
+
+The pipeline (:func:`fit_canes`):
+
+1. rectify the pair; the cane pixels of the rectified left image
+   (:func:`softarm.perception.cane_pixels.cane_mask`);
+2. their disparity by StereoSGBM over the region they occupy, triangulated to the left
+   camera frame (with ``depth`` given: the left image's own pixels, back-projected);
+3. the camera sees the front of each tube, on average π r / 4 nearer than its centre
+   line for pixels spread evenly across it: each point is pushed back along its ray by
+   that much, r from the local width of the mask;
+4. in the base frame, sequential RANSAC splits the points into canes
+   (:mod:`softarm.perception.cane_curves`) and each becomes a cubic in u ∈ [0, 1]
+   fitted by least squares with arc-length parameters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm._core import PolynomialCurve
+from softarm.checks import FloatArray
+from softarm.errors import VisionError
+from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
+from softarm.perception.cane_pixels import CaneLook, cane_mask, half_width_px, stereo_disparity
+from softarm.perception.stereo_camera import StereoCamera
+
+__all__ = ["CaneFit", "CaneSettings", "fit_canes"]
+
+
+@dataclass(frozen=True)
+class CaneFit:
+    """One cane: ``curve`` (planning paper eq. 10, u ∈ [0, 1], base frame) with its
+    ``coeffs`` (3, 4), ascending powers; ``radius`` (m); ``points`` (n, 3) the 3D
+    inliers it was fitted to (centre-line estimates, base frame); ``support`` = n."""
+
+    curve: PolynomialCurve
+    coeffs: FloatArray
+    radius: float
+    points: FloatArray
+    support: int
+
+
+@dataclass(frozen=True)
+class CaneSettings:
+    """``look``: which pixels are canes; ``search``: how points become canes;
+    ``depth_range``: nearest and farthest depth (m) a cane is looked for at;
+    ``max_points``: points kept for the fit (an even subsample beyond that)."""
+
+    look: CaneLook = field(default_factory=CaneLook)
+    search: CurveSearch = field(default_factory=CurveSearch)
+    depth_range: tuple[float, float] = (0.6, 1.5)
+    max_points: int = 4000
+
+
+def fit_canes(
+    left: npt.NDArray[np.uint8],
+    right: npt.NDArray[np.uint8] | None,
+    stereo: StereoCamera,
+    depth: FloatArray | None = None,
+    settings: CaneSettings | None = None,
+) -> list[CaneFit]:
+    """The canes C1 sees, largest support first; [] when there is none.
+
+    Args:
+        left, right: C1's BGR uint8 images as OpenCV reads them (distorted, the size of
+            ``stereo.left.image_size``). ``right`` may be None when ``depth`` is given.
+        stereo: the calibrated pair; ``stereo.T_base_left`` places the result.
+        depth: optional (H, W) depth in metres along the left eye's optical axis,
+            aligned with ``left`` (0 or NaN where unknown), e.g. from an RGB-D
+            camera; when given, stereo matching is skipped.
+        settings: thresholds; the defaults were tuned on rendered bushes 0–4.
+
+    Raises:
+        VisionError: an empty image, a wrong dtype or shape, or sizes that disagree.
+    """
+    settings = settings or CaneSettings()
+    _check_inputs(left, right, stereo, depth)
+    if depth is None:
+        assert right is not None
+        camera_points = _stereo_points(left, right, stereo, settings)
+    else:
+        camera_points = _depth_points(left, depth, stereo, settings)
+    if len(camera_points) < settings.search.min_support:
+        return []
+    T = np.asarray(stereo.T_base_left, dtype=np.float64)
+    points = camera_points[:, :3] @ T[:3, :3].T + T[:3, 3]
+    return _fit_all(points, camera_points[:, 3], settings)
+
+
+def _check_inputs(left: object, right: object, stereo: StereoCamera, depth: object) -> None:
+    size = stereo.left.image_size
+    assert size is not None  # StereoCamera requires it
+    _check_image("left", left, size)
+    if depth is None:
+        if right is None:
+            raise VisionError("right is None: give the right image or a depth image")
+        _check_image("right", right, size)
+        return
+    if not isinstance(depth, np.ndarray) or depth.dtype.kind != "f":
+        raise VisionError(f"depth must be a float array in metres, got {_describe(depth)}")
+    if depth.shape != (size[1], size[0]):
+        raise VisionError(f"depth must be {size[1]}x{size[0]} like left, got {depth.shape}")
+
+
+def _check_image(name: str, image: object, size: tuple[int, int]) -> None:
+    if not isinstance(image, np.ndarray) or image.size == 0:
+        raise VisionError(f"{name} must be a non-empty BGR image, got {_describe(image)}")
+    if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 3:
+        raise VisionError(f"{name} must be (H, W, 3) uint8 BGR, got {_describe(image)}")
+    if image.shape[:2] != (size[1], size[0]):
+        raise VisionError(f"{name} is {image.shape[1]}x{image.shape[0]}, the camera {size}")
+
+
+def _describe(value: object) -> str:
+    if isinstance(value, np.ndarray):
+        return f"{value.dtype} array of shape {value.shape}"
+    return type(value).__name__
+
+
+def _stereo_points(
+    left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8],
+    stereo: StereoCamera, settings: CaneSettings,
+) -> FloatArray:  # fmt: skip
+    """(n, 4) rows, one per cane pixel of the rectified left image: the point in the
+    left camera frame, pushed to the centre line, and the radius there (m)."""
+    rect = stereo.rectification
+    rect_left, rect_right = rect.rectify(left, right)
+    mask = cane_mask(rect_left, settings.look)
+    disparity = stereo_disparity(rect_left, rect_right, rect, mask, settings.depth_range)
+    mask &= np.isfinite(disparity)
+    rows, cols = _subsample(np.nonzero(mask), settings.max_points)
+    pixels = np.column_stack([cols, rows]).astype(np.float64)
+    surface = rect.triangulate(pixels, disparity[rows, cols])
+    radius = half_width_px(mask)[rows, cols] * surface[:, 2] / rect.focal
+    return _to_centre_line(surface, radius, settings.depth_range)
+
+
+def _depth_points(
+    left: npt.NDArray[np.uint8], depth: FloatArray,
+    stereo: StereoCamera, settings: CaneSettings,
+) -> FloatArray:  # fmt: skip
+    """As :func:`_stereo_points`, from a depth image aligned with the left eye."""
+    near, far = settings.depth_range
+    z = np.nan_to_num(depth.astype(np.float32), nan=0.0)
+    mask = cane_mask(left, settings.look) & (z >= near) & (z <= far)
+    rows, cols = _subsample(np.nonzero(mask), settings.max_points)
+    if rows.size == 0:
+        return np.zeros((0, 4))
+    pixels = np.column_stack([cols, rows]).astype(np.float64)
+    cam = stereo.left
+    rays = cv2.undistortPoints(pixels.reshape(-1, 1, 2), cam.matrix, cam.distortion)
+    zs = z[rows, cols].astype(np.float64)
+    surface = np.column_stack([rays.reshape(-1, 2) * zs[:, None], zs])
+    radius = half_width_px(mask)[rows, cols] * zs / float(cam.matrix[0, 0])
+    return _to_centre_line(surface, radius, settings.depth_range)
+
+
+def _subsample(
+    indices: tuple[npt.NDArray[np.intp], ...], limit: int
+) -> tuple[npt.NDArray[np.intp], ...]:
+    step = max(1, int(np.ceil(len(indices[0]) / limit)))
+    return tuple(i[::step] for i in indices)
+
+
+def _to_centre_line(
+    surface: FloatArray, radius: FloatArray, depth_range: tuple[float, float]
+) -> FloatArray:
+    """(n, 4): each surface point moved π r / 4 further along its ray, and r; points
+    outside ``depth_range`` dropped."""
+    keep = (surface[:, 2] >= depth_range[0]) & (surface[:, 2] <= depth_range[1])
+    surface, radius = surface[keep], radius[keep]
+    rays = surface / np.linalg.norm(surface, axis=1, keepdims=True)
+    centre = surface + rays * (np.pi / 4.0 * radius)[:, None]
+    return np.column_stack([centre, radius])
+
+
+def _fit_all(points: FloatArray, radius: FloatArray, settings: CaneSettings) -> list[CaneFit]:
+    fits = []
+    for members in split_into_curves(points, settings.search):
+        coeffs = arc_length_cubic(points[members])
+        fits.append(
+            CaneFit(
+                curve=PolynomialCurve(coeffs, (0.0, 1.0)),
+                coeffs=coeffs,
+                radius=float(np.median(radius[members])),
+                points=points[members],
+                support=len(members),
+            )
+        )
+    return fits

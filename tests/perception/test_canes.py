@@ -1,0 +1,142 @@
+"""Canes as curves (planning paper eq. 10): the fit against known cubics, the cane map
+on a small rendered bush, and bad inputs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softarm.errors import VisionError
+from softarm.perception.cane_curves import (
+    CurveSearch,
+    arc_length_cubic,
+    curve_points,
+    split_into_curves,
+)
+from softarm.perception.cane_metrics import cane_map_error
+from softarm.perception.canes import CaneFit, fit_canes
+from softarm.perception.stereo_camera import StereoCamera
+from softarm.vision.camera_model import CameraModel
+
+KNOWN = [
+    np.array([[0.1, 0.2, -0.05, 0.02], [0.5, 0.01, 0.03, -0.01], [0.2, 0.05, 0.04, 0.0]]),
+    np.array([[-0.1, 0.02, 0.03, 0.01], [0.55, 0.02, -0.02, 0.01], [0.1, 0.2, -0.03, -0.02]]),
+]
+
+
+class _Cane:
+    def __init__(self, coeffs: np.ndarray) -> None:
+        self.coeffs = coeffs
+
+
+def _noisy(coeffs: np.ndarray, n: int, noise: float, rng: np.random.Generator) -> np.ndarray:
+    return curve_points(coeffs, u=rng.uniform(0, 1, n)) + rng.normal(0, noise, (n, 3))
+
+
+@pytest.mark.parametrize("coeffs", KNOWN)
+def test_the_cubic_through_noisy_points_is_the_known_curve(coeffs: np.ndarray) -> None:
+    rng = np.random.default_rng(1)
+    fitted = arc_length_cubic(_noisy(coeffs, 600, 0.001, rng))
+    truth = _Cane(coeffs)
+    scores = cane_map_error([_Cane(fitted)], [truth], workspace=5.0)
+    assert scores["coverage"] > 0.98
+    assert scores["median_mm"] < 0.5 and scores["p95_mm"] < 1.5
+    # Either direction along the cane is the same obstacle: compare the end points.
+    ends = curve_points(fitted, 2)
+    true_ends = curve_points(coeffs, 2)
+    gap = min(np.abs(ends - true_ends).max(), np.abs(ends[::-1] - true_ends).max())
+    assert gap < 0.004
+
+
+def test_points_of_two_canes_and_clutter_split_into_two_canes() -> None:
+    rng = np.random.default_rng(2)
+    clutter = rng.uniform([-0.2, 0.4, 0.0], [0.4, 0.7, 0.4], (150, 3))
+    points = np.vstack([_noisy(c, 400, 0.0015, rng) for c in KNOWN] + [clutter])
+    groups = split_into_curves(points, CurveSearch())
+    fits = [_Cane(arc_length_cubic(points[g])) for g in groups]
+    scores = cane_map_error(fits, [_Cane(c) for c in KNOWN], workspace=5.0)
+    assert len(groups) == 2
+    assert scores["coverage"] > 0.95 and scores["median_mm"] < 1.0
+    assert scores["precision"] > 0.95
+
+
+def test_the_map_error_of_no_fit_is_no_coverage() -> None:
+    scores = cane_map_error([], [_Cane(KNOWN[0])], workspace=5.0)
+    assert scores["coverage"] == 0.0 and np.isnan(scores["median_mm"])
+
+
+@pytest.fixture(scope="module")
+def stereo() -> StereoCamera:
+    K = np.array([[900.0, 0, 320], [0, 900.0, 240], [0, 0, 1]])
+    camera = CameraModel(K, np.zeros(5), image_size=(640, 480))
+    T_left_right = np.eye(4)
+    T_left_right[0, 3] = 0.12
+    return StereoCamera(camera, camera, np.eye(4), T_left_right)
+
+
+@pytest.mark.parametrize(
+    ("left", "right", "depth", "names"),
+    [
+        (np.zeros((0, 0, 3), np.uint8), "ok", None, "left"),
+        ("ok", np.zeros((480, 640, 3), np.float32), None, "right"),
+        ("ok", np.zeros((240, 320, 3), np.uint8), None, "right"),
+        ([[0]], "ok", None, "left"),
+        ("ok", None, None, "right"),
+        ("ok", None, np.zeros((480, 640), np.uint16), "depth"),
+        ("ok", None, np.zeros((480, 320), np.float32), "depth"),
+    ],
+)
+def test_bad_inputs_name_the_argument(stereo: StereoCamera, left, right, depth, names) -> None:
+    ok = np.zeros((480, 640, 3), np.uint8)
+    left = ok if isinstance(left, str) else left
+    right = ok if isinstance(right, str) else right
+    with pytest.raises(VisionError, match=names):
+        fit_canes(left, right, stereo, depth=depth)
+
+
+def test_no_cane_in_view_is_an_empty_list(stereo: StereoCamera) -> None:
+    grey = np.full((480, 640, 3), 90, np.uint8)
+    assert fit_canes(grey, grey, stereo) == []
+    assert fit_canes(grey, None, stereo, depth=np.full((480, 640), np.nan, np.float32)) == []
+
+
+@pytest.fixture(scope="module")
+def rendered():
+    pytest.importorskip("mujoco")
+    import softarm
+    from softarm.harvest.sim_rig import default_cameras
+    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.sim.bush import Bush
+    from softarm.sim.render import RenderedBush, RenderUnavailableError
+
+    arm = softarm.SoftArm.blackberry()
+    cams = default_cameras()
+    bush = Bush.generate(arm, 4, 4, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
+    try:
+        world = RenderedBush(
+            bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2,
+            cams.T_ee_cube, cams.T_base_tag, BASE_TAG_ID, cams.base_tag,
+        )  # fmt: skip
+    except RenderUnavailableError as exc:
+        pytest.skip(str(exc))
+    left, right = world.c1(truth=True)
+    yield bush, world.stereo, left, right
+    world.close()
+
+
+def test_the_cane_map_of_a_rendered_bush_is_within_bounds(rendered) -> None:
+    bush, stereo, left, right = rendered
+    fits = fit_canes(left.colour, right.colour, stereo)
+    assert fits and all(isinstance(f, CaneFit) for f in fits)
+    assert all(0.001 < f.radius < 0.006 and f.support == len(f.points) for f in fits)
+    scores = cane_map_error(fits, bush.branches)
+    assert scores["median_mm"] < 4.0
+    assert scores["coverage"] > 0.7
+
+
+def test_an_aligned_depth_image_gives_the_same_canes(rendered) -> None:
+    bush, stereo, left, _ = rendered
+    fits = fit_canes(left.colour, None, stereo, depth=left.depth)
+    scores = cane_map_error(fits, bush.branches)
+    assert scores["median_mm"] < 3.0
+    assert scores["coverage"] > 0.7
