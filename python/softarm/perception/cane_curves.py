@@ -36,7 +36,7 @@ class CurveSearch:
     curve_tolerance: float = 0.006
     min_support: int = 40
     min_length: float = 0.04
-    max_gap: float = 0.06
+    max_gap: float = 0.10
     proposals: int = 150
     seed: int = 0
 

@@ -30,7 +30,7 @@ class CaneLook:
     ``min_texture``: grey-level standard deviation over 7×7 pixels; widths in pixels)."""
 
     hue: tuple[int, int] = (10, 46)
-    min_saturation: int = 90
+    min_saturation: int = 105
     min_value: int = 25
     min_texture: float = 4.0
     thinnest: int = 3
