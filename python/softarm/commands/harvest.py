@@ -68,6 +68,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--record", type=output_file, metavar="RUN.rrd",
         help="save a rerun recording of the run (--sim only; viz extra)",
     )  # fmt: skip
+    p.add_argument(
+        "--world", choices=("tags", "bush"), default="tags",
+        help="--sim: 'tags', berries tagged and canes mapped (fast); 'bush', the rendered "
+        "bush, berries and canes found by the cameras (render extra, MUJOCO_GL=egl); "
+        "--berries counts ripe and unripe together, 30%% unripe",
+    )  # fmt: skip
     add_plant_options(p)
     p.add_argument(
         "--gains",
@@ -77,6 +83,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     add_quiet(p)
     p.set_defaults(run=run)
+
+
+#: The share of unripe fruit on a rendered bush (``--world bush``).
+BUSH_UNRIPE_FRACTION = 0.3
 
 
 @drives_arm("harvest")
@@ -93,6 +103,8 @@ def run(args: argparse.Namespace) -> int:
     options = plant_options(args)
     gains = _gains(args)
     if args.sim:
+        if args.world == "bush":
+            options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
             gains=gains, view=args.view, record=args.record, **options,

@@ -34,6 +34,9 @@ class BerryResult:
         duration_s: clock time from IDLE to the end.
         steps: control steps.
         cameras: control steps per berry source (eye_to_hand, eye_in_hand, held).
+        ripe: the berry's true ripeness, where the berries are found without tags
+            (simulation only; None in the tag world).
+        localisation_error_mm: the perceived position against the true one, likewise.
     """
 
     tag_id: int
@@ -49,6 +52,8 @@ class BerryResult:
     duration_s: float = 0.0
     steps: int = 0
     cameras: dict[str, int] = field(default_factory=dict)
+    ripe: bool | None = None
+    localisation_error_mm: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (NaN → null, enums → their values)."""

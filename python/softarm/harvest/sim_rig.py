@@ -30,12 +30,17 @@ from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import ArmPlant
-from softarm.harvest.sim_vision import SimCameras, look_at, sim_vision
+from softarm.harvest.bush_world import BushGripper, BushScene, harvest_bush
+from softarm.harvest.sim_vision import BASE_TAG_ID, SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
-from softarm.harvest.vision_loop import CameraVision
+from softarm.harvest.vision_loop import CameraVision, register_c1
 from softarm.identification.result import IdentifiedPlant
 from softarm.sim.arm import PlantConfig, SimulatedArm
+from softarm.perception.bush_map import BushMap
+from softarm.perception.bush_vision import BushVision
 from softarm.sim.bush import Bush
+from softarm.sim.render.world import world_for
+from softarm.vision import MarkerCube
 from softarm.units import MAX_PSI
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
@@ -74,6 +79,10 @@ class SimRigOptions:
     #: in flight each step takes out of the measured error; the mode's gain) or "bound"
     #: (no model: the gain bounded by the whole lag, `Gains.for_lag`).
     lag_control: str = "predictor"
+    #: "tags": every berry wears an ArUco tag and the canes are mapped (fast, for
+    #: controller sweeps); "bush": the rendered bush, berries and canes found by
+    #: perception (softarm.perception), the markerless harvest.
+    world: str = "tags"
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -115,6 +124,8 @@ class SimRig:
     gripper: SimGripper
     watch: ArmWatch
     machine: HarvestMachine
+    #: The rendered bush and its map (``world = "bush"``), None in the tag world.
+    scene: BushScene | None = None
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
         """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
@@ -123,6 +134,11 @@ class SimRig:
         eye-to-hand camera a berry tag can hide behind another berry's until that one is
         picked. The report keeps each berry's last attempt.
         """
+        if self.scene is not None:
+            report = harvest_bush(
+                self.scene, self.machine.run_berry, self.gripper.delivered, on_berry
+            )
+            return self._finish(report)
         report = HarvestReport()
         order = [b.tag_id for b in self.bush.berries]
         results: dict[int, BerryResult] = {}
@@ -139,6 +155,9 @@ class SimRig:
             if report.stopped is not None:
                 break
         report.berries = [results.get(t, BerryResult(t)) for t in order]
+        return self._finish(report)
+
+    def _finish(self, report: HarvestReport) -> HarvestReport:
         report.extra.update(
             seed=self.bush.seed,
             min_branch_gap_m=self.watch.min_gap,
@@ -177,7 +196,12 @@ def build_sim_rig(
         limits=(np.zeros_like(true_upper), true_upper),
     )  # fmt: skip
     on_bush = list(bush.berries)
-    canes = [b.curve() for b in bush.branches]
+    canes = [b.curve() for b in bush.branches]  # the truth: contacts are scored on it
+    scene = None
+    if o.world == "bush":
+        scene = _bush_scene(bush, plant, cams)
+    elif o.world != "tags":
+        raise ParameterError(f"world = {o.world!r}: must be 'tags' or 'bush'")
     if o.plant.model == "cosserat":  # the rod's centre line, not arcs
         from softarm.sim.cosserat.clearance import RodClearance
 
@@ -189,11 +213,16 @@ def build_sim_rig(
         SimulatedPressureBank(plant, plant.arm.n_actuators), MAX_PSI, 100.0, 0.5, clock.now,
         watchdog_thread=False,
     )  # fmt: skip
-    vision = sim_vision(
-        cams, plant.pose, lambda: on_bush, cfg.grasp_offset,
-        seed=o.seed, hidden=o.hidden,
-    )  # fmt: skip
-    gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    if scene is None:
+        vision = sim_vision(
+            cams, plant.pose, lambda: on_bush, cfg.grasp_offset,
+            seed=o.seed, hidden=o.hidden,
+        )  # fmt: skip
+        gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    else:
+        vision = _bush_vision(scene, cams, cfg.grasp_offset)
+        gripper = BushGripper(scene, plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+        canes = scene.fit_canes()  # the planner, resolver and clearance avoid these
     # The plant's lag, measured by `softarm identify` when given, else declared by the
     # plant description (its regulators' time constant, as a datasheet states it).
     lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
@@ -261,4 +290,24 @@ def build_sim_rig(
             clearance=model_clearance,
         ),
     )
-    return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine)
+    return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine, scene)
+
+
+def _bush_scene(bush: Bush, plant: ArmPlant, cams: SimCameras) -> BushScene:
+    """The rendered bush with the first C1 look merged into its map."""
+    scene = BushScene(world_for(bush, cams, BASE_TAG_ID), BushMap(), bush, plant)
+    scene.look()
+    return scene
+
+
+def _bush_vision(scene: BushScene, cams: SimCameras, grasp_offset: float) -> BushVision:
+    """The markerless vision: the cube and base tag in the rendered C1, the berries
+    from the map and C2 (softarm.perception.bush_vision)."""
+    c1, c2 = scene.frames()
+    m1, m2 = cams.model(1), cams.model(2)
+    T_base_c1 = register_c1(c1, m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag)
+    cube = MarkerCube.standard(cams.cube_marker)
+    return BushVision(
+        c1, c2, m1, m2, T_base_c1, cams.T_ee_c2, cams.T_ee_cube, cube, cams.berry_tag,
+        grasp_offset, bush_map=scene.bush_map,
+    )  # fmt: skip

@@ -113,10 +113,8 @@ class CameraVision:
         """Both cameras at ``time``: ``T_base_ee`` from the cube in C1 (eq. 22), and the
         berry from the fusion of C1 and C2 (eq. 21), or the held fix."""
         T_c1_ee, berry_c1 = self._view_c1(time)
-        img = self.frame2(time)
-        berry_c2 = None
-        if img is not None:
-            berry_c2 = self._tag_position(self.detector.detect(img, self.model2), self.model2)
+        img = self.frame2(time) if self._want_c2(T_c1_ee) else None
+        berry_c2 = None if img is None else self._berry_c2(img, T_c1_ee)
         est = self.fusion.update(time, T_c1_ee, berry_c1, berry_c2)
         fix = None
         if est.target is not None and est.source != "none":
@@ -135,7 +133,7 @@ class CameraVision:
         is an outlier) and the selected berry's tag position in C1 (None if not seen)."""
         dets = self.detector.detect(_frame(self.frame1, time), self.model1)
         est = self.cube.estimate(dets, self.model1, self._cube_prev)
-        berry_c1 = self._tag_position(dets, self.model1)
+        berry_c1 = self._berry_c1(dets)
         if est is None:
             return None, berry_c1
         T_c1_ee = est.T_camera_cube @ invert(self.T_ee_cube)
@@ -153,6 +151,19 @@ class CameraVision:
         self._rejects = 0
         self._last_ee = T_c1_ee
         return False
+
+    def _want_c2(self, T_c1_ee: FloatArray | None) -> bool:
+        """Whether to read C2 this period (always, for tags: they are cheap to find)."""
+        return True
+
+    def _berry_c1(self, dets: list[Detection]) -> FloatArray | None:
+        """The selected berry in C1's frame from C1's marker detections (its tag)."""
+        return self._tag_position(dets, self.model1)
+
+    def _berry_c2(self, image: Any, T_c1_ee: FloatArray | None) -> FloatArray | None:
+        """The selected berry in C2's frame from C2's image (its tag); ``T_c1_ee`` is
+        this period's tracked end effector, for finders that predict where to look."""
+        return self._tag_position(self.detector.detect(image, self.model2), self.model2)
 
     def _tag_position(self, dets: list[Detection], model: CameraModel) -> FloatArray | None:
         for d in dets:

@@ -1,0 +1,152 @@
+"""The markerless harvest in the rendered bush (``--world bush``): the cameras are the
+rendered C1 stereo pair and C2, the berries to pick come from the bush map (ripe ones
+found in C1 without tags), and the canes given to the planner, the resolver and the
+clearance checks are the ones fitted from C1. The true bush serves only the ground
+truth: the gripper's catch, the contacts, and the report's errors.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from softarm.harvest.interfaces import BerryTarget
+from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.sim_devices import SimGripper
+from softarm.perception.bush_map import BushMap
+from softarm.perception.cane_metrics import cane_map_error
+from softarm.perception.canes import fit_canes
+from softarm.perception.stereo import locate_berries
+from softarm.sim.bush import Berry, Bush
+from softarm.sim.plant import ArmPlant
+from softarm.sim.render.world import RenderedBush, arm_sections, polyline_sections
+
+__all__ = ["BushGripper", "BushScene", "draw_arm", "harvest_bush"]
+
+#: A mapped berry is the true berry nearest it within this distance (m), for the
+#: ground truth only.
+TRUTH_MATCH = 0.03
+
+
+def draw_arm(world: RenderedBush, plant: ArmPlant) -> None:
+    """Draw the TRUE arm (the plant's state) in the world: arcs for the constant-
+    curvature plant, the rod's centre line for the Cosserat one."""
+    if hasattr(plant, "centreline"):
+        sections = polyline_sections(
+            plant.centreline(), plant.centreline_sections(), plant.arm.n_sections
+        )
+    else:
+        sections = arm_sections(plant.arm, plant.q())
+    world.set_arm(sections, plant.pose())
+
+
+@dataclass
+class BushScene:
+    """The rendered world, the map perception builds of it, and the true bush."""
+
+    world: RenderedBush
+    bush_map: BushMap
+    bush: Bush
+    plant: ArmPlant
+
+    def look(self) -> int:
+        """One C1 stereo view with the arm where it truly is, merged into the map; the
+        number of berries new to it."""
+        draw_arm(self.world, self.plant)
+        left, right = self.world.c1()
+        return self.bush_map.update(locate_berries(left.colour, right.colour, self.world.stereo))
+
+    def fit_canes(self) -> list:
+        """The canes fitted from one C1 stereo view (the map keeps them)."""
+        draw_arm(self.world, self.plant)
+        left, right = self.world.c1()
+        self.bush_map.canes = fit_canes(left.colour, right.colour, self.world.stereo)
+        return [c.curve for c in self.bush_map.canes]
+
+    def frames(self) -> tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray]]:
+        """C1's left eye and C2 as ``(time) -> image`` with the arm drawn as it is."""
+
+        def c1(t: float) -> np.ndarray:
+            draw_arm(self.world, self.plant)
+            return self.world.c1_left().colour
+
+        def c2(t: float) -> np.ndarray:
+            draw_arm(self.world, self.plant)
+            return self.world.c2_frame().colour
+
+        return c1, c2
+
+    def truth_of(self, berry_id: int) -> Berry | None:
+        """The true berry (still on the bush or not) a map entry stands for, or None."""
+        entry = self.bush_map.get(berry_id)
+        if entry is None:
+            return None
+        near = min(
+            self.bush.berries, key=lambda b: float(np.linalg.norm(b.position - entry.position))
+        )
+        return near if np.linalg.norm(near.position - entry.position) <= TRUTH_MATCH else None
+
+
+class BushGripper(SimGripper):
+    """:class:`SimGripper` whose selected berry is a map entry: it closes on the true
+    berry that entry stands for (ground truth, :meth:`BushScene.truth_of`)."""
+
+    def __init__(self, scene: BushScene, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self.scene = scene
+
+    def _berry(self, tag_id: int) -> Berry | None:
+        truth = self.scene.truth_of(tag_id)
+        return truth if truth is not None and truth in self.on_bush else None
+
+
+def harvest_bush(
+    scene: BushScene,
+    run_berry: Callable[[BerryTarget], BerryResult],
+    delivered: list[int],
+    on_berry: Callable[[int, BerryResult], None] | None = None,
+) -> HarvestReport:
+    """Pick the map's ripe berries one by one, looking again with C1 each time the arm
+    is home (a berry the arm or a picked one hid may come into view), until no ripe
+    berry is left untried."""
+    report = HarvestReport()
+    tried: set[int] = set()
+    for _ in range(len(scene.bush.berries) + 8):
+        scene.look()
+        todo = [b for b in scene.bush_map.ripe() if b.id not in tried]
+        if not todo:
+            break
+        entry = min(todo, key=lambda b: b.position[0])  # left to right
+        tried.add(entry.id)
+        result = run_berry(BerryTarget(entry.id, f"map berry {entry.id}"))
+        truth = scene.truth_of(entry.id)
+        result.ripe = None if truth is None else bool(truth.ripeness >= 0.5)
+        if truth is not None:
+            result.localisation_error_mm = 1000.0 * float(
+                np.linalg.norm(entry.position - truth.position)
+            )
+        report.berries.append(result)
+        if on_berry is not None:
+            on_berry(len(report.berries) - 1, result)
+    report.extra.update(_bush_extra(scene, delivered))
+    return report
+
+
+def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
+    ripe = [b for b in scene.bush.berries if b.ripeness >= 0.5]
+    picked = {b.tag_id: b for b in scene.bush.berries if b.tag_id in delivered}
+    mapped = {t.tag_id for e in scene.bush_map.berries if (t := scene.truth_of(e.id)) is not None}
+    return {
+        "world": "bush",
+        "ripe_in_reach": len(ripe),
+        "ripe_harvested": sum(b.ripeness >= 0.5 for b in picked.values()),
+        "unripe_picked": sum(b.ripeness < 0.5 for b in picked.values()),
+        "ripe_never_mapped": sum(b.tag_id not in mapped for b in ripe),
+        "cane_map": {
+            k: v
+            for k, v in cane_map_error(scene.bush_map.canes, scene.bush.branches).items()
+            if k in ("median_mm", "p95_mm", "coverage")
+        },
+    }

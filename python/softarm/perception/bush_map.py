@@ -1,0 +1,76 @@
+"""The bush map: the berries found so far, ripe ones to pick and unripe ones to leave,
+each with its position in the base frame and how often it was seen, and the canes
+fitted from C1. Built from C1 at IDLE and refreshed each time the arm is home, since the
+arm and the fruit already picked hide parts of the bush."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from softarm.checks import FloatArray
+from softarm.perception.berries import BerryDetection, Ripeness
+
+__all__ = ["BushMap", "MappedBerry"]
+
+
+@dataclass
+class MappedBerry:
+    """One berry of the map: its ``id`` (the map's own, not a tag), mean ``position``
+    (base frame, m) over its ``sightings``, and the ripe share of those sightings."""
+
+    id: int
+    position: FloatArray
+    ripe_votes: float
+    sightings: int = 1
+
+    @property
+    def ripeness(self) -> Ripeness:
+        """Ripe when most sightings said so (the NIR sensor decides at the grasp)."""
+        return "ripe" if self.ripe_votes >= 0.5 * self.sightings else "unripe"
+
+
+@dataclass
+class BushMap:
+    """Berries merged across C1 views: a detection within ``merge_distance`` of a known
+    berry is that berry seen again; a detection without a position is not mapped."""
+
+    merge_distance: float = 0.02
+    berries: list[MappedBerry] = field(default_factory=list)
+    canes: list = field(default_factory=list)
+
+    def update(self, detections: Iterable[BerryDetection]) -> int:
+        """Merge one view's detections (positions in the base frame); the number of
+        berries new to the map."""
+        new = 0
+        for d in detections:
+            if d.position is None:
+                continue
+            vote = d.probability if d.ripeness == "ripe" else 1.0 - d.probability
+            known = self._near(d.position)
+            if known is None:
+                self.berries.append(MappedBerry(len(self.berries), d.position.copy(), vote))
+                new += 1
+            else:
+                n = known.sightings
+                known.position = (known.position * n + d.position) / (n + 1)
+                known.ripe_votes += vote
+                known.sightings = n + 1
+        return new
+
+    def get(self, berry_id: int) -> MappedBerry | None:
+        """The berry of ``berry_id``, or None."""
+        return next((b for b in self.berries if b.id == berry_id), None)
+
+    def ripe(self) -> list[MappedBerry]:
+        """The berries to pick."""
+        return [b for b in self.berries if b.ripeness == "ripe"]
+
+    def _near(self, position: FloatArray) -> MappedBerry | None:
+        if not self.berries:
+            return None
+        gaps = [float(np.linalg.norm(b.position - position)) for b in self.berries]
+        k = int(np.argmin(gaps))
+        return self.berries[k] if gaps[k] <= self.merge_distance else None
