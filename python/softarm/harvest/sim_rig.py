@@ -19,6 +19,7 @@ from softarm.calibration.result import Calibration
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest.actuator import SafeActuator, lead_gain
+from softarm.harvest.bush_world import BushGripper, BushScene, harvest_bush
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
@@ -30,18 +31,17 @@ from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import ArmPlant
-from softarm.harvest.bush_world import BushGripper, BushScene, harvest_bush
 from softarm.harvest.sim_vision import BASE_TAG_ID, SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
 from softarm.harvest.vision_loop import CameraVision, register_c1
 from softarm.identification.result import IdentifiedPlant
-from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.perception.bush_map import BushMap
 from softarm.perception.bush_vision import BushVision
+from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.render.world import world_for
-from softarm.vision import MarkerCube
 from softarm.units import MAX_PSI
+from softarm.vision import MarkerCube
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
 
