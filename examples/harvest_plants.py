@@ -1,5 +1,5 @@
 """Simulated harvests over plants that differ from the controller's model: regulator lag
-and hysteresis (the closed-loop tables of docs/harvest.md).
+and hysteresis (the results table of docs/harvest.md).
 
 Every (plant, seed) is one bush; the table gives, per plant, the share of berries
 harvested, the mean fine-positioning error (ground truth), cane-contact steps and the
@@ -8,6 +8,10 @@ median simulated seconds per berry. Run it on seeds the controller was not tuned
     python examples/harvest_plants.py --tau 0.08 0.3 0.8 1.0 --hysteresis 1.5 5 \
         --seeds 500 501 502 503 504 505 506 507 508 509 --berries 8 --jobs 16 \
         --out out/plants
+
+The table of docs/harvest.md comes from its saved per-bush reports:
+
+    python examples/harvest_plants.py --summarise docs/data/plants_eighth_boundary_fresh680.json
 """
 
 from __future__ import annotations
@@ -122,7 +126,16 @@ def main() -> None:
         action="store_true",
         help="calibrate each plant first and harvest on the fitted model (softarm calibrate)",
     )
+    ap.add_argument(
+        "--summarise",
+        type=Path,
+        metavar="REPORTS",
+        help="print the table of a saved reports.json (e.g. docs/data/plants_*.json); run nothing",
+    )
     args = ap.parse_args()
+    if args.summarise is not None:
+        print_table(summarise(json.loads(args.summarise.read_text(encoding="utf-8"))))
+        return
     args.out.mkdir(parents=True, exist_ok=True)
     trials = [(t, h, s) for t in args.tau for h in args.hysteresis for s in args.seeds]
     with ProcessPoolExecutor(args.jobs) as pool:
@@ -137,6 +150,11 @@ def main() -> None:
             (args.out / "reports.json").write_text(json.dumps(reports, indent=1))
     rows = summarise(reports)
     (args.out / "summary.json").write_text(json.dumps(rows, indent=1))
+    print_table(rows)
+
+
+def print_table(rows: list[dict]) -> None:
+    """The rows of :func:`summarise` as a Markdown table."""
     print(
         "| τ (s) | hysteresis (psi) | berries | harvested | mean fine error (mm) "
         "| contact steps | min gap (mm) | median sim s / berry | wall s / berry |"
