@@ -40,7 +40,7 @@ test-rust:
 
 # The optional extras whose tests run in CI: Ray sweeps, the Cosserat rod, the rerun view,
 # the rendered bush.
-TEST_EXTRAS := test,sweep,cosserat,viz,render
+TEST_EXTRAS := test,sweep,cosserat,viz,render,ros
 
 dev-all: venv
 	$(VENV)/bin/maturin develop --release --extras $(TEST_EXTRAS) -q
