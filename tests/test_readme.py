@@ -77,7 +77,7 @@ def test_softarm_line_parses(
         # The only acceptable failure is an input file that an earlier line of the README
         # writes (`softarm config init hw.toml`, `--log run.jsonl`, `--out id.json`, ...)
         # or one of the repository's own files (the test runs in a scratch folder).
-        missing = re.search(r"'([^']+)' does not exist", err)
+        missing = re.search(r"'([^']+)'(?: does not exist|: no such file)", err)
         assert missing is not None, err
         name = missing.group(1)
         assert name in written_by_readme() or (ROOT / name).is_file(), err
