@@ -24,6 +24,13 @@ from softarm.commands._args import (
 )
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
+from softarm.commands._run_info import (
+    check_bag,
+    hardware_header,
+    sim_header,
+    start_log,
+    write_run_bag,
+)
 from softarm.commands._signals import drives_arm, vents_on_stop
 from softarm.errors import ConfigError, HardwareUnavailableError
 
@@ -69,6 +76,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="save a rerun recording of the run (--sim only; viz extra)",
     )  # fmt: skip
     p.add_argument(
+        "--bag", type=output_file, metavar="RUN.mcap",
+        help="write the run as a ROS 2 bag (rosbag2, MCAP; ros extra; docs/ros.md)",
+    )  # fmt: skip
+    p.add_argument(
         "--world", choices=("tags", "bush"), default="tags",
         help="--sim: 'tags', berries tagged and canes mapped (fast); 'bush', the rendered "
         "bush, berries and canes found by the cameras (render extra, MUJOCO_GL=egl); "
@@ -99,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
     if (args.view or args.record is not None) and not args.sim:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
+    check_bag(args.bag)
     configure_logging(args.quiet)
     options = plant_options(args)
     gains = _gains(args)
@@ -107,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
             options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
-            gains=gains, view=args.view, record=args.record, **options,
+            gains=gains, view=args.view, record=args.record, bag=args.bag, args=args, **options,
         )  # fmt: skip
     return _run_hardware(args)
 
@@ -130,15 +142,22 @@ def run_sim(
     gains: dict[str, Any] | None = None,
     view: bool = False,
     record: Path | None = None,
+    bag: Path | None = None,
+    args: argparse.Namespace | None = None,
     **options: Any,
 ) -> int:
     """The simulated harvest shared by ``harvest --sim`` and ``demo``; ``options`` are
-    more ``SimRigOptions`` (``plant``, ``identified``: see ``commands/_plant.py``)."""
+    more ``SimRigOptions`` (``plant``, ``identified``: see ``commands/_plant.py``). The
+    log and the report open with the run's header (``args``: the parsed command line);
+    ``bag``: the run as a ROS 2 bag."""
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
     if not quiet:
         print(f"simulated harvest: {berries} berries, seed {seed}", flush=True)
-    rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, log_path=log_path, **options))
+    rig_options = SimRigOptions(n_berries=berries, seed=seed, log_path=log_path, **options)
+    rig = build_sim_rig(rig_options)
+    header = sim_header(rig, rig_options, args)
+    start_log(rig.machine.log, header)
     if gains:
         from softarm.sweep.gains_file import apply_gains
 
@@ -150,10 +169,12 @@ def run_sim(
     finally:
         if viewer is not None:
             viewer.close()  # the recording complete, even after a stop
+    report.header = rig.machine.log.records[0]
     print(summary(report.to_dict()))
     if report_path is not None:
         report.save(report_path)
         print(f"report: {report_path}")
+    write_run_bag(rig.machine.log.records, bag)
     if plot_path is not None:
         _plot(rig, report, plot_path)
         print(f"plot: {plot_path}")
@@ -248,6 +269,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         else identified_from_config(config, args.config)
     )
     log = HarvestLog(args.log)
+    start_log(log, hardware_header(config, args))
     try:
         rig = build_hardware_rig(config, log=log, identified=identified)
     except HardwareUnavailableError as exc:
@@ -266,10 +288,12 @@ def _run_hardware(args: argparse.Namespace) -> int:
     finally:
         rig.close()  # vents and releases every device, whatever happened
         log.close()
+    report.header = log.records[0]
     print(summary(report.to_dict()))
     if args.report:
         report.save(args.report)
         print(f"report: {args.report}")
+    write_run_bag(log.records, args.bag)
     return 0 if report.stopped is None else 1
 
 

@@ -36,7 +36,7 @@ GIT_TIMEOUT_S = 2.0
 #: clock in seconds (simulated time with --sim).
 UNITS: dict[str, dict[str, str]] = {
     HEADER: {
-        "started_unix_s": "s since 1970-01-01 UTC",
+        "started_unix_ns": "ns since 1970-01-01 UTC",
         "seed": "-",
         "grasp_offset_m": "m",
         "arm.sections": "radius m, rest_length m, lower m, upper m, offset m, twist rad",
@@ -107,7 +107,7 @@ def header_record(
         "format": FORMAT,
         "softarm": softarm.__version__,
         "commit": git_commit(),
-        "started_unix_s": time.time(),
+        "started_unix_ns": time.time_ns(),
         "command": command,
         "argv": list(argv),
         "options": {k: _plain_option(v) for k, v in options.items() if k != "run"},
@@ -133,10 +133,12 @@ def arm_settings(arm: Any) -> dict[str, Any]:
     return {"sections": rows}
 
 
-def world_settings(bush: Any, unripe_fraction: float) -> dict[str, Any]:
-    """The simulated bush: its seed, canes (cubic coefficients) and berries."""
+def world_settings(bush: Any, unripe_fraction: float, kind: str = "tags") -> dict[str, Any]:
+    """The simulated bush (``kind``: ``--world``): its seed, canes (cubic coefficients)
+    and berries."""
     return {
         "source": "sim",
+        "kind": kind,
         "seed": bush.seed,
         "unripe_fraction": unripe_fraction,
         "canes": [np.asarray(b.coeffs) for b in bush.branches],
@@ -184,7 +186,9 @@ def sim_settings(rig: Any, options: Any) -> dict[str, Any]:
     return {
         "seed": options.seed,
         "berries": options.n_berries,
-        "world": world_settings(rig.bush, options.unripe_fraction),
+        "world": world_settings(
+            rig.bush, options.unripe_fraction, str(getattr(options, "world", "tags"))
+        ),
         "plant": plant,
         "arm": arm_settings(rig.model),
         "grasp_offset_m": options.config.grasp_offset,

@@ -63,11 +63,13 @@ class BerryResult:
 @dataclass
 class HarvestReport:
     """The results of a run, in berry order, and anything the rig adds in ``extra``
-    (seed, minimum branch clearance, ...)."""
+    (seed, minimum branch clearance, ...); ``header``: the run's header record
+    (:mod:`softarm.harvest.header`), which then opens the report."""
 
     berries: list[BerryResult] = field(default_factory=list)
     stopped: FaultReason | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    header: dict[str, Any] | None = None
 
     @property
     def success_rate(self) -> float:
@@ -79,6 +81,7 @@ class HarvestReport:
         return dict(
             _plain(
                 {
+                    **({} if self.header is None else {"header": self.header}),
                     "success_rate": self.success_rate,
                     "harvested": sum(b.harvested for b in self.berries),
                     "attempted": len(self.berries),

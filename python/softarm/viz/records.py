@@ -269,6 +269,15 @@ class RecordLogger:
             )
         self._text(r, "harvest/log", skip=("q",))
 
+    def _header(self, r: Mapping[str, Any]) -> None:
+        """The run's header (softarm.harvest.header) as one line: what made the run."""
+        argv = r.get("argv") if isinstance(r.get("argv"), list) else []
+        text = (
+            f"softarm {r.get('softarm')} (commit {r.get('commit') or 'unknown'}): "
+            f"softarm {' '.join(str(a) for a in argv)}; seed {r.get('seed')}"
+        )
+        self.stream.log("harvest/log", self.rr.TextLog(text, level="INFO"))
+
     def _ripeness(self, r: Mapping[str, Any]) -> None:
         self._text(r, "harvest/log")
 
@@ -324,4 +333,5 @@ _HANDLERS: dict[str, Callable[[RecordLogger, Mapping[str, Any]], None]] = {
     "plan": RecordLogger._plan,
     "ripeness": RecordLogger._ripeness,
     "berry_result": RecordLogger._berry_result,
+    "header": RecordLogger._header,
 }

@@ -73,7 +73,7 @@ class RunScene:
             canes=[_cane(c) for c in world.get("canes", [])],
             berries=[_berry(b) for b in world.get("berries", [])],
             pressure=_pressure(header.get("pressure_map")),
-            start_ns=round(float(header.get("started_unix_s", 0.0)) * 1e9),
+            start_ns=_start(header.get("started_unix_ns", 0)),
             source=str(world.get("source", "sim")),
         )
 
@@ -139,3 +139,10 @@ def _pressure(value: Any) -> tuple[float, FloatArray, FloatArray]:
     if not np.all(mpp > 0):
         raise InputError("header pressure_map.metres_per_psi must be positive")
     return float(value.get("max_psi", MAX_PSI)), mpp, offset
+
+
+def _start(value: Any) -> int:
+    """The header's start time: a non-negative integer of ns since the epoch."""
+    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+        raise InputError(f"header started_unix_ns must be a non-negative integer, got {value!r}")
+    return value

@@ -1,0 +1,60 @@
+"""The run's header record (:mod:`softarm.harvest.header`) and its ROS 2 bag, for the
+commands that run a harvest (``harvest``, ``demo``): the header opens the log and the
+report; the bag (``--bag``) is written from the log's records once the run ends."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+__all__ = ["check_bag", "hardware_header", "sim_header", "start_log", "write_run_bag"]
+
+
+def check_bag(path: Path | None) -> None:
+    """Before any work: a ``--bag`` path must be a .mcap file name and the ``ros`` extra
+    installed (a one-line error naming the extra)."""
+    if path is not None:
+        from softarm.viz.bag import check_bag_path
+
+        check_bag_path(path)
+
+
+def _invocation(args: argparse.Namespace | None, command: str) -> dict[str, Any]:
+    options = {} if args is None else vars(args)
+    return {"command": options.get("command", command), "argv": sys.argv[1:], "options": options}
+
+
+def sim_header(
+    rig: Any, rig_options: Any, args: argparse.Namespace | None = None, command: str = "harvest"
+) -> dict[str, Any]:
+    """The header of a simulated run: the invocation and the rig's settings."""
+    from softarm.harvest.header import header_record, sim_settings
+
+    return header_record(**_invocation(args, command), **sim_settings(rig, rig_options))
+
+
+def hardware_header(config: Any, args: argparse.Namespace) -> dict[str, Any]:
+    """The header of a hardware run on ``config`` (from ``args.config``)."""
+    from softarm.harvest.header import hardware_settings, header_record
+
+    return header_record(**_invocation(args, "harvest"), **hardware_settings(config, args.config))
+
+
+def start_log(log: Any, header: Mapping[str, Any]) -> None:
+    """Open the run's log (a ``HarvestLog``) with its header record."""
+    from softarm.harvest.header import HEADER
+
+    log.event(HEADER, **header)
+
+
+def write_run_bag(records: list[Any], path: Path | None) -> None:
+    """Write the run's records to the MCAP bag ``path`` (nothing when None)."""
+    if path is None:
+        return
+    from softarm.viz.bag import write_bag
+
+    summary = write_bag(records, path)
+    print(f"bag: {path} ({summary.messages} messages on {len(summary.counts)} topics)")
