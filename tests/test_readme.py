@@ -1,7 +1,8 @@
 """The README cannot drift from the code: every ```python block runs as pasted, every
 `softarm ...` line of a ```sh block parses with the real command-line parser, every
 `make X` names a Makefile target, and every optional extra of pyproject.toml is
-documented."""
+documented. The `softarm` and `make` lines of docs/getting-started.md are checked the
+same way."""
 
 from __future__ import annotations
 
@@ -19,14 +20,17 @@ README = (ROOT / "README.md").read_text(encoding="utf-8")
 BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.DOTALL | re.MULTILINE)
 
 
-def blocks(language: str) -> list[str]:
-    return [body for lang, body in BLOCK.findall(README) if lang == language]
+GETTING_STARTED = (ROOT / "docs" / "getting-started.md").read_text(encoding="utf-8")
 
 
-def commands(program: str) -> list[str]:
+def blocks(language: str, text: str = README) -> list[str]:
+    return [body for lang, body in BLOCK.findall(text) if lang == language]
+
+
+def commands(program: str, text: str = README) -> list[str]:
     """Lines of the sh blocks that run ``program``, without their comments."""
     found = []
-    for body in blocks("sh"):
+    for body in blocks("sh", text):
         for line in body.splitlines():
             words = shlex.split(line, comments=True)
             if words[:1] == [program]:
@@ -35,9 +39,10 @@ def commands(program: str) -> list[str]:
 
 
 def written_by_readme() -> set[str]:
-    """Files that a README line writes: the argument of an output option or `config init`."""
+    """Files that a README (or getting-started) line writes: the argument of an output
+    option or `config init`."""
     out: set[str] = set()
-    for words in commands("softarm"):
+    for words in commands("softarm") + commands("softarm", GETTING_STARTED):
         for i, word in enumerate(words[:-1]):
             if word in ("--out", "--log", "--record", "--report", "init"):
                 out.add(words[i + 1])
@@ -55,7 +60,9 @@ def test_python_block_runs(index: int, tmp_path: Path, monkeypatch: pytest.Monke
     exec(compile(code, f"README.md python block {index}", "exec"), {"__name__": "__readme__"})
 
 
-@pytest.mark.parametrize("words", commands("softarm"), ids=" ".join)
+@pytest.mark.parametrize(
+    "words", commands("softarm") + commands("softarm", GETTING_STARTED), ids=" ".join
+)
 def test_softarm_line_parses(
     words: list[str],
     capsys: pytest.CaptureFixture[str],
@@ -88,7 +95,7 @@ def test_softarm_line_parses(
 def test_make_targets_exist() -> None:
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     targets = set(re.findall(r"(?m)^([\w-]+):", makefile))
-    for words in commands("make"):
+    for words in commands("make") + commands("make", GETTING_STARTED):
         assert words[1] in targets, f"make {words[1]}: no such target"
 
 
