@@ -10,7 +10,14 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-__all__ = ["check_bag", "hardware_header", "sim_header", "start_log", "write_run_bag"]
+__all__ = [
+    "check_bag",
+    "hardware_header",
+    "sim_header",
+    "start_log",
+    "write_log_bag",
+    "write_run_bag",
+]
 
 
 def check_bag(path: Path | None) -> None:
@@ -58,3 +65,17 @@ def write_run_bag(records: list[Any], path: Path | None) -> None:
 
     summary = write_bag(records, path)
     print(f"bag: {path} ({summary.messages} messages on {len(summary.counts)} topics)")
+
+
+def write_log_bag(log: Path, path: Path | None) -> None:
+    """Write the records of the run log ``log`` to the MCAP bag ``path`` (nothing when
+    None); a malformed record is an InputError naming the file and the record."""
+    if path is None:
+        return
+    from softarm.errors import InputError
+    from softarm.harvest.log import read_log
+
+    try:
+        write_run_bag(list(read_log(log)), path)
+    except InputError as exc:
+        raise type(exc)(f"{log}: {exc}") from None

@@ -1,10 +1,12 @@
-"""``softarm replay``: turn a harvest run log into a rerun recording (the ``viz`` extra)."""
+"""``softarm replay``: turn a harvest run log into a rerun recording (the ``viz`` extra)
+and/or a ROS 2 bag (``--bag``, the ``ros`` extra)."""
 
 from __future__ import annotations
 
 import argparse
 
 from softarm.commands._args import data_file, int_range, non_negative_int, output_file
+from softarm.commands._run_info import check_bag, write_log_bag
 from softarm.commands.harvest import MAX_BERRIES
 
 
@@ -16,11 +18,17 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         description="Replay the JSON-lines log of `softarm harvest --log run.jsonl` in rerun: "
         "the state machine, the commanded arm (drawn on the nominal model), the measured "
         "end-effector pose, the berry estimates and the errors on the run's own time. "
-        "Without --record the rerun viewer is started. Needs the viz extra: "
-        "pip install 'softarm[viz]'. Exit status 0, or 2 for a bad log or a missing extra.",
+        "Without --record or --bag the rerun viewer is started. Needs the viz extra: "
+        "pip install 'softarm[viz]'; --bag alone needs only the ros extra: "
+        "pip install 'softarm[ros]'. The log's header record gives the arm, the bush and "
+        "the cameras. Exit status 0, or 2 for a bad log or a missing extra.",
     )
     p.add_argument("log", type=data_file, help="run log written by `softarm harvest --log`")
     p.add_argument("--record", type=output_file, metavar="OUT.rrd", help="save the recording")
+    p.add_argument(
+        "--bag", type=output_file, metavar="RUN.mcap",
+        help="write the log as a ROS 2 bag (rosbag2, MCAP; ros extra; docs/ros.md)",
+    )  # fmt: skip
     p.add_argument(
         "--view",
         action="store_true",
@@ -31,7 +39,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         type=non_negative_int,
         metavar="SEED",
         help="draw the simulated bush of `harvest --sim --seed SEED` (canes, true berries); "
-        "checked against the log's berries",
+        "checked against the log's berries (for a log without a header record)",
     )
     p.add_argument(
         "--berries",
@@ -43,9 +51,16 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def run(args: argparse.Namespace) -> int:
-    """Write the recording; returns 0."""
+    """Write the bag and/or the recording; returns 0."""
+    check_bag(args.bag)
+    if args.bag is not None and not args.view and args.record is None:
+        write_log_bag(args.log, args.bag)
+        return 0
     from softarm.viz.replay import replay
+    from softarm.viz.rerun_sdk import require_rerun
 
+    require_rerun()  # before the bag is written
+    write_log_bag(args.log, args.bag)
     scene = None if args.sim_seed is None else (args.sim_seed, args.berries)
     n = replay(args.log, args.record, spawn=args.view or args.record is None, scene=scene)
     where = f"recording: {args.record}" if args.record is not None else "sent to the viewer"

@@ -10,7 +10,9 @@ from typing import Any
 import numpy as np
 
 from softarm.errors import InputError
+from softarm.harvest.header import find_header
 from softarm.harvest.log import read_log
+from softarm.viz.bag.scene import RunScene
 from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import RecordLogger
 from softarm.viz.rerun_sdk import close_recording, open_recording, require_rerun
@@ -34,10 +36,11 @@ def replay(
 ) -> int:
     """Log every record of ``log`` to ``record`` (.rrd), a spawned viewer, or both;
     returns the number of records. ``model``: the arm the run controlled (default the
-    nominal blackberry arm), on which the commanded elongations are drawn. ``scene`` =
-    (seed, berries) of a ``harvest --sim`` run: its bush is rebuilt and drawn (the canes
-    and the true berries at ``world/bush``), after checking that the log's berries are
-    that bush's.
+    header's arm, else the nominal blackberry arm), on which the commanded elongations
+    are drawn. The bush of a simulated run is drawn (the canes and the true berries at
+    ``world/bush``) from the log's header record (:mod:`softarm.harvest.header`); for an
+    older log without one, ``scene`` = (seed, berries) of its ``harvest --sim`` run
+    rebuilds it, after checking that the log's berries are that bush's.
 
     Raises:
         InputError: a line is not JSON, a record is malformed (the message names the
@@ -48,15 +51,17 @@ def replay(
     path = Path(log)
     records = _read(path)
     bush = None if scene is None else _bush(path, records, *scene)
+    header = _header_scene(path, records)
     if model is None:
-        import softarm
-
-        model = softarm.SoftArm.blackberry()
+        model = header.arm
     stream = open_recording(f"replay {path.name}", record, spawn, harvest_blueprint(False))
     try:
         if bush is not None:
             log_canes(stream, rr, bush.branches)
             log_berries(stream, rr, "world/bush/berries", bush.berries, static=True)
+        elif header.berries:
+            log_canes(stream, rr, header.branches)
+            log_berries(stream, rr, "world/bush/berries", header.berries, static=True)
         logger = RecordLogger(stream, rr, model, grasp_offset, berries_from_results=True)
         for n, rec in enumerate(records, start=1):
             try:
@@ -71,6 +76,14 @@ def replay(
 def _read(path: Path) -> list[Any]:
     """Every record of the log (read_log names a malformed line in an InputError)."""
     return list(read_log(path))
+
+
+def _header_scene(path: Path, records: list[Any]) -> RunScene:
+    """The arm and the bush the log's header describes (the defaults without one)."""
+    try:
+        return RunScene.from_header(find_header(records))
+    except InputError as exc:
+        raise type(exc)(f"{path}: {exc}") from None
 
 
 def _bush(path: Path, records: list[Any], seed: int, berries: int) -> Any:

@@ -15,6 +15,7 @@ import numpy.typing as npt
 import softarm
 from softarm.errors import InputError
 from softarm.harvest.header import FORMAT
+from softarm.sim.bush import Branch
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.viz.records import as_pose, as_vector
 
@@ -44,7 +45,8 @@ class RunScene:
     frames: dict[str, tuple[str, FloatArray]] = field(default_factory=dict)
     #: name -> {"width", "height", "K", "D"}.
     cameras: dict[str, Mapping[str, Any]] = field(default_factory=dict)
-    canes: list[FloatArray] = field(default_factory=list)
+    #: The canes (``softarm.sim.bush.Branch``: cubic coefficients).
+    branches: list[Branch] = field(default_factory=list)
     berries: list[BerryMark] = field(default_factory=list)
     #: (max_psi, metres_per_psi per actuator, offset per actuator in m).
     pressure: tuple[float, FloatArray, FloatArray] = (
@@ -65,12 +67,14 @@ class RunScene:
         if header.get("format") != FORMAT:
             raise InputError(f"header format must be {FORMAT}, got {header.get('format')!r}")
         world = header.get("world") or {}
+        if not isinstance(world, Mapping):
+            raise InputError(f"header world must be an object, got {world!r:.60}")
         return cls(
             arm=_arm(header.get("arm")),
             grasp_offset=float(header.get("grasp_offset_m", 0.03)),
             frames={k: _frame(k, v) for k, v in (header.get("frames") or {}).items()},
             cameras=dict(header.get("cameras") or {}),
-            canes=[_cane(c) for c in world.get("canes", [])],
+            branches=[_cane(c) for c in world.get("canes", [])],
             berries=[_berry(b) for b in world.get("berries", [])],
             pressure=_pressure(header.get("pressure_map")),
             start_ns=_start(header.get("started_unix_ns", 0)),
@@ -93,6 +97,11 @@ class RunScene:
             cameras={"camera_c1": camera(cams.model(1)), "camera_c2": camera(cams.model(2))},
         )
 
+    @property
+    def canes(self) -> list[FloatArray]:
+        """Each cane as (CANE_SAMPLES, 3) points (m, base frame)."""
+        return [b.points(CANE_SAMPLES) for b in self.branches]
+
     def pressures(self, q: FloatArray) -> FloatArray:
         """The pressures (psi) the actuators were sent for elongations ``q`` (m)."""
         max_psi, mpp, offset = self.pressure
@@ -114,12 +123,14 @@ def _frame(name: str, value: Any) -> tuple[str, FloatArray]:
     return value["parent"], as_pose(value.get("pose"), f"header frames.{name}.pose")
 
 
-def _cane(coeffs: Any) -> FloatArray:
-    c = np.asarray(coeffs, dtype=np.float64)
+def _cane(coeffs: Any) -> Branch:
+    try:
+        c = np.asarray(coeffs, dtype=np.float64)
+    except (TypeError, ValueError):
+        c = np.zeros(0)
     if c.ndim != 2 or c.shape[0] != 3 or not np.all(np.isfinite(c)):
         raise InputError(f"header world.canes: each cane must be 3 x k coefficients, got {c.shape}")
-    u = np.linspace(0.0, 1.0, CANE_SAMPLES)
-    return (c @ np.vander(u, c.shape[1], increasing=True).T).T
+    return Branch(c)
 
 
 def _berry(value: Any) -> BerryMark:
