@@ -22,6 +22,7 @@ from softarm.perception.stereo import locate_berries
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.plant import ArmPlant
 from softarm.sim.render.world import RenderedBush, arm_sections, polyline_sections
+from softarm.vision.poses import invert
 
 __all__ = ["BushGripper", "BushScene", "draw_arm", "harvest_bush"]
 
@@ -69,14 +70,29 @@ class BushScene:
         """C1's left eye and C2 as ``(time) -> image`` with the arm drawn as it is."""
 
         def c1(t: float) -> np.ndarray:
+            # The window around the cube (where it truly is, as the tag world's
+            # render_crop does); the cube is all the tracking looks for in C1.
             draw_arm(self.world, self.plant)
-            return self.world.c1_left().colour
+            return self.world.c1_left_window(self._cube_pixel())
 
         def c2(t: float) -> np.ndarray:
             draw_arm(self.world, self.plant)
             return self.world.c2_frame().colour
 
         return c1, c2
+
+    def c1_whole(self, t: float) -> np.ndarray:
+        """C1's whole left image with the arm as it is (registration finds the base tag
+        in it)."""
+        draw_arm(self.world, self.plant)
+        return self.world.c1_left().colour
+
+    def _cube_pixel(self) -> tuple[float, float]:
+        stereo = self.world.stereo
+        cube = self.plant.pose() @ self.world.T_ee_cube
+        p = invert(stereo.T_base_left) @ cube[:, 3]
+        u, v = stereo.left.project(p[None, :3])[0]
+        return float(u), float(v)
 
     def truth_of(self, berry_id: int) -> Berry | None:
         """The true berry (still on the bush or not) a map entry stands for, or None."""

@@ -293,9 +293,16 @@ def build_sim_rig(
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine, scene)
 
 
+#: C2's image in the rendered bush is rendered at half size (320 x 240): the berry
+#: fills much of it in the last centimetres, and the software rasteriser's cost goes
+#: with the pixels.
+C2_SCALE = 0.5
+
+
 def _bush_scene(bush: Bush, plant: ArmPlant, cams: SimCameras) -> BushScene:
     """The rendered bush with the first C1 look merged into its map."""
-    scene = BushScene(world_for(bush, cams, BASE_TAG_ID), BushMap(), bush, plant)
+    world = world_for(bush, cams, BASE_TAG_ID, c2_scale=C2_SCALE)
+    scene = BushScene(world, BushMap(), bush, plant)
     scene.look()
     return scene
 
@@ -304,8 +311,8 @@ def _bush_vision(scene: BushScene, cams: SimCameras, grasp_offset: float) -> Bus
     """The markerless vision: the cube and base tag in the rendered C1, the berries
     from the map and C2 (softarm.perception.bush_vision)."""
     c1, c2 = scene.frames()
-    m1, m2 = cams.model(1), cams.model(2)
-    T_base_c1 = register_c1(c1, m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag)
+    m1, m2 = cams.model(1), scene.world.c2
+    T_base_c1 = register_c1(scene.c1_whole, m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag)
     cube = MarkerCube.standard(cams.cube_marker)
     return BushVision(
         c1, c2, m1, m2, T_base_c1, cams.T_ee_c2, cams.T_ee_cube, cube, cams.berry_tag,

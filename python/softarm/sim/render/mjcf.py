@@ -136,11 +136,14 @@ def _capsule(name: str, a: FloatArray, b: FloatArray, radius: float, rgba: str) 
 
 
 def _background(look: BushLook) -> str:
-    """A wall behind the bush and the ground below it."""
+    """A wall behind the bush and the ground below it (MuJoCo planes)."""
     wall, ground = _rgba(look.background_colour), _rgba(look.ground_colour)
+    facing = _quat(np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]]))  # normal -y
     return (
-        f'<geom name="bg_wall" type="box" size="12 0.01 6" pos="0 1.4 0.3" rgba="{wall}"/>'
-        f'<geom name="bg_ground" type="box" size="12 12 0.01" pos="0 0.5 -0.45" rgba="{ground}"/>'
+        f'<geom name="bg_wall" type="plane" size="12 6 0.1" pos="0 1.4 0.3" '
+        f'quat="{facing}" rgba="{wall}"/>'
+        f'<geom name="bg_ground" type="plane" size="12 12 0.1" pos="0 0.5 -0.45" '
+        f'rgba="{ground}"/>'
     )
 
 
@@ -209,8 +212,9 @@ def _clutter(look: BushLook, rng: np.random.Generator) -> str:
     """Dark look-alikes: black mulch and dead leaves on the ground, a black irrigation
     line, dark stones in front of the wall."""
     out = [
-        _capsule("clutter_line", np.array([-1.0, 0.75, -0.2]), np.array([1.0, 0.75, -0.2]),
+        _capsule(f"clutter_line{k}", np.array([x, 0.75, -0.2]), np.array([x + 0.25, 0.75, -0.2]),
                  0.008, _rgba(np.array([0.05, 0.05, 0.05])))
+        for k, x in enumerate(np.arange(-1.0, 1.0, 0.25))
     ]  # fmt: skip
     for k in range(look.clutter):
         pos = np.array([rng.uniform(-0.6, 0.6), rng.uniform(0.55, 1.3), rng.uniform(-0.44, 0.6)])
@@ -234,8 +238,8 @@ def _near_segment(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
 
 
 def _camera(cam: CameraSpec) -> str:
-    """A camera from OpenCV intrinsics. MuJoCo takes the principal point as an offset from
-    the image centre (y up); OpenCV's is measured from the top-left pixel's centre."""
+    """A camera from OpenCV intrinsics. MuJoCo takes the principal point as the offset of
+    the image centre from it; OpenCV's is measured from the top-left pixel's centre."""
     w, h = cam.size
     dx = cam.principal[0] - (w - 1) / 2
     dy = cam.principal[1] - (h - 1) / 2
@@ -243,7 +247,7 @@ def _camera(cam: CameraSpec) -> str:
     return (
         f'<camera name="{cam.name}" pos="{_v(cam.T_parent_camera[:3, 3])}" quat="{_quat(R)}" '
         f'resolution="{w} {h}" sensorsize="{w * 1e-6:.6g} {h * 1e-6:.6g}" '
-        f'focalpixel="{cam.focal:.6g} {cam.focal:.6g}" principalpixel="{-dx:.6g} {dy:.6g}"/>'
+        f'focalpixel="{cam.focal:.6g} {cam.focal:.6g}" principalpixel="{-dx:.6g} {-dy:.6g}"/>'
     )
 
 

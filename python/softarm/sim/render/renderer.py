@@ -29,6 +29,8 @@ from softarm.sim.render.mjcf import (
 )
 from softarm.sim.render.mjcf import z_to as _z_to
 
+#: The sensor pixel pitch (m) the scene's cameras are declared with (mjcf._camera).
+PIXEL = 1e-6
 #: The geom group of everything that can hide a berry (leaves, canes, clutter, the arm).
 OCCLUDER_GROUP = 2
 
@@ -159,6 +161,33 @@ class BushRenderer:
         if d is not None and s is not None:
             d[s < 0] = np.nan
         return RenderedFrame(colour, d, s)
+
+    def render_window(self, camera: str, origin: tuple[int, int], side: int) -> np.ndarray:
+        """Colour (side, side, 3) BGR of the ``side``-pixel square of ``camera``'s pinhole
+        image whose top-left pixel is ``origin`` (x0, y0), which may reach past the frame:
+        the camera's principal point is moved for one render, so only the window's
+        pixels are drawn (a software rasteriser's cost goes with them)."""
+        mj, m = self._mj, self.model
+        spec = self.cameras[camera]
+        cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
+        saved = (m.cam_resolution[cam].copy(), m.cam_sensorsize[cam].copy(),
+                 m.cam_intrinsic[cam].copy())  # fmt: skip
+        centre = (side - 1) / 2
+        # MuJoCo takes the principal point as an offset of the image centre from it.
+        px = centre - (spec.principal[0] - origin[0])
+        py = centre - (spec.principal[1] - origin[1])
+        m.cam_resolution[cam] = (side, side)
+        m.cam_sensorsize[cam] = (side * PIXEL, side * PIXEL)
+        m.cam_intrinsic[cam] = (spec.focal * PIXEL, spec.focal * PIXEL, px * PIXEL, py * PIXEL)
+        try:
+            mj.mj_kinematics(m, self.data)
+            mj.mj_camlight(m, self.data)
+            window = CameraSpec(camera, spec.T_parent_camera, (side, side), spec.focal, (0, 0))
+            r = self._renderer(window)
+            r.update_scene(self.data, camera=camera)
+            return np.ascontiguousarray(r.render()[..., ::-1])
+        finally:
+            m.cam_resolution[cam], m.cam_sensorsize[cam], m.cam_intrinsic[cam] = saved
 
     def close(self) -> None:
         """Free the OpenGL contexts."""

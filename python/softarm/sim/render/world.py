@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+import cv2
 import numpy as np
 
 from softarm._core import SoftArm
@@ -24,11 +25,16 @@ from softarm.sim.render.look import BushLook
 from softarm.sim.render.mjcf import ARM_SEGMENTS_PER_SECTION, CameraSpec, SceneSpec
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.crop import ImageCrop
 
 __all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
 
 #: The ZED2's stereo baseline (m).
 ZED2_BASELINE = 0.12
+#: Side (px) of the C1 window rendered around the marker cube while tracking it; the
+#: pinhole window rendered for it is WINDOW_MARGIN px larger (the distortion's shift).
+WINDOW = 256
+WINDOW_MARGIN = 24
 
 
 def arm_sections(arm: SoftArm, q: FloatArray) -> list[FloatArray]:
@@ -131,6 +137,29 @@ class RenderedBush:
         """C1's left eye alone (the cube tracking needs one eye)."""
         return self._frame("c1_left", "c1", truth)
 
+    def c1_left_window(self, centre: tuple[float, float], side: int = WINDOW) -> ImageCrop:
+        """The ``side``-pixel square of C1's left eye around ``centre`` (px, clamped into
+        the frame), with lens distortion, as an :class:`ImageCrop` that detectors read in
+        full-frame coordinates. Only the pinhole pixels the window needs are rendered
+        (:meth:`BushRenderer.render_window`); they equal the full frame's."""
+        w, h = self.stereo.left.image_size or (0, 0)
+        x0 = int(np.clip(round(centre[0] - side / 2), 0, max(w - side, 0)))
+        y0 = int(np.clip(round(centre[1] - side / 2), 0, max(h - side, 0)))
+        d = self._distort["c1"]
+        mx = d.map_x[y0 : y0 + side, x0 : x0 + side]
+        my = d.map_y[y0 : y0 + side, x0 : x0 + side]
+        px0, py0 = int(np.floor(mx.min())) - 2, int(np.floor(my.min())) - 2
+        span = side + WINDOW_MARGIN
+        if mx.max() - px0 >= span - 2 or my.max() - py0 >= span - 2:  # strong distortion
+            return ImageCrop(
+                self.c1_left().colour[y0 : y0 + side, x0 : x0 + side], (x0, y0), (w, h)
+            )
+        pin = self.renderer.render_window("c1_left", (px0, py0), span)
+        colour = cv2.remap(
+            pin, mx - px0, my - py0, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+        )
+        return ImageCrop(colour, (x0, y0), (w, h))
+
     def c2_frame(self, truth: bool = False) -> RenderedFrame:
         """C2's image from where the arm is drawn."""
         return self._frame("c2", "c2", truth)
@@ -169,12 +198,26 @@ def _approach_lines(bush: Bush) -> list[tuple[FloatArray, FloatArray]]:
 
 
 def world_for(
-    bush: Bush, cams: Any, base_tag_id: int, look: BushLook | None = None
+    bush: Bush, cams: Any, base_tag_id: int, look: BushLook | None = None, c2_scale: float = 1.0
 ) -> RenderedBush:
     """The rendered world of ``bush`` seen by the simulated rig's cameras ``cams`` (a
     ``softarm.harvest.sim_vision.SimCameras``: C1's left eye where the tag world's
-    eye-to-hand camera is)."""
+    eye-to-hand camera is); ``c2_scale`` shrinks C2's image and focal length."""
     return RenderedBush(
-        bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2, cams.T_ee_cube,
+        bush, cams.T_base_c1, cams.model(1), scaled(cams.model(2), c2_scale), cams.T_ee_c2,
+        cams.T_ee_cube,
         cams.T_base_tag, base_tag_id, cams.base_tag, cams.cube_marker, look,
     )  # fmt: skip
+
+
+def scaled(camera: CameraModel, scale: float) -> CameraModel:
+    """``camera`` with its image and focal length scaled by ``scale`` (same field of
+    view, same distortion)."""
+    if scale == 1.0:
+        return camera
+    w, h = camera.image_size or (0, 0)
+    size = (round(w * scale), round(h * scale))
+    K = camera.matrix.copy()
+    K[:2] *= scale
+    K[0, 2], K[1, 2] = (size[0] - 1) / 2, (size[1] - 1) / 2
+    return CameraModel(K, camera.distortion, size)
