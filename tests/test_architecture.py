@@ -132,7 +132,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "viz/arm.py": _HARVEST_UP,
     "viz/gripper.py": _HARVEST_UP,
     "harvest": (*_TOP, "softarm.planning", "softarm.viz.records", "softarm.viz.replay",
-                "softarm.viz.sim_view", "softarm.viz.layout", "softarm.viz.scene"),
+                "softarm.viz.sim_view", "softarm.viz.layout", "softarm.viz.scene",
+                "softarm.viz.bag"),
 }  # fmt: skip
 #: What a leaf module may import of softarm (softarm.files is itself a leaf over errors).
 LEAF_MAY = ("softarm.errors", "softarm._core", "softarm.files")

@@ -30,8 +30,11 @@ def check_bag(path: Path | None) -> None:
 
 
 def _invocation(args: argparse.Namespace | None, command: str) -> dict[str, Any]:
-    options = {} if args is None else vars(args)
-    return {"command": options.get("command", command), "argv": sys.argv[1:], "options": options}
+    """The command, its arguments as typed (``softarm.cli.main`` keeps them in
+    ``args.argv``) and as parsed."""
+    options = {} if args is None else {k: v for k, v in vars(args).items() if k != "argv"}
+    argv = sys.argv[1:] if args is None else getattr(args, "argv", sys.argv[1:])
+    return {"command": options.get("command", command), "argv": argv, "options": options}
 
 
 def sim_header(

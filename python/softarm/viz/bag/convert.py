@@ -120,7 +120,7 @@ class Converter:
                 yield from self._flush()
             self.t = max(self.t, t)
         if r["kind"] == "step":
-            self._pending = (self.t, r)
+            self._pending = (self.t, self._checked_step(r))
             return
         if r["kind"] == HEADER:
             return
@@ -132,12 +132,21 @@ class Converter:
             self._pending = None
             yield from self._step(self.ns(t), r)
 
+    def _checked_step(self, r: Mapping[str, Any]) -> dict[str, Any]:
+        """A step with its vectors checked (an error names this record, not the next)."""
+        out = dict(r)
+        for key, length in (("target", 3), ("goal", 3), ("q", self.scene.arm.n_actuators)):
+            if r.get(key) is not None:
+                out[key] = as_vector(r[key], key, length)
+        if r.get("pose") is not None:
+            out["pose"] = as_pose(r["pose"], "pose")
+        return out
+
     def _step(self, ns: int, r: Mapping[str, Any]) -> Iterator[Message]:
         m, d = self.m, self.draw
         if r.get("q") is not None:
-            d.q = as_vector(r["q"], "q", self.scene.arm.n_actuators)
-        d.estimate = None if r.get("target") is None else as_vector(r["target"], "target", 3)
-        d.goal = None if r.get("goal") is None else as_vector(r["goal"], "goal", 3)
+            d.q = r["q"]
+        d.estimate, d.goal = r.get("target"), r.get("goal")
         if d.q is not None:
             yield Message("/tf", ns, m.tf(self._arm_transforms(ns, d.q, r.get("pose"))))
             yield Message("/joint_states", ns, m.joint_state(ns, self.names, d.q))
@@ -160,15 +169,15 @@ class Converter:
             for i in range(len(frames) - 1)
         ]
         if measured is not None:
-            out.append(self.m.transform(ns, "base", "gripper_measured", as_pose(measured, "pose")))
+            out.append(self.m.transform(ns, "base", "gripper_measured", measured))
         return out
 
     def _diagnostics(self, ns: int, r: Mapping[str, Any]) -> Any:
         state = str(r.get("state"))
         level = "ERROR" if state == "fault" else "WARN" if r.get("saturated") else "OK"
         values = [
-            (key, _text(r.get(field), scale))
-            for key, field, scale in (
+            (key, _text(r.get(name), scale))
+            for key, name, scale in (
                 ("berry", "berry", None),
                 ("camera", "camera", None),
                 ("position_error_mm", "position_error", 1e3),
