@@ -10,7 +10,7 @@ export MPLBACKEND ?= Agg
 # Offscreen OpenGL for the rendered bush (MuJoCo): EGL, Mesa's software rasteriser without a GPU.
 export MUJOCO_GL ?= egl
 
-.PHONY: help venv dev dev-all install docs test test-rust test-python demo lint fmt bench clean
+.PHONY: help venv dev dev-all install docs docs-site test test-rust test-python demo lint fmt bench clean
 
 help:
 	@echo "make demo   - simulated harvest with plots (no hardware, no test tools)"
@@ -18,6 +18,7 @@ help:
 	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
 	@echo "make bench  - criterion and pytest-benchmark"
 	@echo "make docs   - regenerate the generated docs (docs/planning.md, docs/experiments.md and their figures)"
+	@echo "make docs-site - the documentation site with its API reference, into site/ (the docs extra)"
 
 $(VENV)/.stamp: pyproject.toml
 	python3 -m venv $(VENV)
@@ -56,6 +57,12 @@ test: dev-all test-rust
 docs: dev
 	$(PY) -m softarm.planning.report --out docs/planning.md
 	$(VENV)/bin/softarm experiment all --out docs/experiments --report docs/experiments.md -q
+
+# The documentation site (mkdocs.yml): the manual pages and an API reference from the
+# docstrings and softarm/_core.pyi, built strict (a warning fails it) into site/.
+docs-site: venv
+	$(VENV)/bin/maturin develop --release --extras docs -q
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
 
 demo: install
 	$(VENV)/bin/softarm demo
