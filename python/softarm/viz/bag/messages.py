@@ -36,11 +36,11 @@ class Messages:
     def header(self, ns: int, frame: str) -> Any:
         return self.new("std_msgs/msg/Header", stamp=self.time(ns), frame_id=frame)
 
-    def point(self, xyz: Sequence[float]) -> Any:
+    def point(self, xyz: Iterable[float]) -> Any:
         x, y, z = (float(v) for v in xyz)
         return self.new("geometry_msgs/msg/Point", x=x, y=y, z=z)
 
-    def vector(self, xyz: Sequence[float]) -> Any:
+    def vector(self, xyz: Iterable[float]) -> Any:
         x, y, z = (float(v) for v in xyz)
         return self.new("geometry_msgs/msg/Vector3", x=x, y=y, z=z)
 
