@@ -271,10 +271,11 @@ class RecordLogger:
 
     def _header(self, r: Mapping[str, Any]) -> None:
         """The run's header (softarm.harvest.header) as one line: what made the run."""
-        argv = r.get("argv") if isinstance(r.get("argv"), list) else []
+        argv = r.get("argv")
+        words = " ".join(str(a) for a in argv) if isinstance(argv, list) else ""
         text = (
             f"softarm {r.get('softarm')} (commit {r.get('commit') or 'unknown'}): "
-            f"softarm {' '.join(str(a) for a in argv)}; seed {r.get('seed')}"
+            f"softarm {words}; seed {r.get('seed')}"
         )
         self.stream.log("harvest/log", self.rr.TextLog(text, level="INFO"))
 
