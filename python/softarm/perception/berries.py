@@ -23,7 +23,7 @@ from softarm.checks import FloatArray
 from softarm.errors import VisionError
 from softarm.vision.camera_model import CameraModel
 
-__all__ = ["BerryDetection", "DetectorSettings", "detect_berries"]
+__all__ = ["BerryDetection", "DetectorSettings", "detect_berries", "fruit_mask"]
 
 Ripeness = Literal["ripe", "unripe"]
 
@@ -104,6 +104,17 @@ def _check(image: object, depth: object) -> None:
         if not isinstance(depth, np.ndarray) or depth.shape != image.shape[:2]:
             shape = getattr(depth, "shape", None)
             raise VisionError(f"depth must be an (H, W) array like image, got shape {shape}")
+
+
+def fruit_mask(
+    image: npt.NDArray[np.uint8], settings: DetectorSettings | None = None
+) -> npt.NDArray[np.uint8]:
+    """The pixels (0/255) of either fruit colour class in a BGR image, closed over the
+    drupelet gaps: the silhouettes that stereo matches (:mod:`softarm.perception.stereo`)."""
+    s = settings or DetectorSettings()
+    hsv = cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV)
+    ripe, unripe = _colour_masks(hsv, s)
+    return _close(cv2.bitwise_or(ripe, unripe))
 
 
 def _colour_masks(

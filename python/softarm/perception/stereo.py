@@ -1,16 +1,17 @@
 """Berry positions from C1's stereo pair.
 
-Both images are rectified; the berries are detected in the rectified left image; each
-one is matched along its rows in the rectified right image with its own mask as the
-template (the background behind a berry shifts by another disparity, so only the
-berry's pixels vote), and the match is refined to a fraction of a pixel by a parabola
-through the best cost and its two neighbours. With f ≈ 900 px and B = 0.12 m a pixel of
-disparity is about 13 mm of depth at 1.2 m, so the sub-pixel step is what the 3 mm
-budget rests on. A dark fruit's interior is nearly uniform, so the match is carried by its
-silhouette against what lies behind it, and the silhouette of a round fruit is its
-equator: the triangulated point is taken as the centre, with no push along the ray
-(pushing it by two thirds of the radius, the mean depth of the visible cap, put it
-6 mm too far on the tuning bushes, seeds 0–4).
+Both images are rectified and the berries are detected in the rectified left image.
+Each one is matched along its rows in the rectified right image by its silhouette: the
+fruit colour mask of each eye (:func:`~softarm.perception.berries.fruit_mask`), blurred,
+with the berry's own mask as the template's support; the match is refined to a fraction
+of a pixel by a parabola through the best cost and its two neighbours. Matching the
+silhouettes rather than the grey levels keeps the background behind a fruit and the
+highlights on it (which move with the eye) out of the match: on the tuning bushes
+(seeds 0–4) a change of the wall's shading moved the grey-level matches by 3 mm and not
+the silhouettes. With f ≈ 900 px and B = 0.12 m a pixel of disparity is about 13 mm of
+depth at 1.2 m. The silhouette of a round fruit is its equator, so the triangulated
+point is taken as the centre. The drupelets that form the outline differ between the
+two eyes, which leaves about half a pixel of disparity noise per berry (±5 mm at 1 m).
 """
 
 from __future__ import annotations
@@ -22,12 +23,20 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.checks import FloatArray
-from softarm.perception.berries import BerryDetection, DetectorSettings, detect_berries
+from softarm.perception.berries import (
+    BerryDetection,
+    DetectorSettings,
+    detect_berries,
+    fruit_mask,
+)
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
 
 __all__ = ["locate_berries", "match_disparity"]
 
+#: The blur (px) of the silhouettes: the edge spread over a few pixels gives the match
+#: a smooth cost, whose parabola vertex is the sub-pixel disparity.
+SILHOUETTE_BLUR = 1.0
 #: The fruit's width (m): 1.5–2.5 cm across, with a margin either side.
 FRUIT_ACROSS = (0.013, 0.032)
 #: How much better (as a share of the cost) the best match must be than any other.
@@ -49,12 +58,11 @@ def locate_berries(
     L, R = rect.rectify(left, right)
     rect_cam = CameraModel(rect.P1[:3, :3], None, rect.size)
     out = []
-    gray_l = cv2.cvtColor(L, cv2.COLOR_BGR2GRAY).astype(np.float32)
-    gray_r = cv2.cvtColor(R, cv2.COLOR_BGR2GRAY).astype(np.float32)
+    sil_l, sil_r = (_silhouettes(img, settings) for img in (L, R))
     d_lo = rect.focal * rect.baseline / DEPTH_RANGE[1]
     d_hi = rect.focal * rect.baseline / DEPTH_RANGE[0]
     for det in detect_berries(L, rect_cam, settings=settings):
-        d = match_disparity(gray_l, gray_r, det, (d_lo, d_hi))
+        d = match_disparity(sil_l, sil_r, det, (d_lo, d_hi))
         position = None
         if d is not None and _plausible(d, det.radius, rect.baseline):
             centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
@@ -98,6 +106,14 @@ def match_disparity(
     sub = 0.5 * (a - c) / curvature  # the parabola's vertex, in [-0.5, 0.5]
     x_right = s0 + k + sub
     return float(x0 - x_right)
+
+
+def _silhouettes(image: npt.NDArray[np.uint8], settings: DetectorSettings | None) -> FloatArray:
+    """The fruit silhouettes of a rectified image as a smooth [0, 1] image: what the two
+    eyes match, so that neither the background behind a fruit nor the highlights on it
+    (which move with the eye) pull the match."""
+    mask = fruit_mask(image, settings).astype(np.float32) / 255.0
+    return cv2.GaussianBlur(mask, (0, 0), SILHOUETTE_BLUR)
 
 
 def _plausible(disparity: float, radius_px: float, baseline: float) -> bool:
