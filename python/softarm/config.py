@@ -8,6 +8,11 @@ tuning.
 shipped as ``softarm/data/blackberry.toml``. Units are SI, except the pressure channels,
 which are the hardware boundary (psi, volts). Unknown keys are errors: a typo must not
 silently fall back to a default.
+
+Every path the file names (a camera ``file``, a camera ``source`` that is a file, the
+``[plant_model]`` ``file``) resolves against the file's own folder, not the working
+directory; the camera intrinsics come from a ``file`` or from inline ``matrix`` and
+``distortion``, and giving both is an error.
 """
 
 from __future__ import annotations
@@ -86,13 +91,37 @@ class GainsConfig:
 
 @dataclass(frozen=True)
 class CameraConfig:
-    """One camera: its OpenCV source and intrinsics, inline or in a file (a path
-    relative to the config file; the vision code reads it)."""
+    """One camera: its OpenCV source and intrinsics, inline or in a file, never both.
+
+    ``file`` and a ``source`` that names a file are kept as written; ``folder`` is the
+    config file's folder, which :attr:`path` and :attr:`device` resolve them against
+    (it is not written back, and two configs differing only in it are equal).
+    """
 
     source: int | str = 0
     matrix: Matrix | None = None
     distortion: tuple[float, ...] | None = None
     file: str | None = None
+    folder: str | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def path(self) -> str | None:
+        """The camera file, resolved against the config file's folder."""
+        return None if self.file is None else resolve(self.file, self.folder)
+
+    @property
+    def device(self) -> int | str:
+        """The OpenCV source; a relative file name (not a URL or a GStreamer pipeline)
+        resolved against the config file's folder."""
+        if isinstance(self.source, int) or "://" in self.source or "!" in self.source:
+            return self.source
+        return resolve(self.source, self.folder)
+
+
+def resolve(path: str, folder: str | Path | None) -> str:
+    """``path`` as written in a config file, resolved against the file's ``folder`` (an
+    absolute path, or no folder, leaves it as it is)."""
+    return path if folder is None else str(Path(folder) / path)
 
 
 @dataclass(frozen=True)
@@ -171,12 +200,16 @@ def load_config(path: str | Path) -> Config:
         ConfigError: the file is missing, not TOML, or a value is invalid (the message
             names the key path and the value).
     """
-    return parse_config(read_text(path, "config file"), source=str(path))
+    text = read_text(path, "config file")
+    return parse_config(text, source=str(path), folder=Path(path).parent)
 
 
-def parse_config(text: str, source: str = "<string>") -> Config:
-    """Validate TOML text (see :func:`load_config`)."""
-    return _build(_Table(parse_toml(text, source), "", source))
+def parse_config(text: str, source: str = "<string>", folder: str | Path | None = None) -> Config:
+    """Validate TOML text (see :func:`load_config`); the paths it names resolve against
+    ``folder`` (None: as written, against the working directory)."""
+    root = _Table(parse_toml(text, source), "", source)
+    root.folder = None if folder is None else str(folder)
+    return _build(root)
 
 
 def default_config() -> Config:
@@ -199,6 +232,7 @@ class _Table:
     def __init__(self, data: dict[str, Any], path: str, source: str) -> None:
         self.data, self.path, self.source = data, path, source
         self.used: set[str] = set()
+        self.folder: str | None = None
 
     def key(self, name: str) -> str:
         return f"{self.path}.{name}" if self.path else name
@@ -238,7 +272,9 @@ class _Table:
         value = self.get(name, ... if required else {})
         if not isinstance(value, dict):
             raise self.error(name, "must be a table")
-        return _Table(value, self.key(name), self.source)
+        child = _Table(value, self.key(name), self.source)
+        child.folder = self.folder
+        return child
 
     def done(self) -> None:
         unknown = sorted(set(self.data) - self.used)
@@ -308,9 +344,16 @@ def _camera(t: _Table, default_source: int) -> CameraConfig:
     if isinstance(source, bool) or not isinstance(source, int | str):
         raise t.error("source", "must be a device index or a path/URL string")
     file = t.get("file", None)
-    if file is not None and not isinstance(file, str):
+    if file is not None and (not isinstance(file, str) or not file):
         raise t.error("file", "must be a path string")
-    cam = CameraConfig(source, _matrix(t, "matrix", 3, 3), _matrix(t, "distortion", 0), file)
+    matrix, distortion = _matrix(t, "matrix", 3, 3), _matrix(t, "distortion", 0)
+    inline = [name for name in ("matrix", "distortion") if name in t.data]
+    if file is not None and inline:
+        raise ConfigError(
+            f"{t.source}: {t.key(inline[0])} and {t.key('file')} are both given: "
+            "the intrinsics come from one place, the file or the inline values"
+        )
+    cam = CameraConfig(source, matrix, distortion, file, t.folder)
     t.done()
     return cam
 
@@ -535,7 +578,8 @@ def dump_config(config: Config) -> str:
     poses = {"T_C1_base": cal.T_C1_base, "T_C2_EE": cal.T_C2_EE, "T_EE_cube": cal.T_EE_cube}
     out += ["[calibration]", *_lines({**poses, "berry_tag": cal.berry_tag}), ""]
     for name, cam in (("c1", cal.c1), ("c2", cal.c2)):
-        out += [f"[calibration.{name}]", *_lines(asdict(cam)), ""]
+        written = {k: v for k, v in asdict(cam).items() if k != "folder"}
+        out += [f"[calibration.{name}]", *_lines(written), ""]
     out += ["[channels]", *_lines(asdict(config.channels)), ""]
     out += ["[serial]", *_lines(asdict(config.serial)), ""]
     out += ["[harvest]", *_lines(asdict(config.harvest))]

@@ -114,6 +114,8 @@ def stop_arm(vent: Callable[[str], object], exc: BaseException, log: EventLog | 
             exit_status=128 + sig.value if sig else None,
         )
         log.close()
+        # The exit message names the log only once the stop is recorded in it.
+        exc.written_log = getattr(log, "path", None)  # type: ignore[attr-defined]
     return vented
 
 
@@ -145,7 +147,7 @@ def drives_arm(command: str) -> Callable[[Run], Run]:
                 try:
                     return run(args)
                 except Interrupted as exc:
-                    log = getattr(args, "log", None)
+                    log = getattr(exc, "written_log", None)  # set by stop_arm
                     where = f"; log {log}" if log else ""
                     _log.info("softarm %s %s: arm vented", command, exc)
                     print(f"softarm {command}: {exc}: arm vented{where}", file=sys.stderr)

@@ -8,11 +8,19 @@ softarm harvest --config hw.toml
 from __future__ import annotations
 
 import argparse
+import functools
+import sys
+from collections.abc import Callable
 from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from softarm.commands._args import RawDefaultsFormatter, config_file, output_file
-from softarm.errors import ConfigError
+from softarm.errors import ConfigError, SoftarmError
 from softarm.files import write_text
+
+if TYPE_CHECKING:
+    from softarm.config import Config
 
 #: Replaces the shipped file's [calibration] tables: every entry the hardware harvest
 #: needs, commented out with a placeholder of the right shape and where its value comes
@@ -78,7 +86,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     init.add_argument("path", type=output_file, help="the TOML file to write")
     init.add_argument("--force", action="store_true", help="overwrite an existing file")
     init.set_defaults(run=run_init)
-    check = actions.add_parser("check", help="validate a configuration for a harvest")
+    check = actions.add_parser(
+        "check",
+        help="validate a configuration for a harvest, opening every file it names",
+    )
     check.add_argument("path", type=config_file, help="the TOML file to check")
     check.set_defaults(run=run_check)
 
@@ -93,12 +104,18 @@ def run_init(args: argparse.Namespace) -> int:
 
 
 def run_check(args: argparse.Namespace) -> int:
-    """Load and validate; exit 0 when a hardware harvest can start from it, 1 when the
-    calibration is incomplete (each missing entry is named), 2 when it is invalid."""
+    """Load and validate, then open and parse every file the config names; exit 0 when
+    a hardware harvest can start from it, 1 when the calibration is incomplete (each
+    missing entry is named), 2 when it is invalid (each problem on its own line)."""
     from softarm.commands.harvest import missing_calibration
     from softarm.config import load_config
 
     config = load_config(args.path)
+    problems = file_problems(config, args.path)
+    for problem in problems:
+        print(f"softarm config: error: {args.path}: {problem}", file=sys.stderr)
+    if problems:
+        return 2
     ch = config.channels
     print(
         f"{args.path}: valid; {len(config.arm.sections)} sections, {len(ch.names)} channels, "
@@ -110,3 +127,40 @@ def run_check(args: argparse.Namespace) -> int:
         return 1
     print(f"ready: softarm harvest --config {args.path}")
     return 0
+
+
+def file_problems(config: Config, path: Path) -> list[str]:
+    """One line per file the config names that cannot be opened or parsed, and per
+    inline value that the harvest would refuse: both cameras' intrinsics, the gains and
+    the identified plant (``[plant_model]``)."""
+    from softarm._core import Gains
+    from softarm.vision.camera_model import camera_from_config
+
+    checks: list[Callable[[], object]] = [
+        functools.partial(camera_from_config, cam, name)
+        for name, cam in (("c1", config.calibration.c1), ("c2", config.calibration.c2))
+        if cam.file is not None or cam.matrix is not None
+    ]
+    checks.append(lambda: Gains(**config.gains.values))
+    checks.append(lambda: _plant_model(config, path))
+    return [p for p in map(_problem, checks) if p is not None]
+
+
+def _plant_model(config: Config, path: Path) -> object:
+    """The identified plant of ``[plant_model]``; a bad file's error names the key."""
+    from softarm.identified_plant import identified_from_config
+
+    try:
+        return identified_from_config(config, path)
+    except ConfigError as exc:
+        key = "plant_model.file: " if config.plant_model and config.plant_model.file else ""
+        raise ConfigError(f"{key}{exc}") from None
+
+
+def _problem(check: Callable[[], object]) -> str | None:
+    """The one-line message of the error ``check`` raises, or None."""
+    try:
+        check()
+    except (SoftarmError, ValueError, TypeError) as exc:
+        return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    return None

@@ -36,6 +36,8 @@ from softarm.errors import ConfigError, HardwareUnavailableError
 
 if TYPE_CHECKING:
     from softarm.config import Config
+    from softarm.harvest.hw_rig import HardwareRig
+    from softarm.harvest.log import HarvestLog
     from softarm.harvest.report import HarvestReport
     from softarm.harvest.sim_rig import SimRig
 
@@ -242,10 +244,45 @@ def _gains(args: argparse.Namespace) -> dict[str, Any] | None:
 
 
 def _run_hardware(args: argparse.Namespace) -> int:
-    from softarm.config import load_config
-    from softarm.harvest.hw_rig import build_hardware_rig
     from softarm.harvest.interfaces import BerryTarget
     from softarm.harvest.log import HarvestLog
+
+    log = HarvestLog(args.log)  # first of all: a stop during set-up is recorded in it
+    try:
+        # Nothing is pressurised yet; a device opened so far is vented by its own close.
+        with vents_on_stop(lambda reason: None, log):
+            rig = _hardware_rig(args, log)
+    except HardwareUnavailableError as exc:
+        log.close()
+        print(
+            f"softarm harvest: hardware not available: {exc}\n"
+            "  Check the devices with `python examples/hardware_bringup.py`, "
+            "or run `softarm harvest --sim` for the simulator.",
+            file=sys.stderr,
+        )
+        return 2
+    except Exception:
+        log.close()
+        raise
+    try:
+        # On hardware the berries are the tags 10, 11, ... stuck to them (section IV-E).
+        with vents_on_stop(rig.machine.actuator.vent, log):
+            report = rig.machine.run([BerryTarget(10 + i) for i in range(args.berries)])
+    finally:
+        rig.close()  # vents and releases every device, whatever happened
+        log.close()
+    report.header = log.records[0]
+    print(summary(report.to_dict()))
+    if args.report:
+        report.save(args.report)
+        print(f"report: {args.report}")
+    write_run_bag(log.records, args.bag)
+    return 0 if report.stopped is None else 1
+
+
+def _hardware_config(args: argparse.Namespace) -> Config:
+    """The hardware config with ``--gains`` over its ``[gains]``, its calibration complete."""
+    from softarm.config import load_config
 
     config = load_config(args.config)
     if args.gains is not None:
@@ -261,40 +298,22 @@ def _run_hardware(args: argparse.Namespace) -> int:
             f"{args.config}: set {', '.join(missing)} to harvest (see the comments that "
             "`softarm config init` writes)"
         )
+    return config
+
+
+def _hardware_rig(args: argparse.Namespace, log: HarvestLog) -> HardwareRig:
+    """The hardware rig of ``args``, its header written to ``log`` first."""
+    from softarm.harvest.hw_rig import build_hardware_rig
     from softarm.identified_plant import identified_from_config, load_identified
 
+    config = _hardware_config(args)
     identified = (
         load_identified(args.identified)
         if getattr(args, "identified", None) is not None
         else identified_from_config(config, args.config)
     )
-    log = HarvestLog(args.log)
     start_log(log, hardware_header(config, args))
-    try:
-        rig = build_hardware_rig(config, log=log, identified=identified)
-    except HardwareUnavailableError as exc:
-        log.close()
-        print(
-            f"softarm harvest: hardware not available: {exc}\n"
-            "  Check the devices with `python examples/hardware_bringup.py`, "
-            "or run `softarm harvest --sim` for the simulator.",
-            file=sys.stderr,
-        )
-        return 2
-    try:
-        # On hardware the berries are the tags 10, 11, ... stuck to them (section IV-E).
-        with vents_on_stop(rig.machine.actuator.vent, log):
-            report = rig.machine.run([BerryTarget(10 + i) for i in range(args.berries)])
-    finally:
-        rig.close()  # vents and releases every device, whatever happened
-        log.close()
-    report.header = log.records[0]
-    print(summary(report.to_dict()))
-    if args.report:
-        report.save(args.report)
-        print(f"report: {args.report}")
-    write_run_bag(log.records, args.bag)
-    return 0 if report.stopped is None else 1
+    return build_hardware_rig(config, log=log, identified=identified)
 
 
 def line(i: int, n: int, r: Any, wall: float, retry: bool = False) -> str:

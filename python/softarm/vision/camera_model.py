@@ -224,13 +224,21 @@ class CameraModel:
 
 def camera_from_config(cam: CameraConfig, name: str) -> CameraModel:
     """The intrinsics of camera ``name`` (``c1``, ``c2``) of a configuration: its
-    ``file``, else its inline ``matrix`` and ``distortion``.
+    ``file`` (resolved against the config file's folder), else its inline ``matrix``
+    and ``distortion``.
 
     Raises:
-        ConfigError: neither is given.
+        ConfigError: neither is given, the file is missing or unparsable, or the inline
+            values are not a camera (the message names the key).
     """
-    if cam.file is not None:
-        return CameraModel.load(cam.file)
+    if cam.path is not None:
+        try:
+            return CameraModel.load(cam.path)
+        except ConfigError as exc:
+            raise ConfigError(f"calibration.{name}.file: {exc}") from None
     if cam.matrix is None:
         raise ConfigError(f"calibration.{name}: no intrinsics (matrix or file) in the config")
-    return CameraModel(np.array(cam.matrix), np.array(cam.distortion or [0.0] * 5))
+    try:
+        return CameraModel(np.array(cam.matrix), np.array(cam.distortion or [0.0] * 5))
+    except ValueError as exc:  # the model's InputErrors
+        raise ConfigError(f"calibration.{name}: {exc}") from None
