@@ -3,12 +3,14 @@
 Both images are rectified and the berries are detected in the rectified left image.
 Each one is matched along its rows in the rectified right image by its silhouette: the
 fruit colour mask of each eye (:func:`~softarm.perception.berries.fruit_mask`), blurred,
-with the berry's own mask as the template's support; the match is refined to a fraction
-of a pixel by a parabola through the best cost and its two neighbours. Matching the
-silhouettes rather than the grey levels keeps the background behind a fruit and the
-highlights on it (which move with the eye) out of the match: on the tuning bushes
-(seeds 0–4) a change of the wall's shading moved the grey-level matches by 3 mm and not
-the silhouettes. With f ≈ 900 px and B = 0.12 m a pixel of disparity is about 13 mm of
+with the berry's own mask as the template's support, and again by its grey levels; each
+match is refined to a fraction of a pixel by a parabola through the best cost and its
+two neighbours. The two err differently: the outline by the drupelets that form it in
+each eye, the shading by the background behind the fruit and the highlights on it (which
+move with the eye). Their mean is taken where they agree within a pixel; where they do
+not, the match is on a neighbour or on a fruit half hidden in one eye, and the berry is
+left without a position for a later look (on the diagnosis bushes 200–219: p95 8.6 mm
+with the outline alone, 6.9 with the shading alone, 6.0 with both, 93 % localised). With f ≈ 900 px and B = 0.12 m a pixel of disparity is about 13 mm of
 depth at 1.2 m. The silhouette of a round fruit is its equator, so the triangulated
 point is taken as the centre. The drupelets that form the outline differ between the
 two eyes, which leaves about half a pixel of disparity noise per berry (±5 mm at 1 m).
@@ -37,6 +39,8 @@ __all__ = ["locate_berries", "match_disparity"]
 #: The blur (px) of the silhouettes: the edge spread over a few pixels gives the match
 #: a smooth cost, whose parabola vertex is the sub-pixel disparity.
 SILHOUETTE_BLUR = 1.0
+#: How far (px) the outline's and the shading's disparities may differ.
+AGREEMENT = 1.0
 #: The fruit's width (m): 1.5–2.5 cm across, with a margin either side.
 FRUIT_ACROSS = (0.013, 0.032)
 #: How much better (as a share of the cost) the best match must be than any other.
@@ -59,10 +63,14 @@ def locate_berries(
     rect_cam = CameraModel(rect.P1[:3, :3], None, rect.size)
     out = []
     sil_l, sil_r = (_silhouettes(img, settings) for img in (L, R))
+    grey_l, grey_r = (cv2.cvtColor(img, cv2.COLOR_BGR2GRAY).astype(np.float32) for img in (L, R))
     d_lo = rect.focal * rect.baseline / DEPTH_RANGE[1]
     d_hi = rect.focal * rect.baseline / DEPTH_RANGE[0]
     for det in detect_berries(L, rect_cam, settings=settings):
-        d = match_disparity(sil_l, sil_r, det, (d_lo, d_hi))
+        d = _agreed(
+            match_disparity(sil_l, sil_r, det, (d_lo, d_hi)),
+            match_disparity(grey_l, grey_r, det, (d_lo, d_hi)),
+        )
         position = None
         if d is not None and _plausible(d, det.radius, rect.baseline):
             centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
@@ -106,6 +114,16 @@ def match_disparity(
     sub = 0.5 * (a - c) / curvature  # the parabola's vertex, in [-0.5, 0.5]
     x_right = s0 + k + sub
     return float(x0 - x_right)
+
+
+def _agreed(by_outline: float | None, by_shading: float | None) -> float | None:
+    """The mean of the two disparities when they agree within AGREEMENT px, else None:
+    the outline and the shading of a fruit err differently (the drupelets on the
+    outline, the background and highlights in the shading), and a match where they
+    disagree is on a neighbour or half hidden in one eye."""
+    if by_outline is None or by_shading is None or abs(by_outline - by_shading) > AGREEMENT:
+        return None
+    return 0.5 * (by_outline + by_shading)
 
 
 def _silhouettes(image: npt.NDArray[np.uint8], settings: DetectorSettings | None) -> FloatArray:
