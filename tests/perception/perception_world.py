@@ -13,7 +13,7 @@ from softarm.sim.bush import Bush
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 
-def rendered_world(seed: int, n_berries: int = 8):  # type: ignore[no-untyped-def]
+def rendered_world(seed: int, n_berries: int = 10):  # type: ignore[no-untyped-def]
     """The rendered world of a fresh bush of ``seed`` seen by the simulated rig's cameras,
     or a skip when this machine cannot render."""
     from softarm.harvest.sim_rig import default_cameras
