@@ -1,0 +1,221 @@
+"""Stereo calibration from ChArUco views (``cv2.stereoCalibrate``): both eyes' intrinsics
+and the right eye's pose in the left eye's frame.
+
+Each eye is first calibrated on its own views (as :func:`calibrate_charuco`); the pair is
+then refined together on the views where both eyes see at least 6 common corners, each
+eye's intrinsics kept as the start. ``T_left_right`` follows
+:class:`softarm.perception.stereo_camera.StereoCamera`: ``x_left = T_left_right @ x_right``,
+metres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import InputError, ParameterError, VisionError
+from softarm.vision._checks import FloatArray, as_gray, as_pose, positive
+from softarm.vision._opencv import opencv_errors
+from softarm.vision.calibration import DEFAULT_FLAGS, grid_size
+from softarm.vision.camera_model import CameraModel
+from softarm.vision.dictionaries import get_dictionary
+from softarm.vision.poses import invert
+
+if TYPE_CHECKING:
+    from softarm.perception.stereo_camera import StereoCamera
+
+__all__ = ["StereoModel", "calibrate_stereo_charuco", "split_side_by_side"]
+
+#: Fewest ChArUco corners a view needs (as calibrate_charuco), and fewest usable views.
+MIN_CORNERS = 6
+MIN_VIEWS = 3
+_TERM = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-9)
+
+Corners = tuple[npt.NDArray[np.int32], npt.NDArray[np.float32]]  # ids (N,), pixels (N, 2)
+
+
+@dataclass(frozen=True)
+class StereoModel:
+    """A calibrated pair: each eye's intrinsics and the right eye's pose in the left
+    eye's frame (4×4, m)."""
+
+    left: CameraModel
+    right: CameraModel
+    T_left_right: FloatArray
+
+    def __post_init__(self) -> None:
+        pose = as_pose(self.T_left_right, "T_left_right")
+        pose.setflags(write=False)
+        object.__setattr__(self, "T_left_right", pose)
+
+    @property
+    def baseline(self) -> float:
+        """Distance (m) between the two optical centres."""
+        return float(np.linalg.norm(self.T_left_right[:3, 3]))
+
+    def stereo_camera(self, T_base_left: npt.ArrayLike | None = None) -> StereoCamera:
+        """The :class:`~softarm.perception.stereo_camera.StereoCamera` of this pair, its
+        left eye at ``T_base_left`` in the base frame (default: the identity)."""
+        from softarm.perception.stereo_camera import StereoCamera
+
+        pose = np.eye(4) if T_base_left is None else as_pose(T_base_left, "T_base_left")
+        return StereoCamera(self.left, self.right, pose, np.array(self.T_left_right))
+
+
+def split_side_by_side(frame: npt.NDArray[Any], name: str = "frame") -> tuple[Any, Any]:
+    """The (left, right) halves of a side-by-side stereo frame (the ZED2 over USB video:
+    one image, the left eye in the left half)."""
+    if not isinstance(frame, np.ndarray) or frame.ndim < 2:
+        raise VisionError(f"{name} must be an image array, got {type(frame).__name__}")
+    width = frame.shape[1]
+    if width < 2 or width % 2:
+        raise VisionError(f"{name} is {width} px wide: a side-by-side frame has an even width")
+    return frame[:, : width // 2], frame[:, width // 2 :]
+
+
+def calibrate_stereo_charuco(
+    left_images: Sequence[npt.NDArray[Any]],
+    right_images: Sequence[npt.NDArray[Any]],
+    squares: tuple[int, int],
+    square_length: float,
+    marker_length: float,
+    dictionary: str = "DICT_4X4_50",
+    flags: int = DEFAULT_FLAGS,
+) -> tuple[StereoModel, float]:
+    """Calibrate a stereo pair from simultaneous views of a ChArUco board of ``squares``
+    = (columns, rows) squares: ``left_images[k]`` and ``right_images[k]`` were taken at
+    the same moment. Returns the model and the RMS reprojection error (px) of the joint
+    refinement. ``flags`` are ``cv2.calibrateCamera`` flags (default: k3 fixed at 0).
+
+    Raises:
+        InputError: the two lists differ in length, or a board argument is invalid.
+        VisionError: an image is unusable, or fewer than 3 views show the board to both
+            eyes with at least 6 common corners.
+    """
+    if len(left_images) != len(right_images):
+        raise InputError(
+            f"left_images and right_images must pair up, got {len(left_images)} and "
+            f"{len(right_images)} images"
+        )
+    board = _board(squares, square_length, marker_length, dictionary)
+    left = _detect_all(board, left_images, "left_images")
+    right = _detect_all(board, right_images, "right_images")
+    model_l = _mono(board, left, "left_images", flags)
+    model_r = _mono(board, right, "right_images", flags)
+    return _stereo(board, left, right, model_l, model_r, flags)
+
+
+def _board(squares: Any, square_length: float, marker_length: float, dictionary: str) -> Any:
+    square, marker = (
+        positive(square_length, "square_length"),
+        positive(marker_length, "marker_length"),
+    )
+    if marker >= square:
+        raise ParameterError(
+            f"marker_length = {marker!r} must be smaller than square_length = {square!r}"
+        )
+    with opencv_errors("ChArUco board"):
+        return cv2.aruco.CharucoBoard(
+            grid_size(squares, "squares", least=2), square, marker, get_dictionary(dictionary)
+        )
+
+
+def _detect_all(
+    board: Any, images: Sequence[npt.NDArray[Any]], name: str
+) -> tuple[list[Corners | None], tuple[int, int]]:
+    """Each image's ChArUco corners (None: fewer than 6) and the common (w, h)."""
+    detector = cv2.aruco.CharucoDetector(board)
+    found: list[Corners | None] = []
+    shape: tuple[int, ...] | None = None
+    for k, image in enumerate(images):
+        gray = as_gray(image, f"{name}[{k}]")
+        if shape is not None and gray.shape != shape:
+            raise VisionError(f"{name}[{k}] has shape {gray.shape}, the first image {shape}")
+        shape = gray.shape
+        corners, ids, _, _ = detector.detectBoard(gray)
+        ok = ids is not None and len(ids) >= MIN_CORNERS
+        found.append((ids.ravel(), corners.reshape(-1, 2)) if ok else None)
+    if shape is None:
+        raise VisionError(f"{name} is empty: calibration needs >= {MIN_VIEWS} views")
+    return found, (int(shape[1]), int(shape[0]))
+
+
+def _points(board: Any, corners: Corners) -> tuple[npt.NDArray[Any], npt.NDArray[Any]]:
+    """The board points (N, 1, 3) and image points (N, 1, 2) of detected corners."""
+    ids, pixels = corners
+    obj = board.getChessboardCorners()[ids].reshape(-1, 1, 3)
+    return obj.astype(np.float32), pixels.reshape(-1, 1, 2).astype(np.float32)
+
+
+def _mono(
+    board: Any, detected: tuple[list[Corners | None], tuple[int, int]], name: str, flags: int
+) -> CameraModel:
+    views, size = detected
+    pairs = [_points(board, c) for c in views if c is not None]
+    if len(pairs) < MIN_VIEWS:
+        raise VisionError(
+            f"{name}: calibration needs >= {MIN_VIEWS} usable views, got {len(pairs)}"
+        )
+    obj, img = zip(*pairs, strict=True)
+    with opencv_errors(f"calibrateCamera ({name})"):
+        _, mat, dist, _, _ = cv2.calibrateCamera(obj, img, size, None, None, flags=flags)
+    return CameraModel(np.asarray(mat, dtype=np.float64), np.ravel(dist), size)
+
+
+def _common(a: Corners, b: Corners) -> tuple[Corners, Corners] | None:
+    """The corners both eyes saw, in the same order (None: fewer than 6)."""
+    ids = np.intersect1d(a[0], b[0])
+    if len(ids) < MIN_CORNERS:
+        return None
+    return (ids, _at(a, ids)), (ids, _at(b, ids))
+
+
+def _at(corners: Corners, ids: npt.NDArray[np.int32]) -> npt.NDArray[np.float32]:
+    """The pixels of the corners ``ids`` (each one detected in ``corners``)."""
+    where = {int(i): k for k, i in enumerate(corners[0])}
+    return corners[1][[where[int(i)] for i in ids]]
+
+
+def _stereo(
+    board: Any,
+    left: tuple[list[Corners | None], tuple[int, int]],
+    right: tuple[list[Corners | None], tuple[int, int]],
+    model_l: CameraModel,
+    model_r: CameraModel,
+    flags: int,
+) -> tuple[StereoModel, float]:
+    pairs = [
+        _common(a, b)
+        for a, b in zip(left[0], right[0], strict=True)
+        if a is not None and b is not None
+    ]
+    usable = [p for p in pairs if p is not None]
+    if right[1] != left[1]:
+        raise VisionError(f"left images are {left[1]} px, right images {right[1]} px")
+    if len(usable) < MIN_VIEWS:
+        raise VisionError(
+            f"stereo calibration needs >= {MIN_VIEWS} views with >= {MIN_CORNERS} corners "
+            f"seen by both eyes, got {len(usable)}"
+        )
+    obj = [_points(board, a)[0] for a, _ in usable]
+    img_l = [_points(board, a)[1] for a, _ in usable]
+    img_r = [_points(board, b)[1] for _, b in usable]
+    with opencv_errors("stereoCalibrate"):
+        rms, k1, d1, k2, d2, R, T, _, _ = cv2.stereoCalibrate(
+            obj, img_l, img_r, model_l.matrix.copy(), model_l.distortion.copy(),
+            model_r.matrix.copy(), model_r.distortion.copy(), left[1],
+            flags=flags | cv2.CALIB_USE_INTRINSIC_GUESS, criteria=_TERM,
+        )  # fmt: skip
+    T_right_left = np.eye(4)
+    T_right_left[:3, :3], T_right_left[:3, 3] = R, np.ravel(T)
+    model = StereoModel(
+        CameraModel(np.asarray(k1, dtype=np.float64), np.ravel(d1), left[1]),
+        CameraModel(np.asarray(k2, dtype=np.float64), np.ravel(d2), right[1]),
+        invert(T_right_left),
+    )
+    return model, float(rms)

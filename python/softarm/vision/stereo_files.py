@@ -1,0 +1,128 @@
+"""Stereo calibration files: one OpenCV FileStorage file for the pair, and a ROS
+``camera_info`` YAML per eye.
+
+**OpenCV** (``stereo.yml``), the keys of OpenCV's stereo calibration sample
+(``samples/cpp/stereo_calib.cpp``) in one file: ``image_width``, ``image_height``,
+``M1``/``D1`` and ``M2``/``D2`` (left and right intrinsics), ``R``/``T`` (the left eye's
+points in the right eye's frame: ``x_right = R x_left + T``, metres), and
+``T_left_right`` (4×4, its inverse: softarm's convention).
+
+**ROS** (``left.yaml``, ``right.yaml``), as ``camera_calibration`` writes a stereo pair:
+each eye's intrinsics, its rectification rotation and its rectified projection (the
+right one carries ``-fx B`` in ``P[0, 3]``). softarm reads either eye back as a camera
+(:meth:`CameraModel.load`, which ignores the rectification).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from softarm.errors import ConfigError
+from softarm.files import atomic_path, read_text, write_text
+from softarm.vision.camera_files import _ROS_MODELS, _open, _ros_matrix
+from softarm.vision.camera_model import CameraModel
+from softarm.vision.poses import invert
+from softarm.vision.stereo_calibration import StereoModel
+
+__all__ = ["read_stereo", "write_ros_stereo", "write_stereo"]
+
+
+def write_stereo(model: StereoModel, path: str | Path) -> None:
+    """Write ``model`` as one OpenCV FileStorage file (see the module docstring)."""
+    T_right_left = invert(model.T_left_right)
+    size = model.left.image_size or (0, 0)
+    with atomic_path(path, "stereo file") as tmp:
+        fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE)
+        if not fs.isOpened():
+            raise ConfigError(f"cannot write stereo file {str(path)!r}")
+        try:
+            fs.write("image_width", int(size[0]))
+            fs.write("image_height", int(size[1]))
+            for key, value in _matrices(model, T_right_left).items():
+                fs.write(key, np.asarray(value, dtype=np.float64))
+        finally:
+            fs.release()
+
+
+def _matrices(model: StereoModel, T_right_left: np.ndarray) -> dict[str, Any]:
+    return {
+        "M1": model.left.matrix,
+        "D1": model.left.distortion.reshape(-1, 1),
+        "M2": model.right.matrix,
+        "D2": model.right.distortion.reshape(-1, 1),
+        "R": T_right_left[:3, :3],
+        "T": T_right_left[:3, 3].reshape(3, 1),
+        "T_left_right": model.T_left_right,
+    }
+
+
+def read_stereo(path: str | Path) -> StereoModel:
+    """The pair of a ``stereo.yml`` that :func:`write_stereo` wrote.
+
+    Raises:
+        ConfigError: the file is missing, unparsable or lacks a key (named).
+    """
+    text = read_text(path, "stereo file")
+    fs = _open(path, text.lstrip("\ufeff \t\r\n"))
+    try:
+        mats = {k: _mat(fs, k, path) for k in ("M1", "D1", "M2", "D2", "T_left_right")}
+        size = (int(fs.getNode("image_width").real()), int(fs.getNode("image_height").real()))
+    finally:
+        fs.release()
+    try:
+        return StereoModel(
+            CameraModel(mats["M1"], mats["D1"].ravel(), size),
+            CameraModel(mats["M2"], mats["D2"].ravel(), size),
+            mats["T_left_right"],
+        )
+    except ValueError as exc:
+        raise ConfigError(f"stereo file {str(path)!r}: {exc}") from None
+
+
+def _mat(fs: Any, key: str, path: str | Path) -> np.ndarray:
+    node = fs.getNode(key)
+    mat = None if node.isNone() else node.mat()
+    if mat is None:
+        raise ConfigError(f"stereo file {str(path)!r}: {key} is missing or not a matrix")
+    return np.asarray(mat, dtype=np.float64)
+
+
+def write_ros_stereo(model: StereoModel, left: str | Path, right: str | Path) -> None:
+    """Write each eye as a ROS ``camera_info`` YAML with its rectification and rectified
+    projection (``cv2.stereoRectify``), named ``left`` and ``right``."""
+    size = model.left.image_size
+    if size is None:
+        raise ConfigError("a ROS camera_info file needs the image size")
+    T = invert(model.T_left_right)
+    L, R = model.left, model.right
+    R1, R2, P1, P2, *_ = cv2.stereoRectify(
+        L.matrix, L.distortion, R.matrix, R.distortion, size,
+        np.ascontiguousarray(T[:3, :3]), T[:3, 3].reshape(3, 1).copy(), alpha=0,
+        flags=cv2.CALIB_ZERO_DISPARITY,
+    )  # fmt: skip
+    for path, name, cam, rect, proj in ((left, "left", L, R1, P1), (right, "right", R, R2, P2)):
+        write_text(path, _ros_text(cam, name, rect, proj), "camera file")
+
+
+def _ros_text(cam: CameraModel, name: str, rect: np.ndarray, proj: np.ndarray) -> str:
+    dist = np.asarray(cam.distortion, dtype=np.float64)
+    if dist.size in (0, 4):
+        dist = np.concatenate([dist, np.zeros(5 - dist.size)])
+    if dist.size not in _ROS_MODELS:
+        raise ConfigError(f"ROS camera_info has no distortion model with {dist.size} values")
+    width, height = cam.image_size or (0, 0)
+    lines = [
+        f"image_width: {int(width)}",
+        f"image_height: {int(height)}",
+        f"camera_name: {name}",
+        *_ros_matrix("camera_matrix", cam.matrix),
+        f"distortion_model: {_ROS_MODELS[dist.size]}",
+        *_ros_matrix("distortion_coefficients", dist.reshape(1, -1)),
+        *_ros_matrix("rectification_matrix", np.asarray(rect, dtype=np.float64)),
+        *_ros_matrix("projection_matrix", np.asarray(proj, dtype=np.float64)),
+    ]
+    return "\n".join(lines) + "\n"
