@@ -35,6 +35,7 @@ COMMANDS: dict[str, str] = {
     "identify": "softarm.commands.identify",
     "replay": "softarm.commands.replay",
     "dataset": "softarm.commands.dataset",
+    "camera": "softarm.commands.camera",
 }
 
 

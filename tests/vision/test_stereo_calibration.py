@@ -39,7 +39,6 @@ def _T_left_right() -> np.ndarray:
 @pytest.fixture(scope="module")
 def views() -> tuple[list[np.ndarray], list[np.ndarray]]:
     """12 simultaneous (left, right) views of the board in front of the pair."""
-    pytest.importorskip("mujoco")
     from softarm.sim.render import RenderUnavailableError
     from softarm.sim.render.charuco import BoardSpec, CharucoScene, board_poses
 
