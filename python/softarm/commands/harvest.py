@@ -290,7 +290,7 @@ def _hardware_config(args: argparse.Namespace) -> Config:
 
         from softarm.config import GainsConfig
 
-        merged = {**config.gains.values, **_gains(args)}
+        merged = {**config.gains.values, **(_gains(args) or {})}
         config = dataclasses.replace(config, gains=GainsConfig(merged))
     missing = missing_calibration(config)
     if missing:

@@ -139,10 +139,15 @@ def _detect_all(
         shape = gray.shape
         corners, ids, _, _ = detector.detectBoard(gray)
         ok = ids is not None and len(ids) >= MIN_CORNERS
-        found.append((ids.ravel(), corners.reshape(-1, 2)) if ok else None)
+        found.append(_corners(ids, corners) if ok else None)
     if shape is None:
         raise VisionError(f"{name} is empty: calibration needs >= {MIN_VIEWS} views")
     return found, (int(shape[1]), int(shape[0]))
+
+
+def _corners(ids: Any, corners: Any) -> Corners:
+    """A detection as (ids (N,) int32, pixels (N, 2) float32)."""
+    return np.asarray(ids, np.int32).ravel(), np.asarray(corners, np.float32).reshape(-1, 2)
 
 
 def _points(board: Any, corners: Corners) -> tuple[npt.NDArray[Any], npt.NDArray[Any]]:
