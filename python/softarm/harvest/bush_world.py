@@ -8,10 +8,12 @@ truth: the gripper's catch, the contacts, and the report's errors.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from softarm.checks import FloatArray
+from softarm.errors import ParameterError
 from softarm.harvest.interfaces import BerryTarget
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.sim_devices import SimGripper
@@ -19,6 +21,7 @@ from softarm.perception.bush_map import BushMap
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.canes import fit_canes
 from softarm.perception.stereo import locate_berries
+from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.plant import ArmPlant
 from softarm.sim.render.world import RenderedBush, arm_sections, polyline_sections
@@ -51,19 +54,33 @@ class BushScene:
     bush_map: BushMap
     bush: Bush
     plant: ArmPlant
+    #: C1 as the rig knows it: the calibrated pair, placed in the base frame by the
+    #: base-tag registration (eq. 22), as the cube tracking places it. The world's own
+    #: C1 pose is the truth, which only the renderer uses.
+    stereo: StereoCamera | None = None
+
+    def registered(self, T_base_c1: FloatArray) -> None:
+        """Place C1 where the registration found it."""
+        self.stereo = replace(self.world.stereo, T_base_left=T_base_c1)
+
+    def c1(self) -> StereoCamera:
+        """C1 as the rig knows it (after :meth:`registered`)."""
+        if self.stereo is None:
+            raise ParameterError("the bush scene's C1 is not registered yet")
+        return self.stereo
 
     def look(self) -> int:
         """One C1 stereo view with the arm where it truly is, merged into the map; the
         number of berries new to it."""
         draw_arm(self.world, self.plant)
         left, right = self.world.c1()
-        return self.bush_map.update(locate_berries(left.colour, right.colour, self.world.stereo))
+        return self.bush_map.update(locate_berries(left.colour, right.colour, self.c1()))
 
     def fit_canes(self) -> list:
         """The canes fitted from one C1 stereo view (the map keeps them)."""
         draw_arm(self.world, self.plant)
         left, right = self.world.c1()
-        self.bush_map.canes = fit_canes(left.colour, right.colour, self.world.stereo)
+        self.bush_map.canes = fit_canes(left.colour, right.colour, self.c1())
         return [c.curve for c in self.bush_map.canes]
 
     def frames(self) -> tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray]]:

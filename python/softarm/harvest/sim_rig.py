@@ -300,9 +300,13 @@ C2_SCALE = 0.5
 
 
 def _bush_scene(bush: Bush, plant: ArmPlant, cams: SimCameras) -> BushScene:
-    """The rendered bush with the first C1 look merged into its map."""
+    """The rendered bush, C1 registered on its base tag, the first C1 look merged
+    into its map."""
     world = world_for(bush, cams, BASE_TAG_ID, c2_scale=C2_SCALE)
     scene = BushScene(world, BushMap(), bush, plant)
+    scene.registered(
+        register_c1(scene.c1_whole, cams.model(1), BASE_TAG_ID, cams.base_tag, cams.T_base_tag)
+    )
     scene.look()
     return scene
 
@@ -312,7 +316,7 @@ def _bush_vision(scene: BushScene, cams: SimCameras, grasp_offset: float) -> Bus
     from the map and C2 (softarm.perception.bush_vision)."""
     c1, c2 = scene.frames()
     m1, m2 = cams.model(1), scene.world.c2
-    T_base_c1 = register_c1(scene.c1_whole, m1, BASE_TAG_ID, cams.base_tag, cams.T_base_tag)
+    T_base_c1 = scene.c1().T_base_left
     cube = MarkerCube.standard(cams.cube_marker)
     return BushVision(
         c1, c2, m1, m2, T_base_c1, cams.T_ee_c2, cams.T_ee_cube, cube, cams.berry_tag,

@@ -1,9 +1,9 @@
 """The two-camera vision of the markerless harvest: the end effector from the marker
 cube in C1 (eq. 22), as in the tag world; the selected berry from the bush map (C1's
 stereo, :mod:`softarm.perception.stereo`) while the gripper is far, and from C2 once it
-is near (eq. 21): C2 finds the berry without a tag and gives the ray it lies on, and the
-map's C1 position along that ray gives its depth (a fruit's width varies by ±15 %, so
-its apparent size alone would put it several millimetres off at the grasp)."""
+is near (eq. 21): C2 finds the berry without a tag in each frame, and its views from the
+tracked poses of the approach, with the map's position as a prior, give the berry's
+centre (:class:`~softarm.perception.approach.ApproachTriangulation`)."""
 
 from __future__ import annotations
 
@@ -12,9 +12,11 @@ from typing import Any
 import numpy as np
 
 from softarm.checks import FloatArray
+from softarm.perception.approach import ApproachTriangulation
 from softarm.perception.berries import BerryDetection, DetectorSettings, detect_berries
 from softarm.perception.bush_map import BushMap
 from softarm.vision.detector import Detection
+from softarm.vision.observation import BerryTarget
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision
 
@@ -39,6 +41,13 @@ class BushVision(CameraVision):
         self.settings = DetectorSettings()
         self._T_ee_c2 = self.fusion.T_ee_c2
         self._grasp = np.array([0.0, 0.0, self.fusion.tool_point[2], 1.0])
+        self._track: ApproachTriangulation | None = None
+
+    def select(self, berry: BerryTarget) -> None:
+        """Track the map's berry ``berry.tag_id``; its C2 sightings start afresh."""
+        super().select(berry)
+        p = self._mapped()
+        self._track = None if p is None else ApproachTriangulation(p)
 
     def _mapped(self) -> FloatArray | None:
         berry = self.bush_map.get(self.selected.tag_id)
@@ -64,11 +73,10 @@ class BushVision(CameraVision):
         if predicted[2] <= 0.0:
             return None
         det = self._nearest(detect_berries(image, self.model2, settings=self.settings), predicted)
-        if det is None:
+        if det is None or self._track is None:
             return None
-        x, y = self.model2.normalize(np.array([det.center]))[0]
-        ray = np.array([x, y, 1.0])
-        return ray * float(predicted @ ray) / float(ray @ ray)  # the point nearest the map's
+        self._track.add(invert(T_c2_base), self.model2, det)
+        return (T_c2_base @ np.append(self._track.estimate(), 1.0))[:3]
 
     def _nearest(self, dets: list[BerryDetection], predicted: FloatArray) -> BerryDetection | None:
         """The ripe detection nearest where the mapped berry projects, within the gate."""
