@@ -1,19 +1,20 @@
 """Berry positions from C1's stereo pair.
 
-Both images are rectified and the berries are detected in the rectified left image.
-Each one is matched along its rows in the rectified right image by its silhouette: the
-fruit colour mask of each eye (:func:`~softarm.perception.berries.fruit_mask`), blurred,
-with the berry's own mask as the template's support, and again by its grey levels; each
-match is refined to a fraction of a pixel by a parabola through the best cost and its
-two neighbours. The two err differently: the outline by the drupelets that form it in
-each eye, the shading by the background behind the fruit and the highlights on it (which
-move with the eye). Their mean is taken where they agree within a pixel; where they do
-not, the match is on a neighbour or on a fruit half hidden in one eye, and the berry is
-left without a position for a later look (on the diagnosis bushes 200–219: p95 8.6 mm
-with the outline alone, 6.9 with the shading alone, 6.0 with both, 93 % localised). With f ≈ 900 px and B = 0.12 m a pixel of disparity is about 13 mm of
-depth at 1.2 m. The silhouette of a round fruit is its equator, so the triangulated
-point is taken as the centre. The drupelets that form the outline differ between the
-two eyes, which leaves about half a pixel of disparity noise per berry (±5 mm at 1 m).
+Both images are rectified and the berries are detected in the rectified left image. Each
+one is matched along its rows in the rectified right image by its silhouette: the fruit
+colour mask of each eye (:func:`~softarm.perception.berries.fruit_mask`), blurred, with
+the berry's own mask as the template's support, and again by its grey levels; each match
+is refined to a fraction of a pixel by a parabola through the best cost and its two
+neighbours. The two err differently: the outline by the drupelets that form it in each
+eye, the shading by the background behind the fruit and the highlights on it (which move
+with the eye). Their mean is taken where they agree within a pixel; where they do not,
+the match is on a neighbour or on a fruit half hidden in one eye, and the berry is left
+without a position for a later look (on the diagnosis bushes 200–219: p95 8.6 mm with
+the outline alone, 6.9 with the shading alone, 6.0 with both, 93 % localised). With f ≈
+900 px and B = 0.12 m a pixel of disparity is about 13 mm of depth at 1.2 m. The
+silhouette of a round fruit is its equator, so the triangulated point is taken as the
+centre. The drupelets that form the outline differ between the two eyes, which leaves
+about half a pixel of disparity noise per berry (±5 mm at 1 m).
 """
 
 from __future__ import annotations
