@@ -2,29 +2,53 @@
 //!
 //! For each obstacle the exact closest pair to the arm's whole body (arcs, end plates,
 //! gripper: [`crate::distance::bodies`]) is found. Within the influence distance ρ₀ of
-//! the surface gap `g = d − body_radius`, the closest arm point is pushed straight away
-//! from the obstacle by `F = k_r (1/g − 1/ρ₀) / g²` (m per step; the gradient of
-//! Khatib's potential, the repulsive term of eq. 9, with `g` clamped at 1 mm), through
-//! the damped pseudo-inverse of its 3×n point Jacobian (eq. 8): `Δq_j = J_sj⁺ F_j`. The
-//! step projects `Σ_j Δq_j` onto the null space of every task of its mode, as eq. (20)
-//! does the joint-limit gradient, caps it on its own, and never schedules it off: it is
-//! safety, and it must keep acting at the target.
+//! the surface gap `g = d − body_radius`, the gap is asked to grow by
+//! `f = k_r (1/g − 1/ρ₀) / g²` per step (the gradient of Khatib's potential, the
+//! repulsive term of eq. 9, with `g` clamped at 1 mm), by at least a tenth of the way to
+//! ρ₀ ([`TAIL`]) and by at most what a step may move (half of `max_step`).
+//!
+//! The ask is a ONE-row task on the gap, solved in the null space of every task of the
+//! mode, where eq. (20) puts the joint-limit gradient of eq. (14):
+//! `Δq_j = c_j f_j / ‖c_j‖²` with `c_j = P ∇g_j`, `∇g_j = J_sjᵀ n_j` (n_j the unit
+//! direction from the obstacle to the arm point, J_sj the point's 3×n Jacobian, P the
+//! tasks' null-space projector), faded out where the null space has no leverage on the
+//! gap ([`add_gap_step`]). Its first-order change of the gap is `f_j` where the null
+//! space has leverage, and never negative; the step vanishes where the gap is stationary
+//! on the tasks' self-motion manifold.
+//!
+//! Issue 27 item 1: it replaces `P Σ_j J_sj⁺ F_j`, the projection of the three-row push
+//! of eq. (8)–(9). Projected, that vector is no ascent direction of the gap
+//! (`nᵀ J_s P J_sᵀ (J_s J_sᵀ)⁻¹ n` has no sign), and it does not vanish where the gap is
+//! stationary; with `F` ~1 m per step inside the body it always ran at the length cap.
+//! The arm slid along its self-motion manifold onto the joint limits, where the higher
+//! tasks lost columns, brought the body nearer the cane once the limits had reshaped the
+//! projection, or oscillated by the cap (±2 mm) about the best clearance, and that
+//! oscillation moved the gripper by second-order terms, always the same way: the pose
+//! drifted by 0.05–0.4 mm. [`step_fraction`] also bounds what the step may cost the
+//! position task at second order.
 //!
 //! The pairs are evaluated on the MODEL at the commanded `q`, not on the measurement, so
 //! the repulsion adds no loop through the plant's lag.
 
 use nalgebra::DMatrix;
 
-use super::pinv::normal_inverse3;
 use super::Gains;
-use crate::chain::point_unchecked;
+use crate::chain::{forward_unchecked, point_unchecked};
 use crate::distance::bodies::{closest_piece_within, placed_pieces_into, BodyBox, Piece};
 use crate::distance::Obstacle;
 use crate::kinematics::Kinematics;
-use crate::math::{Mat3, Vec3};
+use crate::math::Vec3;
 
 /// Smallest surface gap (m) used in the law: below it the push no longer grows.
 const MIN_GAP: f64 = 1e-3;
+
+/// The smallest ask, as a fraction of the gap still to go to the influence distance ρ₀,
+/// per step. Eq. (9) alone asks `k_r (ρ₀ − g) / ρ₀⁴` near ρ₀: with the blackberry gains
+/// 0.2 % of the way per step, a time constant of 540 steps, so an arm whose null space
+/// frees the body crept on for hundreds of steps (~1 mm per 50 steps). A tenth settles it
+/// in tens of steps. With the blackberry gains eq. (9) is the larger below a 7.9 mm gap
+/// (`g³ = k_r / (ρ₀ TAIL)`), and is unchanged there.
+const TAIL: f64 = 0.1;
 
 /// One obstacle's push on its closest arm point.
 #[derive(Debug, Clone)]
@@ -35,8 +59,10 @@ pub struct Repulsion {
     pub arm_point: Vec3,
     /// Columns of the point's 3×n Jacobian.
     pub jac: Vec<Vec3>,
-    /// The displacement F asked of the point (m per step).
-    pub push: Vec3,
+    /// Unit direction from the obstacle point to the arm point: ∂g/∂p.
+    pub normal: Vec3,
+    /// The gap increase eq. (9) asks for this step, `f` (m).
+    pub ask: f64,
 }
 
 fn columns(j: &nalgebra::Matrix3xX<f64>) -> Vec<Vec3> {
@@ -80,7 +106,11 @@ pub fn repulsions_into<K: Kinematics + ?Sized>(
             continue;
         }
         let g = gap.max(MIN_GAP);
-        let push = away * (gains.repulsion_gain * (1.0 / g - 1.0 / rho) / (g * g) / d);
+        // The ask is a gap increase for ONE step: never more than a step may move (half
+        // of max_step, the repulsion's cap). Eq. (9) asks 1.45 m per step at the 1 mm
+        // clamp, which would keep every step at its cap, also where P ∇g is small.
+        let khatib = gains.repulsion_gain * (1.0 / g - 1.0 / rho) / (g * g);
+        let ask = khatib.max(TAIL * (rho - gap)).min(0.5 * gains.max_step);
         let cols = if !hit.rigid {
             columns(&point_unchecked(arm, q, c.section, c.s).1)
         } else {
@@ -103,33 +133,163 @@ pub fn repulsions_into<K: Kinematics + ?Sized>(
             gap,
             arm_point: c.arm_point,
             jac: cols,
-            push,
+            normal: away / d,
+            ask,
         });
     }
     clearance
 }
 
-/// `out += Σ_j J_sj⁺ F_j` (eq. 8–9) with the columns of coordinates that are not `free`
-/// removed, through the damped pseudo-inverse of [`normal_inverse3`].
-pub fn add_pseudo_inverse_pushes(
-    reps: &[Repulsion],
-    free: &[bool],
-    threshold: f64,
-    damping: f64,
-    out: &mut [f64],
-) {
-    for r in reps {
-        let gram = r
-            .jac
-            .iter()
-            .zip(free)
-            .filter(|(_, f)| **f)
-            .fold(Mat3::zeros(), |s, (c, _)| s + c * c.transpose());
-        let y = normal_inverse3(&gram, [true; 3], threshold, damping) * r.push;
-        for ((o, c), f) in out.iter_mut().zip(&r.jac).zip(free) {
-            if *f {
-                *o += c.dot(&y);
+/// Writes the gap's gradient `∇g = J_sᵀ n` of `r` into `row`, with the coordinates that
+/// are not `free` zeroed (saturation rounds: they no longer move).
+pub fn gap_row_into(r: &Repulsion, free: &[bool], row: &mut [f64]) {
+    for ((o, c), &f) in row.iter_mut().zip(&r.jac).zip(free) {
+        *o = if f { r.normal.dot(c) } else { 0.0 };
+    }
+}
+
+/// `out += c f (1 − ε²/‖c‖²) / ‖c‖²`: the one-row pseudo-inverse (eq. 8) of the projected
+/// gap row `c = P ∇g` applied to the ask `f`, faded out as the null space's leverage on
+/// the gap, ‖c‖ (m of gap per m of elongation), falls to the singular threshold ε, and
+/// nothing below it. There a step long enough to earn `f` would move the body far for
+/// almost no clearance (2 mm steps earned 4 µm, and their second-order motion held the
+/// gripper 0.3 mm off the pose); a damped one (`c f / λ²`) still crept along the
+/// self-motion manifold at a constant rate and never settled.
+pub fn add_gap_step(c: &[f64], ask: f64, threshold: f64, out: &mut [f64]) {
+    let sigma2: f64 = c.iter().map(|x| x * x).sum();
+    let t2 = threshold * threshold;
+    if ask <= 0.0 || sigma2 <= t2 {
+        return;
+    }
+    let k = ask * (1.0 - t2 / sigma2) / sigma2;
+    for (o, x) in out.iter_mut().zip(c) {
+        *o += k * x;
+    }
+}
+
+/// How far (m) the repulsion's step may move the gripper, per metre of clearance it earns
+/// to first order ([`step_fraction`]). The step lies in the tasks' null space, so the
+/// gripper moves only by its second-order terms, ∝ t²; the tasks then take that motion
+/// back, and their correction moves the body too. A 2 mm step earning 0.13 mm of gap
+/// moved the gripper 0.1 mm: the correction took the gap back, and the pair cycled with
+/// period 2 and the gripper 0.3 mm off the pose.
+const DRIFT_PER_GAIN: f64 = 0.1;
+
+/// The largest fraction t of a step whose gripper motion at t = 1 is `drift` (m, second
+/// order, so t² `drift` at t) and whose first-order gap gain is `slope`:
+/// t² drift ≤ [`DRIFT_PER_GAIN`] · t · slope.
+pub fn fraction_for_drift(slope: f64, drift: f64) -> f64 {
+    if drift <= 0.0 {
+        return 1.0;
+    }
+    (DRIFT_PER_GAIN * slope.max(0.0) / drift).min(1.0)
+}
+
+/// The fraction of the repulsion step `a` (its part of the increment) to take from `q`
+/// ([`fraction_for_drift`], with the largest first-order gain of a gap among `reps`):
+/// the step is tried on the model, clamped into the limits, in `trial`. `tip` is the
+/// gripper's position at `q` where the position is a task (else 1: a null space without
+/// the position task moves the gripper at first order, on purpose).
+pub fn step_fraction<K: Kinematics + ?Sized>(
+    arm: &K,
+    q: &[f64],
+    a: &[f64],
+    (reps, tip): (&[Repulsion], Option<&Vec3>),
+    trial: &mut [f64],
+) -> f64 {
+    let Some(tip) = tip else {
+        return 1.0;
+    };
+    if reps.is_empty() || a.iter().all(|x| *x == 0.0) {
+        return 1.0;
+    }
+    let gain = reps
+        .iter()
+        .map(|r| r.jac.iter().zip(a).map(|(c, x)| r.normal.dot(c) * x).sum())
+        .fold(0.0_f64, f64::max);
+    let (lower, upper) = (arm.lower(), arm.upper());
+    for k in 0..q.len() {
+        trial[k] = (q[k] + a[k]).clamp(lower[k], upper[k]);
+    }
+    let drift = (forward_unchecked(arm, trial).pos - tip).norm();
+    fraction_for_drift(gain, drift)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    fn random_matrix(rng: &mut StdRng, rows: usize, cols: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(rows, cols, |_, _| rng.random_range(-1.0..1.0))
+    }
+
+    /// `I − A⁺A` for a random 5×9 task Jacobian (position and two orientation rows of
+    /// eq. 20).
+    fn null_projector(rng: &mut StdRng) -> DMatrix<f64> {
+        let a = random_matrix(rng, 5, 9);
+        let Ok(pinv) = a.clone().pseudo_inverse(1e-12) else {
+            panic!("the SVD of a 5×9 matrix");
+        };
+        DMatrix::identity(9, 9) - pinv * a
+    }
+
+    /// The mechanism of issue 27 item 1: projected onto the tasks' null space, the
+    /// pseudo-inverse push `P J_s⁺ (f n)` of eq. (8)–(9) takes the gap DOWN to first order
+    /// for some arms and obstacles; the gap's own row `P ∇g` never does, and earns the
+    /// ask wherever the null space has leverage on the gap.
+    #[test]
+    fn the_projected_push_can_close_the_gap_and_the_gap_row_cannot() {
+        let mut rng = StdRng::seed_from_u64(27);
+        let ask = 1e-3;
+        let mut closing = 0;
+        for _ in 0..500 {
+            let p = null_projector(&mut rng);
+            let js = random_matrix(&mut rng, 3, 9);
+            let n = DVector::from_fn(3, |_, _| rng.random_range(-1.0..1.0)).normalize();
+            let grad = js.transpose() * &n;
+            let Ok(js_pinv) = js.clone().pseudo_inverse(1e-12) else {
+                panic!("the SVD of a 3×9 matrix");
+            };
+            let old = &p * js_pinv * (&n * ask);
+            if grad.dot(&old) < -1e-12 {
+                closing += 1;
             }
+            let c: Vec<f64> = (&p * &grad).iter().copied().collect();
+            let mut new = vec![0.0; 9];
+            add_gap_step(&c, ask, 0.0, &mut new);
+            let gain: f64 = grad.iter().zip(&new).map(|(g, d)| g * d).sum();
+            assert!((gain - ask).abs() < 1e-9 * ask.max(1.0), "{gain}");
         }
+        assert!(closing > 0, "the projected push never closed the gap");
+    }
+
+    #[test]
+    fn the_step_fades_out_where_the_null_space_has_no_leverage() {
+        let mut out = [0.0; 3];
+        add_gap_step(&[0.03, 0.0, 0.04], 1e-3, 0.05, &mut out);
+        assert_eq!(out, [0.0; 3], "‖c‖ = 0.05 is at the threshold");
+        add_gap_step(&[0.06, 0.0, 0.08], 1e-3, 0.05, &mut out);
+        let gain = 0.06 * out[0] + 0.08 * out[2];
+        assert!(
+            (gain - 0.75e-3).abs() < 1e-15,
+            "{gain}: (1 − 1/4) of the ask"
+        );
+        let mut none = [0.0; 3];
+        add_gap_step(&[1.0, 0.0, 0.0], 0.0, 0.05, &mut none);
+        assert_eq!(none, [0.0; 3]);
+    }
+
+    #[test]
+    fn a_step_that_moves_the_gripper_more_than_it_earns_is_cut() {
+        // 0.1 mm of gripper motion (second order) against 0.13 mm of gap: t = 0.13.
+        let t = fraction_for_drift(0.13e-3, 0.1e-3);
+        assert!((t - 0.13).abs() < 1e-12, "{t}");
+        assert!((t * t * 0.1e-3) <= DRIFT_PER_GAIN * t * 0.13e-3 + 1e-18);
+        assert_eq!(fraction_for_drift(2e-3, 1e-6), 1.0);
+        assert_eq!(fraction_for_drift(-1e-3, 1e-6), 0.0);
+        assert_eq!(fraction_for_drift(0.0, 0.0), 1.0);
     }
 }

@@ -179,8 +179,11 @@ impl<K: Kinematics> Resolver<K> {
             BOUNDARY_FRACTION,
         ));
         let s_avoid = cap_scale(&ws.avoid, 0.5 * max);
+        // The repulsion's part is kept as applied: the step may still cut it
+        // (Resolver::hold_repulsion).
+        ws.avoid.iter_mut().for_each(|a| *a *= s_avoid);
         for ((d, v), a) in ws.dq.iter_mut().zip(&ws.null).zip(&ws.avoid) {
-            *d = s_task * *d + s_null * v + s_avoid * a;
+            *d = s_task * *d + s_null * v + a;
         }
     }
 

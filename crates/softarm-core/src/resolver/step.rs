@@ -51,6 +51,8 @@ pub struct Workspace {
     pub(super) free: Vec<bool>,
     pub(super) fixed: Vec<f64>,
     pub(super) avoid: Vec<f64>,
+    pub(super) row: Vec<f64>,
+    pub(super) trial: Vec<f64>,
     pub(super) pieces: Vec<Piece>,
     pub(super) repulsions: Vec<Repulsion>,
 }
@@ -71,6 +73,8 @@ impl Workspace {
             free: vec![true; n],
             fixed: vec![0.0; n],
             avoid: vec![0.0; n],
+            row: vec![0.0; n],
+            trial: vec![0.0; n],
             pieces: Vec::new(),
             repulsions: Vec::new(),
         }
@@ -267,6 +271,7 @@ impl<K: Kinematics> Resolver<K> {
         // the model along their ill-conditioned directions (Gains::loop_damping).
         let dls = self.gains.dls(input.current.is_some());
         let saturated = self.saturation_rounds(ws, q, &errors, goal.1.is_some(), alpha, dls);
+        self.hold_repulsion(ws, q, &model.pos);
         self.write_command(ws, q, out)?;
         Ok(StepInfo {
             saturated,
@@ -414,6 +419,30 @@ impl<K: Kinematics> Resolver<K> {
                 } else {
                     g.hybrid_alpha
                 }
+            }
+        }
+    }
+
+    /// Cuts the repulsion's part of the increment (`ws.avoid`, as the last saturation
+    /// round applied it) to the fraction [`avoid::step_fraction`] finds on the model
+    /// (`tip`: the gripper at `q`): a long null-space step moves the gripper by its
+    /// second-order terms, the position task takes that back, and its correction undid
+    /// the clearance the step had earned, so that the pair cycled instead of settling.
+    fn hold_repulsion(&self, ws: &mut Workspace, q: &[f64], tip: &Vec3) {
+        if ws.repulsions.is_empty() {
+            return;
+        }
+        let held = matches!(self.mode, Mode::Position | Mode::Hybrid).then_some(tip);
+        let t = avoid::step_fraction(
+            &self.arm,
+            q,
+            &ws.avoid,
+            (&ws.repulsions, held),
+            &mut ws.trial,
+        );
+        if t < 1.0 {
+            for (d, a) in ws.dq.iter_mut().zip(&ws.avoid) {
+                *d -= (1.0 - t) * a;
             }
         }
     }

@@ -196,7 +196,8 @@ impl<K: Kinematics> Resolver<K> {
     /// The null-space terms of eq. (13) / (20), each projected by
     /// `I − A⁺A − T⁺T` (`A⁺ = Aᵀ pa` with A = `ws.a`; `T⁺ = Tᵀ pt` with T = `ws.t`, if
     /// given): `ws.null = s (I − A⁺A − T⁺T) ∇H` (skipped when the schedule gives `s = 0`)
-    /// and `ws.avoid = (I − A⁺A − T⁺T) Σ_j J_sj⁺ F_j` (eq. 9; never scheduled).
+    /// and `ws.avoid = Σ_j c_j f_j / ‖c_j‖²` with `c_j = (I − A⁺A − T⁺T) ∇g_j` (eq. 9 as a
+    /// one-row task on each gap, see [`avoid`]; never scheduled).
     fn add_null_terms(
         &self,
         ws: &mut Workspace,
@@ -204,7 +205,7 @@ impl<K: Kinematics> Resolver<K> {
         s: f64,
         pa: &Mat3,
         pt: Option<&Mat3>,
-        (eps, lam): Dls,
+        (eps, _): Dls,
     ) {
         if s != 0.0 {
             joint_limits::gradient_into(
@@ -219,9 +220,14 @@ impl<K: Kinematics> Resolver<K> {
             }
             project(&mut ws.null, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
         }
-        if !ws.repulsions.is_empty() {
-            avoid::add_pseudo_inverse_pushes(&ws.repulsions, &ws.free, eps, lam, &mut ws.avoid);
-            project(&mut ws.avoid, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
+        // Planning paper eq. (9) as a one-row task on each gap, solved in the null space
+        // of the tasks (eq. 20): c = P ∇g, Δq = c f / ‖c‖². Projecting the gap's row
+        // first, not the three-row push J_s⁺ F after, makes each obstacle's step an
+        // ascent of its own gap that vanishes where the gap is stationary (avoid.rs).
+        for j in 0..ws.repulsions.len() {
+            avoid::gap_row_into(&ws.repulsions[j], &ws.free, &mut ws.row);
+            project(&mut ws.row, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
+            avoid::add_gap_step(&ws.row, ws.repulsions[j].ask, eps, &mut ws.avoid);
         }
     }
 }
