@@ -12,6 +12,7 @@ from __future__ import annotations
 
 __all__ = [
     "ConfigError",
+    "DivergenceError",
     "HardwareError",
     "HardwareUnavailableError",
     "InputError",
@@ -33,7 +34,16 @@ class SoftarmError(Exception):
 
 
 class InputError(SoftarmError, ValueError):
-    """An argument has a wrong shape, type or value."""
+    """An argument has a wrong shape, type or value.
+
+    ``argument`` names it, ``value`` is the rejected value (None where there is no single
+    one) and ``expected`` says what is accepted. Errors from the native core always set
+    them; None where a Python caller did not.
+    """
+
+    argument: str | None = None
+    value: object = None
+    expected: str | None = None
 
 
 class ShapeError(InputError):
@@ -41,11 +51,17 @@ class ShapeError(InputError):
 
 
 class NonFiniteError(InputError):
-    """An argument contains NaN or an infinite value."""
+    """An argument contains NaN or an infinite value (``index``: the first one's flat
+    index)."""
+
+    index: int | None = None
 
 
 class OutOfRangeError(InputError):
-    """A value lies outside its allowed range (section index, fraction s, limits)."""
+    """A value lies outside its allowed range (section index, fraction s, limits);
+    ``bounds`` is the closed range ``(min, max)``."""
+
+    bounds: tuple[float, float] | None = None
 
 
 class ParameterError(InputError):
@@ -55,6 +71,10 @@ class ParameterError(InputError):
 class PoseError(InputError):
     """A 4x4 pose is malformed: non-finite, last row not [0, 0, 0, 1], or a rotation
     block that is not orthonormal with determinant +1."""
+
+
+class DivergenceError(SoftarmError, FloatingPointError):
+    """A simulation diverged: its state is no longer finite (time step too large?)."""
 
 
 class UnreachableError(SoftarmError):

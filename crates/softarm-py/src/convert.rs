@@ -10,7 +10,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt};
 use softarm_core::{Frame, Mat4, Vec3};
 
-use crate::errors::{InputError, OutOfRangeError, ShapeError};
+use crate::errors::{fielded, range_err, Given, InputError, ShapeError};
 
 static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
 static CONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
@@ -26,16 +26,21 @@ fn real_asarray<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, 
     let asarray = ASARRAY.get_or_try_init(py, || -> PyResult<Py<PyAny>> {
         Ok(py.import("numpy")?.getattr("asarray")?.unbind())
     })?;
-    let a = asarray.bind(py).call1((obj,)).map_err(|e| {
-        InputError::new_err(format!("{arg}: cannot be read as a float array ({e})"))
-    })?;
+    let a = asarray
+        .bind(py)
+        .call1((obj,))
+        .map_err(|e| unreadable(obj, arg, Some(&e)))?;
     let dtype = a.getattr("dtype")?;
     let kind: String = dtype.getattr("kind")?.extract()?;
     if !REAL_KINDS.contains(kind.as_str()) {
-        return Err(InputError::new_err(format!(
-            "{arg}: expected real numbers, got dtype {}",
-            dtype.str()?
-        )));
+        let got = format!("dtype {}", dtype.str()?);
+        let msg = format!("{arg}: expected real numbers, got {got}");
+        return Err(fielded(
+            InputError::new_err(msg),
+            arg,
+            Given::Text(got),
+            "real numbers",
+        ));
     }
     Ok(a)
 }
@@ -58,12 +63,34 @@ pub fn as_array<'py>(obj: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, 
     let converted = contiguous
         .bind(py)
         .call((real,), Some(&kwargs))
-        .map_err(|e| {
-            InputError::new_err(format!("{arg}: cannot be read as a float array ({e})"))
-        })?;
+        .map_err(|e| unreadable(obj, arg, Some(&e)))?;
     converted
         .cast_into::<PyArrayDyn<f64>>()
-        .map_err(|_| InputError::new_err(format!("{arg}: cannot be read as a float array")))
+        .map_err(|_| unreadable(obj, arg, None))
+}
+
+/// The [`InputError`] of an argument that numpy cannot read as a float array (`cause`:
+/// numpy's error), its `value` the type of the object given.
+fn unreadable(obj: &Bound<'_, PyAny>, arg: &str, cause: Option<&PyErr>) -> PyErr {
+    let msg = match cause {
+        Some(e) => format!("{arg}: cannot be read as a float array ({e})"),
+        None => format!("{arg}: cannot be read as a float array"),
+    };
+    fielded(InputError::new_err(msg), arg, type_of(obj), "a float array")
+}
+
+/// The name of `obj`'s type, as the `value` of a type error.
+pub fn type_of(obj: &Bound<'_, PyAny>) -> Given {
+    Given::Text(
+        obj.get_type()
+            .name()
+            .map_or_else(|_| "?".to_owned(), |n| n.to_string()),
+    )
+}
+
+/// `obj` as Python shows it, as the `value` of an error.
+fn shown(obj: &Bound<'_, PyAny>) -> String {
+    obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string())
 }
 
 /// A real scalar argument: a Python float or int, or a numpy real scalar or 0-d array.
@@ -74,15 +101,22 @@ pub fn real(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<f64> {
     }
     if obj.is_instance_of::<PyInt>() && !obj.is_instance_of::<PyBool>() {
         return obj.extract::<f64>().map_err(|_| {
-            let shown = obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string());
-            OutOfRangeError::new_err(format!("{arg} = {shown} is beyond the float range"))
+            let shown = shown(obj);
+            let msg = format!("{arg} = {shown} is beyond the float range");
+            range_err(msg, arg, Given::Text(shown), (f64::MIN, f64::MAX))
         });
     }
     let not_real = || -> PyResult<PyErr> {
-        Ok(InputError::new_err(format!(
+        let msg = format!(
             "{arg}: expected a real number, got {}",
             obj.get_type().name()?
-        )))
+        );
+        Ok(fielded(
+            InputError::new_err(msg),
+            arg,
+            type_of(obj),
+            "a real number",
+        ))
     };
     if obj.is_instance_of::<PyBool>() {
         return Err(not_real()?);
@@ -101,14 +135,25 @@ pub fn real(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<f64> {
 /// [`OutOfRangeError`] that shows the value given.
 pub fn count(obj: &Bound<'_, PyAny>, arg: &str, min: usize, max: usize) -> PyResult<usize> {
     let out_of_range = || {
-        let shown = obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string());
-        OutOfRangeError::new_err(format!("{arg} = {shown} is out of range [{min}, {max}]"))
+        let shown = shown(obj);
+        let msg = format!("{arg} = {shown} is out of range [{min}, {max}]");
+        let value = match shown.parse::<i64>() {
+            Ok(v) => Given::Int(v),
+            Err(_) => Given::Text(shown),
+        };
+        range_err(msg, arg, value, (min as f64, max as f64))
+    };
+    let not_integer = || -> PyResult<PyErr> {
+        let msg = format!("{arg}: expected an integer, got {}", obj.get_type().name()?);
+        Ok(fielded(
+            InputError::new_err(msg),
+            arg,
+            type_of(obj),
+            "an integer",
+        ))
     };
     if obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyFloat>() {
-        return Err(InputError::new_err(format!(
-            "{arg}: expected an integer, got {}",
-            obj.get_type().name()?
-        )));
+        return Err(not_integer()?);
     }
     match obj.extract::<i64>() {
         Ok(v) => usize::try_from(v)
@@ -116,11 +161,14 @@ pub fn count(obj: &Bound<'_, PyAny>, arg: &str, min: usize, max: usize) -> PyRes
             .filter(|&v| v >= min && v <= max)
             .ok_or_else(out_of_range),
         Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => Err(out_of_range()),
-        Err(_) => Err(InputError::new_err(format!(
-            "{arg}: expected an integer, got {}",
-            obj.get_type().name()?
-        ))),
+        Err(_) => Err(not_integer()?),
     }
+}
+
+/// The [`ShapeError`] "`arg`: expected `expected`, got `got`", its fields set.
+pub fn shape_err(arg: &str, expected: String, got: String) -> PyErr {
+    let msg = format!("{arg}: expected {expected}, got {got}");
+    fielded(ShapeError::new_err(msg), arg, Given::Text(got), &expected)
 }
 
 /// Shape of an array as a readable string, e.g. `(3, 4)`.
@@ -142,10 +190,11 @@ pub fn shape_str(shape: &[usize]) -> String {
 pub fn vector(obj: &Bound<'_, PyAny>, arg: &str, len: usize) -> PyResult<Vec<f64>> {
     let a = as_array(obj, arg)?;
     if a.shape() != [len] {
-        return Err(ShapeError::new_err(format!(
-            "{arg}: expected shape ({len},), got {}",
-            shape_str(a.shape())
-        )));
+        return Err(shape_err(
+            arg,
+            format!("shape ({len},)"),
+            shape_str(a.shape()),
+        ));
     }
     let ro = a.readonly();
     Ok(ro.as_slice()?.to_vec())
@@ -170,11 +219,8 @@ pub fn array_view<'py>(
             .iter()
             .map(|d| d.map_or("N".to_owned(), |v| v.to_string()))
             .collect();
-        return Err(ShapeError::new_err(format!(
-            "{arg}: expected shape ({}), got {}",
-            want.join(", "),
-            shape_str(actual)
-        )));
+        let expected = format!("shape ({})", want.join(", "));
+        return Err(shape_err(arg, expected, shape_str(actual)));
     }
     Ok(a)
 }

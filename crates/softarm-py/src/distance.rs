@@ -9,8 +9,8 @@ use softarm_core::chain::SectionModel;
 use softarm_core::distance::{self as dist, Obstacle};
 use softarm_core::{self as core, Vec3};
 
-use crate::convert::{array, count, points_out, real, reshape, vec3_out, vector};
-use crate::errors::{InputError, IntoPyResult};
+use crate::convert::{array, count, points_out, real, reshape, type_of, vec3_out, vector};
+use crate::errors::{fielded, Given, InputError, IntoPyResult};
 use crate::kinematics::{ArcChain, SoftArm};
 
 /// An arm model taken from Python: a `SoftArm` or an `ArcChain`.
@@ -30,10 +30,14 @@ impl Model {
         if let Ok(c) = obj.cast::<ArcChain>() {
             return Ok(Model::Chain(c.get().inner.clone()));
         }
-        Err(InputError::new_err(format!(
-            "{arg}: expected a SoftArm or an ArcChain, got {}",
-            obj.get_type().name()?
-        )))
+        let expected = "a SoftArm or an ArcChain";
+        let msg = format!("{arg}: expected {expected}, got {}", obj.get_type().name()?);
+        Err(fielded(
+            InputError::new_err(msg),
+            arg,
+            type_of(obj),
+            expected,
+        ))
     }
 
     /// Number of coordinates.
@@ -290,9 +294,14 @@ impl TriangleMesh {
             let mut t = [0u32; 3];
             for (k, &v) in c.iter().enumerate() {
                 if !(v >= 0.0 && v.fract() == 0.0 && v < u32::MAX as f64) {
-                    return Err(InputError::new_err(format!(
-                        "triangles: expected non-negative integer vertex indices, got {v}"
-                    )));
+                    let expected = "non-negative integer vertex indices";
+                    let msg = format!("triangles: expected {expected}, got {v}");
+                    return Err(fielded(
+                        InputError::new_err(msg),
+                        "triangles",
+                        Given::Float(v),
+                        expected,
+                    ));
                 }
                 t[k] = v as u32;
             }
@@ -378,10 +387,16 @@ pub fn obstacle_from(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Obstacle> {
     // every obstacle form), like every obstacle the core receives.
     match vector(obj, arg, 3) {
         Ok(v) => Ok(Obstacle::Point(Vec3::new(v[0], v[1], v[2]))),
-        Err(_) => Err(InputError::new_err(format!(
-            "{arg}: expected a PolynomialCurve, Segment, PointCloud, TriangleMesh or a point (3,), got {}",
-            obj.get_type().name()?
-        ))),
+        Err(_) => {
+            let expected = "a PolynomialCurve, Segment, PointCloud, TriangleMesh or a point (3,)";
+            let msg = format!("{arg}: expected {expected}, got {}", obj.get_type().name()?);
+            Err(fielded(
+                InputError::new_err(msg),
+                arg,
+                type_of(obj),
+                expected,
+            ))
+        }
     }
 }
 

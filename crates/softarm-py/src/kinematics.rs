@@ -7,11 +7,12 @@ use pyo3::types::{PyList, PyTuple, PyType};
 use softarm_core::chain::{forward_jacobian_into, forward_unchecked, SectionModel};
 use softarm_core::{self as core, Kinematics};
 
+use crate::convert::type_of;
 use crate::convert::{
     array, count, dmatrix_out, mat4_out, matrix3x_out, points_out, real, vec3_out, vector,
     write_dmatrix, write_frame, write_mat4,
 };
-use crate::errors::{InputError, IntoPyResult};
+use crate::errors::{fielded, InputError, IntoPyResult};
 
 /// Converts a Python section index, rejecting negative and too large values by name.
 fn section_index<M: SectionModel>(model: &M, section: &Bound<'_, PyAny>) -> PyResult<usize> {
@@ -25,20 +26,32 @@ fn sections_arg(obj: &Bound<'_, PyAny>) -> PyResult<Vec<core::Section>> {
     } else if let Ok(t) = obj.cast::<PyTuple>() {
         t.iter().collect()
     } else {
-        return Err(InputError::new_err(format!(
+        let msg = format!(
             "sections: expected a list of Section, got {}",
             obj.get_type().name()?
-        )));
+        );
+        return Err(fielded(
+            InputError::new_err(msg),
+            "sections",
+            type_of(obj),
+            "a list of Section",
+        ));
     };
     items
         .iter()
         .enumerate()
         .map(|(k, item)| match item.cast::<Section>() {
             Ok(s) => Ok(s.get().inner),
-            Err(_) => Err(InputError::new_err(format!(
-                "sections[{k}]: expected a Section, got {}",
-                item.get_type().name()?
-            ))),
+            Err(_) => {
+                let arg = format!("sections[{k}]");
+                let msg = format!("{arg}: expected a Section, got {}", item.get_type().name()?);
+                Err(fielded(
+                    InputError::new_err(msg),
+                    &arg,
+                    type_of(item),
+                    "a Section",
+                ))
+            }
         })
         .collect()
 }

@@ -7,9 +7,9 @@ use pyo3::types::PyDict;
 use softarm_core::planner::{self as pl, scenarios};
 use softarm_core::{self as core, Vec3};
 
-use crate::convert::{array, count, points_out, real, reshape, vec3_out, vector};
+use crate::convert::{array, count, points_out, real, reshape, type_of, vec3_out, vector};
 use crate::distance::{obstacle_from, Model, PolynomialCurve};
-use crate::errors::{InputError, IntoPyResult};
+use crate::errors::{fielded, given_text, unknown_termination, InputError, IntoPyResult};
 use crate::kinematics::{ArcChain, SoftArm};
 use softarm_core::error::MAX_ITERATIONS;
 
@@ -308,12 +308,9 @@ fn paper_scenario<'py>(
     name: &Bound<'py, PyAny>,
 ) -> PyResult<(Bound<'py, numpy::PyArray1<f64>>, Vec<PolynomialCurve>)> {
     let name = name.cast::<pyo3::types::PyString>().map_err(|_| {
-        InputError::new_err(format!(
-            "name: expected a str, got {}",
-            name.get_type()
-                .name()
-                .map_or_else(|_| "?".to_owned(), |n| n.to_string())
-        ))
+        let got = type_of(name);
+        let msg = format!("name: expected a str, got {}", given_text(&got));
+        fielded(InputError::new_err(msg), "name", got, "a str")
     })?;
     let sc = scenarios::scenario(name.to_str()?).py()?;
     let curves = sc
@@ -344,7 +341,7 @@ fn _rebuild_plan(
     ]
     .into_iter()
     .find(|t| t.name() == termination)
-    .ok_or_else(|| InputError::new_err(format!("termination: unknown {termination:?}")))?;
+    .ok_or_else(|| unknown_termination(termination))?;
     Ok(Plan {
         inner: pl::Plan {
             path: flat.chunks_exact(n.max(1)).map(<[f64]>::to_vec).collect(),

@@ -10,9 +10,12 @@ use softarm_core::error::MAX_ITERATIONS;
 use softarm_core::resolver::{self as core, Mode, Schedule, SolveOptions, Target};
 use softarm_core::SoftArm as CoreArm;
 
-use crate::convert::{array, as_array, shape_str};
+use crate::convert::{array, as_array, shape_err, shape_str, type_of};
 use crate::distance::obstacle_from;
-use crate::errors::{InputError, IntoPyResult, ParameterError, ShapeError};
+use crate::errors::{
+    fielded, given_text, parameter_err, range_err, unknown_termination, Given, InputError,
+    IntoPyResult, ParameterError,
+};
 use crate::kinematics::SoftArm;
 
 /// The core's declaration of a float gain named `name`.
@@ -34,27 +37,31 @@ fn apply(mut g: core::Gains, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<cor
         for (k, v) in kw.iter() {
             let name: String = k.extract()?;
             if let Some(f) = float_field(&name) {
-                let x = v.extract::<f64>().map_err(|_| {
-                    ParameterError::new_err(format!("{name}: expected a float, got {v}"))
-                })?;
+                let x = v
+                    .extract::<f64>()
+                    .map_err(|_| parameter_err(&name, &v, "a float"))?;
                 (f.set)(&mut g, x);
             } else if name == "schedule" {
-                let s: String = v.extract().map_err(|_| {
-                    ParameterError::new_err(format!("schedule: expected a str, got {v}"))
-                })?;
+                let s: String = v
+                    .extract()
+                    .map_err(|_| parameter_err("schedule", &v, "a str"))?;
                 g.schedule = Schedule::parse(&s).py()?;
             } else if name == "axis_mask" {
-                let m: Vec<bool> = v.extract().map_err(|_| {
-                    ParameterError::new_err(format!("axis_mask: expected 3 bools, got {v}"))
-                })?;
+                let m: Vec<bool> = v
+                    .extract()
+                    .map_err(|_| parameter_err("axis_mask", &v, "3 bools"))?;
                 g.axis_mask = <[bool; 3]>::try_from(m.as_slice()).map_err(|_| {
-                    ShapeError::new_err(format!("axis_mask: expected 3 bools, got {}", m.len()))
+                    shape_err("axis_mask", "3 bools".to_owned(), m.len().to_string())
                 })?;
             } else {
-                return Err(ParameterError::new_err(format!(
-                    "{name}: unknown gain; expected one of {}",
-                    field_names().collect::<Vec<_>>().join(", ")
-                )));
+                let expected = format!("one of {}", field_names().collect::<Vec<_>>().join(", "));
+                let msg = format!("{name}: unknown gain; expected {expected}");
+                return Err(fielded(
+                    ParameterError::new_err(msg),
+                    &name,
+                    Given::Text(name.clone()),
+                    &expected,
+                ));
             }
         }
     }
@@ -344,10 +351,11 @@ fn target(obj: &Bound<'_, PyAny>) -> PyResult<Target> {
     match shape.as_slice() {
         [4, 4] => Ok(Target::Pose(Matrix4::from_row_slice(flat))),
         [3] => Ok(Target::Position(Vector3::from_column_slice(flat))),
-        _ => Err(ShapeError::new_err(format!(
-            "target: expected shape (4, 4) or (3,), got {}",
-            shape_str(&shape)
-        ))),
+        _ => Err(shape_err(
+            "target",
+            "shape (4, 4) or (3,)".to_owned(),
+            shape_str(&shape),
+        )),
     }
 }
 
@@ -373,20 +381,22 @@ fn obstacle_list(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Obstacle>> {
         }
     }
     let iter = obj.try_iter().map_err(|_| {
-        InputError::new_err(format!(
-            "obstacles: expected a sequence of obstacles, got {}",
-            obj.get_type()
-                .name()
-                .map(|n| n.to_string())
-                .unwrap_or_default()
-        ))
+        let got = type_of(obj);
+        let expected = "a sequence of obstacles";
+        let msg = format!("obstacles: expected {expected}, got {}", given_text(&got));
+        fielded(InputError::new_err(msg), "obstacles", got, expected)
     })?;
     let mut out = Vec::new();
     for (i, item) in iter.enumerate() {
         if i >= MAX_OBSTACLES {
-            return Err(crate::errors::OutOfRangeError::new_err(format!(
-                "obstacles: more than {MAX_OBSTACLES} obstacles"
-            )));
+            let msg = format!("obstacles: more than {MAX_OBSTACLES} obstacles");
+            let bounds = (0.0, MAX_OBSTACLES as f64);
+            return Err(range_err(
+                msg,
+                "obstacles",
+                Given::Text("more".to_owned()),
+                bounds,
+            ));
         }
         out.push(obstacle_from(&item?, &format!("obstacles[{i}]"))?);
     }
@@ -415,12 +425,9 @@ impl Resolver {
         let mode: String = match mode.filter(|m| !m.is_none()) {
             None => "hybrid".to_owned(),
             Some(m) => m.extract().map_err(|_| {
-                InputError::new_err(format!(
-                    "mode: expected a string, got {}",
-                    m.get_type()
-                        .name()
-                        .map_or_else(|_| "?".to_owned(), |n| n.to_string())
-                ))
+                let got = type_of(m);
+                let msg = format!("mode: expected a string, got {}", given_text(&got));
+                fielded(InputError::new_err(msg), "mode", got, "a string")
             })?,
         };
         let mode = Mode::parse(&mode).py()?;
@@ -570,10 +577,11 @@ impl LagModel {
     fn new(tau_s: f64, period_s: f64, q0: &Bound<'_, PyAny>) -> PyResult<Self> {
         let (q0, _) = array(q0, "q0", &[None])?;
         if q0.is_empty() || q0.len() > 1024 {
-            return Err(ShapeError::new_err(format!(
-                "q0: expected 1 to 1024 elongations, got {}",
-                q0.len()
-            )));
+            return Err(shape_err(
+                "q0",
+                "1 to 1024 elongations".to_owned(),
+                q0.len().to_string(),
+            ));
         }
         Ok(LagModel {
             inner: core::LagModel::new(tau_s, period_s, &q0).py()?,
@@ -655,10 +663,11 @@ fn add_float_properties(py: Python<'_>) -> PyResult<()> {
 fn pickled_vector(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<f64>> {
     let (v, _) = array(obj, arg, &[None])?;
     if v.is_empty() || v.len() > 1024 {
-        return Err(ShapeError::new_err(format!(
-            "{arg}: expected 1 to 1024 values, got {}",
-            v.len()
-        )));
+        return Err(shape_err(
+            arg,
+            "1 to 1024 values".to_owned(),
+            v.len().to_string(),
+        ));
     }
     Ok(v)
 }
@@ -704,7 +713,7 @@ fn _rebuild_solution(
     ]
     .into_iter()
     .find(|t| t.name() == termination)
-    .ok_or_else(|| InputError::new_err(format!("termination: unknown {termination:?}")))?;
+    .ok_or_else(|| unknown_termination(termination))?;
     Ok(Solution {
         inner: core::Solution {
             q: pickled_vector(q, "q")?,

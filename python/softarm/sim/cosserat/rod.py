@@ -42,7 +42,7 @@ import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm._core import SoftArm
-from softarm.errors import NonFiniteError, ShapeError
+from softarm.errors import DivergenceError, NonFiniteError, ShapeError
 from softarm.geometry import ACTUATOR_RADIUS
 from softarm.sim.cosserat import require_elastica
 from softarm.sim.cosserat.params import RodParameters
@@ -254,7 +254,7 @@ class RodArm:
         self.steps += n
         v = self.rod.velocity_collection
         if not np.all(np.isfinite(v)):
-            raise FloatingPointError("the Cosserat rod diverged (time step too large?)")
+            raise DivergenceError("the Cosserat rod diverged (time step too large?)")
         self._at_rest = float(np.sqrt((v * v).sum(axis=0)).max()) < 0.1 * self.params.settle_speed
         self._rest_at = self.elongation.copy()
 
@@ -271,7 +271,7 @@ class RodArm:
             spent += 100 * self.dt
             v = self.rod.velocity_collection
             if not np.all(np.isfinite(v)):
-                raise FloatingPointError("the Cosserat rod diverged (time step too large?)")
+                raise DivergenceError("the Cosserat rod diverged (time step too large?)")
             if float(np.sqrt((v * v).sum(axis=0)).max()) < p.settle_speed:
                 break
         return spent
