@@ -1,108 +1,85 @@
-"""A berry's position from the eye-in-hand camera as the gripper closes in on it.
+"""A berry's position from the two cameras together as the gripper closes in on it.
 
-One C2 view gives the ray the berry lies on, and its apparent size gives its distance
-only as well as its width is known (z = f D / d: a fruit's width varies by ±15 %, so
-±15 % of the distance). As the arm approaches, C2 sees the berry from a sequence of
-tracked poses (eq. 21): the rays cross, and the growth of the apparent radius with the
-known advance fixes the distance whatever the fruit's true width (the looming of a
-fruit, r_i = f R / |p − c_i| for every view i, with R unknown but shared). The
-estimate solves for the centre p and the radius R by least squares over the recent
-views, with C1's stereo position and the nominal fruit size as priors.
+C1's stereo places a berry well across its line of sight (a fifth of a pixel, a fifth
+of a millimetre at 1 m) and poorly along it (half a pixel of disparity, ±5 mm). C2
+places it well across its own line of sight and, without a tag of known size, not at
+all along it: a fruit's width varies by ±15 %, and so would its distance from its
+apparent size. The two lines of sight cross at 40–50° (C1 looks across the bush, C2
+along the approach), so the berry is where C2's ray through the fruit passes nearest
+C1's ray to it: each camera supplies the directions it measures well.
+
+C2's ray reaches the base frame through the tracked end effector (eq. 21), and so
+does the gripper (eq. 22): an error of the cube tracking moves the fix and the
+gripper together and cancels at the grasp, as it does for a tag in the tag world.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-from scipy.optimize import least_squares
 
 from softarm.checks import FloatArray
 from softarm.perception.berries import BerryDetection
 from softarm.vision.camera_model import CameraModel
 
-__all__ = ["ApproachTriangulation", "Sighting"]
+__all__ = ["RayCrossing", "distance_from_size"]
 
-#: The farthest (m, per axis) the estimate may move from C1's position: C1's stereo
-#: puts a berry within a centimetre, so a farther estimate is another fruit's.
-MAX_SHIFT = 0.015
-#: The nominal fruit radius (m) and its spread: 1.5–2.5 cm across.
-FRUIT_RADIUS = (0.011, 0.003)
-
-
-@dataclass(frozen=True)
-class Sighting:
-    """One C2 view: the optical centre and the unit ray to the berry's image centre (base
-    frame), its apparent radius and the focal length (px)."""
-
-    centre: FloatArray
-    ray: FloatArray
-    radius_px: float
-    focal: float
+#: A detection is this berry when its size is within this ratio of the expected one...
+SIZE_RANGE = (0.6, 1.6)
+#: ...and its centre within the expected radius, or this many pixels, of the expected one.
+MIN_GATE_PX = 8.0
+#: Rays crossing at less than this angle (rad) leave the depth undetermined.
+MIN_CROSSING = np.radians(15.0)
 
 
-class ApproachTriangulation:
-    """The berry's centre from its C2 sightings (see the module docstring).
+def distance_from_size(radius_m: float, radius_px: float, focal: float) -> float:
+    """The distance (m) to the centre of a sphere of ``radius_m`` whose outline has
+    ``radius_px`` in an image of focal length ``focal`` (px): R / sin(atan(r / f))."""
+    return radius_m / float(np.sin(np.arctan2(radius_px, focal)))
+
+
+class RayCrossing:
+    """The berry where C2's ray to it crosses C1's (see the module docstring).
 
     Args:
-        prior: the berry's position from C1's stereo (base frame, m).
-        prior_sigma: its uncertainty (m).
-        ray_px, size_px: the uncertainty (px) of a detection's centre and radius.
-        bin_width: sightings are kept one per ``bin_width`` (m) of distance to the
-            prior, the latest in each: the fine positioning holds the camera at one
-            distance for hundreds of frames, and a window of the latest views alone
-            would lose the spread of distances that the looming needs.
+        c1_centre: C1's (left eye's) optical centre in the base frame.
+        position: the berry's position from C1's stereo (base frame), which gives C1's
+            ray and, with ``radius`` (m), where and how large C2 should see it.
     """
 
-    def __init__(
-        self,
-        prior: FloatArray,
-        prior_sigma: float = 0.006,
-        ray_px: float = 1.0,
-        size_px: float = 1.5,
-        bin_width: float = 0.004,
-    ) -> None:
-        self.prior = np.asarray(prior, dtype=np.float64)
-        self.prior_sigma, self.ray_px, self.size_px = prior_sigma, ray_px, size_px
-        self.bin_width = bin_width
-        self._bins: dict[int, Sighting] = {}
-        self._last = np.append(self.prior, FRUIT_RADIUS[0])
+    def __init__(self, c1_centre: FloatArray, position: FloatArray, radius: float) -> None:
+        self.c1_centre = np.asarray(c1_centre, dtype=np.float64)
+        self.position = np.asarray(position, dtype=np.float64)
+        ray = self.position - self.c1_centre
+        self.c1_ray = ray / np.linalg.norm(ray)
+        self.radius = float(radius)
 
-    def add(self, T_base_camera: FloatArray, camera: CameraModel, det: BerryDetection) -> None:
-        """Record ``det``, seen by ``camera`` at ``T_base_camera``."""
+    def fix(
+        self, det: BerryDetection, T_base_camera: FloatArray, camera: CameraModel
+    ) -> FloatArray | None:
+        """The berry's centre in the camera's frame, on the ray through ``det`` where it
+        passes nearest C1's ray; None when the two rays are too near parallel."""
         x, y = camera.normalize(np.array([det.center]))[0]
-        ray = T_base_camera[:3, :3] @ np.array([x, y, 1.0])
-        centre = T_base_camera[:3, 3].copy()
-        key = round(float(np.linalg.norm(self.prior - centre)) / self.bin_width)
-        self._bins[key] = Sighting(centre, ray / np.linalg.norm(ray), det.radius, camera.focal)
+        local = np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0])
+        origin, ray = T_base_camera[:3, 3], T_base_camera[:3, :3] @ local
+        # Closest points of o1 + s u1 and o2 + t u2: the 2x2 normal equations.
+        w = origin - self.c1_centre
+        b = float(self.c1_ray @ ray)
+        if 1.0 - b * b < np.sin(MIN_CROSSING) ** 2:
+            return None
+        t = (b * float(self.c1_ray @ w) - float(ray @ w)) / (1.0 - b * b)
+        return local * t
 
-    @property
-    def sightings(self) -> list[Sighting]:
-        """The sightings in use, one per distance bin."""
-        return list(self._bins.values())
-
-    def estimate(self) -> FloatArray:
-        """The berry's centre (base frame, m): the prior until a sighting is added."""
-        if not self.sightings:
-            return self.prior.copy()
-        lower = np.append(self.prior - MAX_SHIFT, FRUIT_RADIUS[0] - 2 * FRUIT_RADIUS[1])
-        upper = np.append(self.prior + MAX_SHIFT, FRUIT_RADIUS[0] + 2 * FRUIT_RADIUS[1])
-        start = np.clip(self._last, lower + 1e-9, upper - 1e-9)
-        # soft-L1: a view of a neighbour, or of a fruit half behind a finger, is
-        # outvoted rather than averaged in.
-        fit = least_squares(self._residuals, start, bounds=(lower, upper), loss="soft_l1")
-        self._last = fit.x
-        return fit.x[:3].copy()
-
-    def _residuals(self, x: FloatArray) -> FloatArray:
-        p, radius = x[:3], x[3]
-        out = [(p - self.prior) / self.prior_sigma,
-               [(radius - FRUIT_RADIUS[0]) / FRUIT_RADIUS[1]]]  # fmt: skip
-        for s in self.sightings:
-            v = p - s.centre
-            dist = max(float(np.linalg.norm(v)), 1e-3)
-            px_per_m = s.focal / dist
-            off_ray = v - (v @ s.ray) * s.ray  # perpendicular to the ray
-            out.append(off_ray * px_per_m / self.ray_px)
-            out.append([(s.focal * radius / dist - s.radius_px) / self.size_px])
-        return np.concatenate(out)
+    def consistent(
+        self, det: BerryDetection, T_base_camera: FloatArray, camera: CameraModel
+    ) -> bool:
+        """Whether ``det`` can be this berry: within its apparent radius of where C1
+        puts it, and of a size within SIZE_RANGE of what C1's radius gives there."""
+        p = np.linalg.inv(T_base_camera) @ np.append(self.position, 1.0)
+        dist = float(np.linalg.norm(p[:3]))
+        if p[2] <= 0.0 or dist <= self.radius:
+            return False
+        centre = camera.project(p[None, :3])[0]
+        expected = camera.focal * float(np.tan(np.arcsin(self.radius / dist)))
+        offset = float(np.hypot(det.center[0] - centre[0], det.center[1] - centre[1]))
+        ratio = det.radius / expected
+        return offset <= max(expected, MIN_GATE_PX) and SIZE_RANGE[0] <= ratio <= SIZE_RANGE[1]

@@ -53,7 +53,8 @@ class DetectorSettings:
 class BerryDetection:
     """One berry in an image: ``center`` (x, y) px, equivalent ``radius`` px, ``box``
     (x, y, w, h), ``mask`` (H, W) bool, ``score`` in [0, 1], ``ripeness`` and its
-    ``probability``; ``position`` (3,) in the camera frame (m) when depth was given."""
+    ``probability``; ``position`` (3,) in the camera frame (m) and ``radius_m``, the
+    fruit's radius as its outline shows it, when depth was given."""
 
     center: tuple[float, float]
     radius: float
@@ -63,6 +64,7 @@ class BerryDetection:
     ripeness: Ripeness
     probability: float
     position: FloatArray | None = None
+    radius_m: float | None = None
 
 
 def detect_berries(
@@ -191,6 +193,9 @@ def _detection(
         ripeness=ripeness,
         probability=float(p_ripe if ripeness == "ripe" else 1.0 - p_ripe),
         position=position,
+        radius_m=None
+        if position is None
+        else radius * float(np.linalg.norm(position)) / camera.focal,
     )
 
 

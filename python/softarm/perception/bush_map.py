@@ -13,16 +13,21 @@ import numpy as np
 from softarm.checks import FloatArray
 from softarm.perception.berries import BerryDetection, Ripeness
 
-__all__ = ["BushMap", "MappedBerry"]
+__all__ = ["FRUIT_RADIUS", "BushMap", "MappedBerry"]
+
+#: The nominal radius (m) of a fruit's outline: 1.5–2.5 cm across.
+FRUIT_RADIUS = 0.01
 
 
 @dataclass
 class MappedBerry:
     """One berry of the map: its ``id`` (the map's own, not a tag), mean ``position``
-    (base frame, m) over its ``sightings``, and the ripe share of those sightings."""
+    (base frame, m) and outline ``radius`` (m) over its ``sightings``, and the ripe
+    share of those sightings."""
 
     id: int
     position: FloatArray
+    radius: float
     ripe_votes: float
     sightings: int = 1
 
@@ -51,11 +56,13 @@ class BushMap:
             vote = d.probability if d.ripeness == "ripe" else 1.0 - d.probability
             known = self._near(d.position)
             if known is None:
-                self.berries.append(MappedBerry(len(self.berries), d.position.copy(), vote))
+                radius = d.radius_m or FRUIT_RADIUS
+                self.berries.append(MappedBerry(len(self.berries), d.position.copy(), radius, vote))
                 new += 1
             else:
                 n = known.sightings
                 known.position = (known.position * n + d.position) / (n + 1)
+                known.radius = (known.radius * n + (d.radius_m or known.radius)) / (n + 1)
                 known.ripe_votes += vote
                 known.sightings = n + 1
         return new

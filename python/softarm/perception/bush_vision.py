@@ -1,9 +1,8 @@
 """The two-camera vision of the markerless harvest: the end effector from the marker
 cube in C1 (eq. 22), as in the tag world; the selected berry from the bush map (C1's
 stereo, :mod:`softarm.perception.stereo`) while the gripper is far, and from C2 once it
-is near (eq. 21): C2 finds the berry without a tag in each frame, and its views from the
-tracked poses of the approach, with the map's position as a prior, give the berry's
-centre (:class:`~softarm.perception.approach.ApproachTriangulation`)."""
+is near (eq. 21): C2 finds the berry without a tag in each frame, and the berry is where
+C2's ray to it crosses C1's (:class:`~softarm.perception.approach.RayCrossing`)."""
 
 from __future__ import annotations
 
@@ -12,8 +11,8 @@ from typing import Any
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.perception.approach import ApproachTriangulation
-from softarm.perception.berries import BerryDetection, DetectorSettings, detect_berries
+from softarm.perception.approach import RayCrossing
+from softarm.perception.berries import DetectorSettings, detect_berries
 from softarm.perception.bush_map import BushMap
 from softarm.vision.detector import Detection
 from softarm.vision.observation import BerryTarget
@@ -25,9 +24,6 @@ __all__ = ["BushVision"]
 #: C2 is read while the grasp point is this close (m) to the mapped berry: beyond, the
 #: fusion uses C1 (its hand-over is at 6 cm), so C2's frame would go unused.
 C2_RANGE = 0.10
-#: How far (px) a detection may lie from where the mapped berry projects, beyond the
-#: detection's own radius.
-GATE_PX = 40.0
 
 
 class BushVision(CameraVision):
@@ -41,13 +37,16 @@ class BushVision(CameraVision):
         self.settings = DetectorSettings()
         self._T_ee_c2 = self.fusion.T_ee_c2
         self._grasp = np.array([0.0, 0.0, self.fusion.tool_point[2], 1.0])
-        self._track: ApproachTriangulation | None = None
+        self._track: RayCrossing | None = None
 
     def select(self, berry: BerryTarget) -> None:
         """Track the map's berry ``berry.tag_id``; its C2 sightings start afresh."""
         super().select(berry)
-        p = self._mapped()
-        self._track = None if p is None else ApproachTriangulation(p)
+        entry = self.bush_map.get(berry.tag_id)
+        self._track = (
+            None if entry is None
+            else RayCrossing(self.T_base_c1[:3, 3], entry.position, entry.radius)
+        )  # fmt: skip
 
     def _mapped(self) -> FloatArray | None:
         berry = self.bush_map.get(self.selected.tag_id)
@@ -65,25 +64,14 @@ class BushVision(CameraVision):
         return float(np.linalg.norm(grasp - p)) < C2_RANGE
 
     def _berry_c2(self, image: Any, T_c1_ee: FloatArray | None) -> FloatArray | None:
-        p = self._mapped()
-        if T_c1_ee is None or p is None:
+        track = self._track
+        if T_c1_ee is None or track is None:
             return None
-        T_c2_base = invert(self.T_base_c1 @ T_c1_ee @ self._T_ee_c2)
-        predicted = (T_c2_base @ np.append(p, 1.0))[:3]
-        if predicted[2] <= 0.0:
+        T_base_c2 = self.T_base_c1 @ T_c1_ee @ self._T_ee_c2
+        dets = detect_berries(image, self.model2, settings=self.settings)
+        found = [
+            d for d in dets if d.ripeness == "ripe" and track.consistent(d, T_base_c2, self.model2)
+        ]
+        if len(found) != 1:  # none, or two fruits where one is expected: no fix this frame
             return None
-        det = self._nearest(detect_berries(image, self.model2, settings=self.settings), predicted)
-        if det is None or self._track is None:
-            return None
-        self._track.add(invert(T_c2_base), self.model2, det)
-        return (T_c2_base @ np.append(self._track.estimate(), 1.0))[:3]
-
-    def _nearest(self, dets: list[BerryDetection], predicted: FloatArray) -> BerryDetection | None:
-        """The ripe detection nearest where the mapped berry projects, within the gate."""
-        centre = self.model2.project(predicted[None])[0]
-        best, gap = None, np.inf
-        for d in dets:
-            g = float(np.hypot(d.center[0] - centre[0], d.center[1] - centre[1]))
-            if d.ripeness == "ripe" and g < min(gap, GATE_PX + 2.0 * d.radius):
-                best, gap = d, g
-        return best
+        return track.fix(found[0], T_base_c2, self.model2)

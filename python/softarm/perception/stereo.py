@@ -72,11 +72,12 @@ def locate_berries(
             match_disparity(sil_l, sil_r, det, (d_lo, d_hi)),
             match_disparity(grey_l, grey_r, det, (d_lo, d_hi)),
         )
-        position = None
+        position = radius_m = None
         if d is not None and _plausible(d, det.radius, rect.baseline):
             centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
             position = (stereo.T_base_left @ np.append(centre, 1.0))[:3]
-        out.append(replace(det, position=position))
+            radius_m = det.radius * float(np.linalg.norm(centre)) / rect.focal
+        out.append(replace(det, position=position, radius_m=radius_m))
     return out
 
 
