@@ -164,6 +164,8 @@ def run_sim(
         from softarm.sweep.gains_file import apply_gains
 
         apply_gains(rig, gains)  # the closed-loop resolver's (--gains)
+    # What C1 saw at IDLE, before the arm moved (the rendered bush only).
+    seen = rig.scene.picture() if rig.scene is not None and plot_path is not None else None
     viewer = _viewer(rig, view, record)
     try:
         with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
@@ -180,11 +182,27 @@ def run_sim(
     if plot_path is not None:
         _plot(rig, report, plot_path)
         print(f"plot: {plot_path}")
+        if seen is not None:
+            seen_path = plot_path.with_name(plot_path.stem + "_c1.png")
+            _save_image(seen, seen_path)
+            print(f"what C1 saw: {seen_path}")
     if log_path is not None:
         print(f"log: {log_path}")
     if record is not None:
         print(f"recording: {record}")
     return 0 if all(b.final_state.value == "done" for b in report.berries) else 1
+
+
+def _save_image(image: Any, path: Path) -> None:
+    """Write an image through OpenCV's PNG encoder and the atomic writer."""
+    import cv2
+
+    from softarm.files.write import atomic_path
+
+    ok, png = cv2.imencode(".png", image)
+    if ok:
+        with atomic_path(path, "plot") as tmp:
+            tmp.write_bytes(png.tobytes())
 
 
 def _harvest(rig: SimRig, n: int, quiet: bool) -> HarvestReport:

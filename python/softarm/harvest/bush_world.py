@@ -20,6 +20,7 @@ from softarm.harvest.sim_devices import SimGripper
 from softarm.perception.bush_map import BushMap
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.canes import fit_canes
+from softarm.perception.overlay import draw_bush_map
 from softarm.perception.stereo import locate_berries
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.bush import Berry, Bush
@@ -110,6 +111,10 @@ class BushScene:
         p = invert(stereo.T_base_left) @ cube[:, 3]
         u, v = stereo.left.project(p[None, :3])[0]
         return float(u), float(v)
+
+    def picture(self) -> np.ndarray:
+        """C1's left image now, with the map's berries and fitted canes drawn on it."""
+        return draw_bush_map(self.c1_whole(0.0), self.bush_map, self.c1())
 
     def truth_of(self, berry_id: int) -> Berry | None:
         """The true berry (still on the bush or not) a map entry stands for, or None."""
