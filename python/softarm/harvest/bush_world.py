@@ -77,11 +77,16 @@ class BushScene:
         left, right = self.world.c1()
         return self.bush_map.update(locate_berries(left.colour, right.colour, self.c1()))
 
-    def fit_canes(self) -> list:
-        """The canes fitted from one C1 stereo view (the map keeps them)."""
+    def fit_canes(self, rig_parts: FloatArray, reach: float) -> list:
+        """The canes fitted from one C1 stereo view, without what is the rig's own: a fit
+        that comes within SELF_MARGIN of ``rig_parts`` ((N, 3) points of the arm's
+        model at the poses it looks from, its cube and the base tag) is the robot seen
+        by its own camera, the robot self-filter of any point-cloud pipeline; a fit
+        wholly beyond ``reach`` (m) of the base cannot be touched. The map keeps them."""
         draw_arm(self.world, self.plant)
         left, right = self.world.c1()
-        self.bush_map.canes = fit_canes(left.colour, right.colour, self.c1())
+        fits = fit_canes(left.colour, right.colour, self.c1())
+        self.bush_map.canes = [f for f in fits if _a_cane(f.points[:, :3], rig_parts, reach)]
         return [c.curve for c in self.bush_map.canes]
 
     def frames(self) -> tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray]]:
@@ -125,6 +130,16 @@ class BushScene:
             self.bush.berries, key=lambda b: float(np.linalg.norm(b.position - entry.position))
         )
         return near if np.linalg.norm(near.position - entry.position) <= TRUTH_MATCH else None
+
+
+#: How near (m) a fitted curve may come to the rig's own parts and still be a cane.
+SELF_MARGIN = 0.06
+
+
+def _a_cane(points: FloatArray, rig_parts: FloatArray, reach: float) -> bool:
+    gaps = np.linalg.norm(points[:, None, :] - rig_parts[None, :, :], axis=2)
+    in_reach = np.linalg.norm(points, axis=1) <= reach
+    return bool(gaps.min() > SELF_MARGIN and in_reach.any())
 
 
 class BushGripper(SimGripper):

@@ -222,7 +222,8 @@ def build_sim_rig(
     else:
         vision = _bush_vision(scene, cams, cfg.grasp_offset)
         gripper = BushGripper(scene, plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
-        canes = scene.fit_canes()  # the planner, resolver and clearance avoid these
+        # The planner, resolver and clearance avoid these.
+        canes = scene.fit_canes(_rig_parts(model, cfg, cams), CANE_REACH)
     # The plant's lag, measured by `softarm identify` when given, else declared by the
     # plant description (its regulators' time constant, as a datasheet states it).
     lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
@@ -297,6 +298,26 @@ def build_sim_rig(
 #: fills much of it in the last centimetres, and the software rasteriser's cost goes
 #: with the pixels.
 C2_SCALE = 0.5
+
+
+#: Canes farther than this (m) from the base cannot be touched by the arm (it is
+#: 0.56 m long); the map leaves them out.
+CANE_REACH = 0.75
+
+
+def _rig_parts(model: softarm.SoftArm, cfg: HarvestConfig, cams: SimCameras) -> np.ndarray:
+    """(N, 3) points of what C1 sees of the rig itself when it looks (the arm's model
+    at rest and at home, its cube, the base tag), in the base frame."""
+    parts = []
+    for q in (np.zeros(model.n_actuators), np.full(model.n_actuators, cfg.home_elongation)):
+        parts.append(model.backbone(q, 12))
+        cube = model.forward(q) @ cams.T_ee_cube
+        corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+        parts.append(cube[:3, 3] + 0.05 * corners @ cube[:3, :3].T)
+    tag = cams.T_base_tag
+    square = np.array([[x, y, 0.0] for x in (-1, 0, 1) for y in (-1, 0, 1)]) * 0.05
+    parts.append(tag[:3, 3] + square @ tag[:3, :3].T)
+    return np.vstack(parts)
 
 
 def _bush_scene(bush: Bush, plant: ArmPlant, cams: SimCameras) -> BushScene:
