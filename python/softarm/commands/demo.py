@@ -23,6 +23,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--out", type=output_dir, default="out", help="output folder")
     p.add_argument("--berries", type=int_range(1, 1000), default=5, help="berries to harvest")
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the bush and arm")
+    p.add_argument(
+        "--world", choices=("tags", "bush"), default="tags",
+        help="'tags' (default): tagged berries, mapped canes; 'bush': the markerless "
+        "harvest in the rendered bush (render extra), with harvest_c1.png, what C1 saw",
+    )  # fmt: skip
     add_plant_options(p, sim_only_flag=False)
     add_quiet(p)
     p.set_defaults(run=run)
@@ -34,6 +39,10 @@ def run(args: argparse.Namespace) -> int:
     from softarm.commands.harvest import configure_logging, run_sim
 
     options = plant_options(args)  # a bad --plant/--identified fails before any output
+    if args.world == "bush":
+        from softarm.commands.harvest import BUSH_UNRIPE_FRACTION
+
+        options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
     configure_logging(args.quiet)
     args.out.mkdir(parents=True, exist_ok=True)
     log = args.out / "harvest_log.jsonl"

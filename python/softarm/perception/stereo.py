@@ -37,6 +37,8 @@ from softarm.vision.camera_model import CameraModel
 
 __all__ = ["locate_berries", "match_disparity"]
 
+#: Rows (px) read above and below the berries.
+BAND_MARGIN = 8
 #: The blur (px) of the silhouettes: the edge spread over a few pixels gives the match
 #: a smooth cost, whose parabola vertex is the sub-pixel disparity.
 SILHOUETTE_BLUR = 1.0
@@ -60,14 +62,20 @@ def locate_berries(
     ``box`` and ``mask`` refer to the rectified left image. A berry that cannot be
     matched in the right image is returned without a position."""
     rect = stereo.rectification
-    L, R = rect.rectify(left, right)
+    mx, my = rect.maps[0]
+    L = cv2.remap(left, mx, my, cv2.INTER_LINEAR)
     rect_cam = CameraModel(rect.P1[:3, :3], None, rect.size)
-    out = []
-    sil_l, sil_r = (_silhouettes(img, settings) for img in (L, R))
-    grey_l, grey_r = (cv2.cvtColor(img, cv2.COLOR_BGR2GRAY).astype(np.float32) for img in (L, R))
+    detections = detect_berries(L, rect_cam, settings=settings)
+    if not detections:
+        return []
+    rows = _band(detections, L.shape[0])
+    R = _rectified_rows(right, rect.maps[1], rows, L.shape)
+    sil_l, sil_r = (_silhouettes(img, rows, settings) for img in (L, R))
+    grey_l, grey_r = (_grey(img, rows) for img in (L, R))
     d_lo = rect.focal * rect.baseline / DEPTH_RANGE[1]
     d_hi = rect.focal * rect.baseline / DEPTH_RANGE[0]
-    for det in detect_berries(L, rect_cam, settings=settings):
+    out = []
+    for det in detections:
         d = _agreed(
             match_disparity(sil_l, sil_r, det, (d_lo, d_hi)),
             match_disparity(grey_l, grey_r, det, (d_lo, d_hi)),
@@ -128,12 +136,39 @@ def _agreed(by_outline: float | None, by_shading: float | None) -> float | None:
     return 0.5 * (by_outline + by_shading)
 
 
-def _silhouettes(image: npt.NDArray[np.uint8], settings: DetectorSettings | None) -> FloatArray:
-    """The fruit silhouettes of a rectified image as a smooth [0, 1] image: what the two
-    eyes match, so that neither the background behind a fruit nor the highlights on it
-    (which move with the eye) pull the match."""
-    mask = fruit_mask(image, settings).astype(np.float32) / 255.0
-    return cv2.GaussianBlur(mask, (0, 0), SILHOUETTE_BLUR)
+def _band(detections: list[BerryDetection], height: int) -> slice:
+    """The rows the matching reads: those of the berries, with a margin."""
+    top = min(d.box[1] for d in detections) - BAND_MARGIN
+    bottom = max(d.box[1] + d.box[3] for d in detections) + BAND_MARGIN
+    return slice(max(top, 0), min(bottom, height))
+
+
+def _rectified_rows(
+    image: npt.NDArray[np.uint8], maps: tuple, rows: slice, shape: tuple[int, ...]
+) -> npt.NDArray[np.uint8]:
+    """The rectified ``image`` on ``rows`` only, black elsewhere (the right eye is read
+    only where the berries' rows are)."""
+    out = np.zeros(shape, np.uint8)
+    out[rows] = cv2.remap(image, maps[0][rows], maps[1][rows], cv2.INTER_LINEAR)
+    return out
+
+
+def _grey(image: npt.NDArray[np.uint8], rows: slice) -> FloatArray:
+    out = np.zeros(image.shape[:2], np.float32)
+    out[rows] = cv2.cvtColor(image[rows], cv2.COLOR_BGR2GRAY)
+    return out
+
+
+def _silhouettes(
+    image: npt.NDArray[np.uint8], rows: slice, settings: DetectorSettings | None
+) -> FloatArray:
+    """The fruit silhouettes of a rectified image's ``rows`` as a smooth [0, 1] image:
+    what the two eyes match, so that neither the background behind a fruit nor the
+    highlights on it (which move with the eye) pull the match."""
+    out = np.zeros(image.shape[:2], np.float32)
+    mask = fruit_mask(image[rows], settings).astype(np.float32) / 255.0
+    out[rows] = cv2.GaussianBlur(mask, (0, 0), SILHOUETTE_BLUR)
+    return out
 
 
 def _plausible(disparity: float, radius_px: float, baseline: float) -> bool:

@@ -1,0 +1,71 @@
+"""The markerless harvest's goals from its reports (``softarm harvest --sim --world bush
+--report``): harvested share of the ripe berries in reach, the ripe ones never mapped,
+unripe picked, true fine-positioning error, contacts, the cane map; and the wall time
+per berry beside the tag world's on the same seeds when its reports and times are given.
+
+    python -m softarm.experiments.bush_harvest docs/data/perception/bush_harvest_700-709
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+import sys
+from pathlib import Path
+from typing import Any
+
+__all__ = ["summarise"]
+
+
+def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
+    """Pooled figures over ``reports`` (one per bush)."""
+    ripe = sum(r["ripe_in_reach"] for r in reports)
+    errors = [b["true_position_error_mm"] for r in reports for b in r["berries"] if b["harvested"]]
+    maps = [r["cane_map"] for r in reports]
+    return {
+        "bushes": len(reports),
+        "ripe_in_reach": ripe,
+        "ripe_harvested": sum(r["ripe_harvested"] for r in reports),
+        "harvested_share": sum(r["ripe_harvested"] for r in reports) / max(ripe, 1),
+        "ripe_never_mapped": sum(r["ripe_never_mapped"] for r in reports),
+        "unripe_picked": sum(r["unripe_picked"] for r in reports),
+        "mean_true_fine_error_mm": statistics.fmean(errors) if errors else float("nan"),
+        "contact_steps": sum(r["branch_contact_steps"] for r in reports),
+        "cane_median_mm": statistics.median(m["median_mm"] for m in maps),
+        "cane_p95_mm": statistics.median(m["p95_mm"] for m in maps),
+        "cane_coverage": statistics.fmean(m["coverage"] for m in maps),
+        "sim_s_per_berry": sum(r["sim_time_s"] for r in reports)
+        / max(sum(len(r["berries"]) for r in reports), 1),
+    }
+
+
+def wall_per_berry(folder: Path) -> float:
+    """Whole-process wall seconds per berry attempted, from ``wall_times.txt`` (one
+    ``SEED wall SECONDS`` line per run, as /usr/bin/time -f writes them)."""
+    seconds = [
+        float(line.split()[-1])
+        for line in (folder / "wall_times.txt").read_text().splitlines()
+        if " wall " in line
+    ]
+    attempted = sum(len(r["berries"]) for r in _reports(folder))
+    return sum(seconds) / max(attempted, 1)
+
+
+def _reports(folder: Path) -> list[dict[str, Any]]:
+    return [json.loads(p.read_text()) for p in sorted(folder.glob("r*.json"))]
+
+
+def main(argv: list[str]) -> None:
+    """Print the pooled figures of each folder of reports on the command line."""
+    for name in argv:
+        folder = Path(name)
+        reports = _reports(folder)
+        bush = all(r.get("world") == "bush" for r in reports)
+        figures: dict[str, float] = summarise(reports) if bush else {"bushes": len(reports)}
+        if (folder / "wall_times.txt").exists():
+            figures["wall_s_per_berry"] = wall_per_berry(folder)
+        print(folder.name, json.dumps({k: round(v, 3) for k, v in figures.items()}))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
