@@ -11,6 +11,7 @@ A message always names the offending argument and, where it helps, its value.
 from __future__ import annotations
 
 __all__ = [
+    "CapabilityError",
     "ConfigError",
     "DivergenceError",
     "HardwareError",
@@ -95,6 +96,11 @@ class HardwareUnavailableError(HardwareError):
 
 class SafetyError(HardwareError):
     """A command was refused or the system was stopped by the safety layer."""
+
+
+class CapabilityError(InputError):
+    """An object handed to softarm lacks a method its role needs (a controller without
+    plan following or the model's pose); raised when the object is wired in."""
 
 
 class ConfigError(SoftarmError, ValueError):

@@ -135,6 +135,22 @@ class FakeController:
         q_next = np.clip(raw, 0.0, Q_MAX)
         return q_next, bool(np.any(q_next != raw))
 
+    def follow_step(self, q: np.ndarray, target: np.ndarray, current: np.ndarray):
+        return self.step(q, target, current)
+
+    def model_pose(self, q: np.ndarray) -> np.ndarray:
+        """The fake arm's pose at ``q`` (the plant's, exactly: the model has no error)."""
+        out = np.eye(4)
+        out[:3, :3] = FACING_Y
+        out[:3, 3] = P0 + K * np.asarray(q, dtype=np.float64)
+        return out
+
+    def limits(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.zeros(3), np.full(3, Q_MAX)
+
+    def way_gaps(self, q0: np.ndarray, q1: np.ndarray) -> None:
+        return None  # no known canes
+
 
 @dataclass
 class FakeGripper:

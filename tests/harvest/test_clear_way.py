@@ -17,7 +17,7 @@ from softarm.harvest.controller import ResolverController
 from softarm.harvest.servo import WAY_SLACK, Servo, straight_step
 from softarm.sim.bush import Bush
 
-from .fakes import FakeClock
+from .fakes import FakeClock, FakeController
 
 
 def test_straight_step_moves_along_the_line_at_the_fastest_channels_rate() -> None:
@@ -84,7 +84,7 @@ class _Lagging:
         return self.flight
 
 
-class _CaneAtHalf:
+class _CaneAtHalf(FakeController):
     """A controller with the model's gaps of an arm whose only cane is at q[0] = 0.5."""
 
     def way_gaps(self, q0: np.ndarray, q1: np.ndarray, steps: int = 41) -> np.ndarray:
@@ -125,10 +125,10 @@ def test_inside_the_margin_the_way_may_close_in_on_a_cane_only_by_the_slack() ->
     assert servo._clear_way(q, (nearer_by_twice_the_slack,)) is q
 
 
-def test_a_controller_without_the_models_gaps_takes_the_first_command() -> None:
+def test_a_controller_without_known_canes_takes_the_first_command() -> None:
     q = np.array([0.45, 0.0])
     first = np.array([0.8, 0.0])
-    servo = _servo(object(), flight=np.array([0.25, 0.0]))
+    servo = _servo(FakeController(), flight=np.array([0.25, 0.0]))  # its way_gaps: None
     assert servo._clear_way(q, (first, q)) is first
 
 

@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import numpy.typing as npt
 
+from softarm._core import Resolver
 from softarm.harvest.clearance import Clearance
 
 __all__ = ["ResolverController"]
@@ -42,15 +43,15 @@ class ResolverController:
 
     def __init__(
         self,
-        resolver: object,
+        resolver: Resolver,
         obstacles: Sequence[object] = (),
         plant_q: Callable[[], FloatArray | None] | None = None,
-        transport: object | None = None,
+        transport: Resolver | None = None,
         clearance: Clearance | None = None,
     ) -> None:
         self.resolver = resolver
         self.obstacles = list(obstacles)
-        self.arm = resolver.arm  # type: ignore[attr-defined]
+        self.arm = resolver.arm
         self.plant_q = plant_q
         self.transport = transport
         self.clearance = clearance
@@ -62,7 +63,7 @@ class ResolverController:
         bounded by the whole lag, no prediction) when given, else :meth:`step`."""
         if self.transport is None:
             return self.step(q, target, current)
-        info = self.transport.step(  # type: ignore[attr-defined]
+        info = self.transport.step(
             np.asarray(q, dtype=np.float64), target, current, obstacles=self.obstacles or None
         )
         return np.asarray(info.q, dtype=np.float64), bool(info.saturated)
@@ -74,7 +75,7 @@ class ResolverController:
         the measured pose ``current`` closing the loop (the Jacobian is the model's at q)."""
         q = np.asarray(q, dtype=np.float64)
         plant_q = self.plant_q() if current is not None and self.plant_q is not None else None
-        info = self.resolver.step(  # type: ignore[attr-defined]
+        info = self.resolver.step(
             q, target, current, obstacles=self.obstacles or None, plant_q=plant_q
         )
         return np.asarray(info.q, dtype=np.float64), bool(info.saturated)
@@ -83,6 +84,12 @@ class ResolverController:
         """The model's end-effector pose (4, 4) at ``q``: where a planned waypoint puts the
         gripper, the target the loop closes on while following a plan."""
         return np.asarray(self.arm.forward(q), dtype=np.float64)
+
+    def limits(self) -> tuple[FloatArray, FloatArray]:
+        """The model's (lower, upper) elongations (m)."""
+        return np.asarray(self.arm.lower, dtype=np.float64), np.asarray(
+            self.arm.upper, dtype=np.float64
+        )
 
     def way_gaps(self, q0: FloatArray, q1: FloatArray, steps: int = 8) -> FloatArray | None:
         """The model arm's gaps (m) to the canes at ``steps`` points of the straight line

@@ -21,10 +21,12 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
+from softarm.errors import CapabilityError
 from softarm.hardware.protocols import Gripper, RipenessSensor
 from softarm.vision.observation import BerryFix, BerryTarget, CameraName, Observation
 
 __all__ = [
+    "CONTROLLER_METHODS",
     "BerryFix",
     "BerryTarget",
     "CameraName",
@@ -39,6 +41,7 @@ __all__ = [
     "RipenessProbe",
     "RipenessSensor",
     "Vision",
+    "require_controller",
 ]
 
 FloatArray = npt.NDArray[np.float64]
@@ -74,7 +77,10 @@ class Vision(Protocol):
 
 
 class Controller(Protocol):
-    """One resolved-rate step towards a target pose (the hybrid resolver, eq. 20)."""
+    """The resolved-rate step towards a target pose (the hybrid resolver, eq. 20), and
+    what the servo needs of the controller's model to follow a plan and keep its way
+    clear of the known canes. Every method is required (:func:`require_controller`): a
+    controller without them would silently lose plan following and the cane checks."""
 
     def step(
         self, q: FloatArray, target: FloatArray, current: FloatArray | None
@@ -83,6 +89,44 @@ class Controller(Protocol):
         ``target``, with ``current`` the measured pose (None = use the model), and whether
         a joint limit clipped the step."""
         ...
+
+    def follow_step(
+        self, q: FloatArray, target: FloatArray, current: FloatArray
+    ) -> tuple[FloatArray, bool]:
+        """As :meth:`step`, while following a placement plan (its gain may differ)."""
+        ...
+
+    def model_pose(self, q: FloatArray) -> FloatArray:
+        """The model's end-effector pose (4, 4) at ``q``: the target while following a plan."""
+        ...
+
+    def limits(self) -> tuple[FloatArray, FloatArray]:
+        """The model's (lower, upper) elongations (m), which every command stays inside."""
+        ...
+
+    def way_gaps(self, q0: FloatArray, q1: FloatArray) -> FloatArray | None:
+        """The model arm's gaps (m) to the known canes along the straight line ``q0`` to
+        ``q1`` in actuator space, ends included; None when no canes are known."""
+        ...
+
+
+#: The methods of :class:`Controller`, checked by :func:`require_controller`.
+CONTROLLER_METHODS = ("step", "follow_step", "model_pose", "limits", "way_gaps")
+
+
+def require_controller(controller: object) -> Controller:
+    """``controller``, once it has every method of :class:`Controller`.
+
+    Raises:
+        CapabilityError: the methods it lacks, named.
+    """
+    missing = [m for m in CONTROLLER_METHODS if not callable(getattr(controller, m, None))]
+    if missing:
+        raise CapabilityError(
+            f"controller {type(controller).__name__} lacks {', '.join(missing)} "
+            "(softarm.harvest.interfaces.Controller)"
+        )
+    return controller  # type: ignore[return-value]
 
 
 class PlacementPlanner(Protocol):

@@ -20,6 +20,7 @@ from softarm.harvest.interfaces import (
     Observation,
     PlacementPlanner,
     PressureActuator,
+    require_controller,
 )
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.observe import BerryWatch
@@ -62,7 +63,8 @@ class Servo:
         config: HarvestConfig,
         log: HarvestLog,
     ) -> None:
-        self.clock, self.controller, self.actuator = clock, controller, actuator
+        self.clock, self.actuator = clock, actuator
+        self.controller = require_controller(controller)
         self.cfg, self.log = config, log
 
     # -- stages ---------------------------------------------------------------------
@@ -213,14 +215,10 @@ class Servo:
         out as the arm goes and the known canes repel it inside the step (planning paper
         eq. 9), where an open-loop ramp would carry the true arm, a few cm off the model,
         into a cane. The resolver alone is local: closed on a waypoint 20-30 cm away it
-        saturates on the joint limits, which is why the plan's q leads. A controller
-        without a model (``model_pose``) falls back to :meth:`ramp`."""
-        model_pose = getattr(self.controller, "model_pose", None)
-        arm = getattr(self.controller, "arm", None)
-        if model_pose is None or arm is None:
-            return self.ramp(watch, stage, q, q_way, deadline, observe=True)
+        saturates on the joint limits, which is why the plan's q leads."""
         c = self.cfg
-        lower, upper = np.asarray(arm.lower), np.asarray(arm.upper)
+        model_pose = self.controller.model_pose
+        lower, upper = self.controller.limits()
         step = c.home_speed * c.period
         nominal = np.asarray(q, dtype=np.float64).copy()  # the plan's point now
         goal_final = model_pose(q_way)
@@ -257,8 +255,7 @@ class Servo:
                     retreat_from=q,
                 )
             goal = model_pose(nominal)
-            step_fn = getattr(self.controller, "follow_step", self.controller.step)
-            q_fb, saturated = step_fn(q, goal, seen.pose)
+            q_fb, saturated = self.controller.follow_step(q, goal, seen.pose)
             advance = straight_step(nominal, q_way, step)
             # Feedforward of the plan's motion on top of the closed-loop correction, kept
             # inside the limits the resolver's own command respects.
@@ -296,13 +293,10 @@ class Servo:
         calibration the placement loop's correction piled up while the arm trailed, and
         the arm crossed a cane between two clear commands (docs/harvest.md). Holding
         ``q`` keeps the arm on the line checked the period before."""
-        way_gaps = getattr(self.controller, "way_gaps", None)
-        if way_gaps is None:
-            return candidates[0]
         flight = self.actuator.in_flight()
         arm_q = q if flight is None else q - flight
         for candidate in candidates:
-            gaps = way_gaps(arm_q, candidate)
+            gaps = self.controller.way_gaps(arm_q, candidate)
             if gaps is None:
                 return candidate
             need = min(self.cfg.transport_margin, gaps[0] - WAY_SLACK)
