@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from softarm._core import PolynomialCurve, closest
+from softarm._core import PolynomialCurve, SoftArm, closest
 
 # The radii are defined once in softarm.geometry (the Cosserat plant uses them too).
 from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
@@ -33,9 +33,9 @@ class Clearance:
         grasp_offset: the gripper reaches this far (m) ahead of the end-effector frame.
     """
 
-    def __init__(self, arm: object, canes: Sequence[PolynomialCurve], grasp_offset: float) -> None:
+    def __init__(self, arm: SoftArm, canes: Sequence[PolynomialCurve], grasp_offset: float) -> None:
         self.arm, self.canes, self.offset = arm, list(canes), grasp_offset
-        sections = arm.sections  # type: ignore[attr-defined]
+        sections = arm.sections
         self.radii = [s.radius + ACTUATOR_RADIUS + CANE_RADIUS for s in sections]
         self.plate = sections[-1].offset
         self.samples = [c(np.linspace(*c.u_range, 150)) for c in self.canes]  # (150, 3) each
@@ -48,7 +48,7 @@ class Clearance:
         for cane in self.canes:
             c = closest(self.arm, q, cane)
             gaps.append(c.distance - self.radii[c.section])
-        ee = self.arm.forward(q)  # type: ignore[attr-defined]
+        ee = self.arm.forward(q)
         tip = ee[:3, 3] + np.outer(np.linspace(-self.plate, self.offset, 6), ee[:3, 2])
         pts = np.concatenate(self.samples)
         d = np.linalg.norm(tip[:, None, :] - pts[None], axis=2).min()

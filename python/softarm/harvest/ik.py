@@ -67,7 +67,7 @@ class ModelIK:
 
     def __init__(
         self,
-        resolver: object,
+        resolver: Resolver,
         config: HarvestConfig,
         samples: int = 3000,
         starts: int = 4,
@@ -79,7 +79,7 @@ class ModelIK:
         limit_room: float = 0.001,
     ) -> None:
         self.resolver = resolver
-        self.arm = resolver.arm  # type: ignore[attr-defined]
+        self.arm = resolver.arm
         self.cfg = config
         self.samples, self.starts = samples, starts
         self.rng = np.random.default_rng(seed)
@@ -218,7 +218,7 @@ class ModelIK:
             starts += list(qs[np.argsort(score)[: self.starts]])
         found = []
         for q0 in starts:
-            sol = self.resolver.solve(  # type: ignore[attr-defined]
+            sol = self.resolver.solve(
                 q0, target, max_steps=1500, position_tolerance=1e-3, orientation_tolerance=0.02
             )
             if sol.converged:
