@@ -10,7 +10,6 @@ import pytest
 import softarm
 from softarm.errors import ConfigError
 from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
-from softarm.sweep.gains_file import apply_gains
 from softarm.sweep.spec import TrialSpec
 from softarm.sweep.trial import BERRY_COLUMNS, run_trial_rows
 
@@ -26,15 +25,17 @@ def test_a_trial_that_raises_is_one_error_row() -> None:
     assert set(BERRY_COLUMNS) <= set(row)
 
 
-def test_gains_replace_the_closed_loop_resolver_only() -> None:
-    rig = build_sim_rig(SimRigOptions(n_berries=1, seed=0, joint_limit_gain=-1e-5))
-    controller = rig.machine.servo.controller
-    apply_gains(rig, {"hybrid_alpha": 0.11})
-    assert controller.resolver.gains.hybrid_alpha == 0.11
-    assert controller.resolver.gains.hybrid_gamma == -1e-5  # the rig's own setting is kept
-    assert controller.resolver.arm.n_dofs == softarm.SoftArm.blackberry().n_dofs
+def test_gains_reach_every_controller_resolver() -> None:
+    options = SimRigOptions(
+        n_berries=1, seed=0, joint_limit_gain=-1e-5, gains={"hybrid_alpha": 0.11}
+    )
+    controller = build_sim_rig(options).machine.servo.controller
+    for resolver in (controller.resolver, controller.transport):
+        assert resolver.gains.hybrid_alpha == 0.11
+        assert resolver.gains.hybrid_gamma == -1e-5  # the rig's own setting is kept
+        assert resolver.arm.n_dofs == softarm.SoftArm.blackberry().n_dofs
     with pytest.raises(ConfigError, match="alpha: unknown gain"):
-        apply_gains(rig, {"alpha": 0.1})
+        build_sim_rig(SimRigOptions(n_berries=1, seed=0, gains={"alpha": 0.1}))
 
 
 def test_harvest_gains_option_checks_the_file_first(

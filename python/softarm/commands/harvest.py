@@ -156,14 +156,12 @@ def run_sim(
 
     if not quiet:
         print(f"simulated harvest: {berries} berries, seed {seed}", flush=True)
-    rig_options = SimRigOptions(n_berries=berries, seed=seed, log_path=log_path, **options)
+    rig_options = SimRigOptions(
+        n_berries=berries, seed=seed, log_path=log_path, gains=gains or {}, **options
+    )
     rig = build_sim_rig(rig_options)
     header = sim_header(rig, rig_options, args)
     start_log(rig.machine.log, header)
-    if gains:
-        from softarm.sweep.gains_file import apply_gains
-
-        apply_gains(rig, gains)  # the closed-loop resolver's (--gains)
     # What C1 saw at IDLE, before the arm moved (the rendered bush only).
     seen = rig.scene.picture() if rig.scene is not None and plot_path is not None else None
     viewer = _viewer(rig, view, record)

@@ -7,28 +7,25 @@ returns the report with ground-truth errors and the arm's clearance to the canes
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 import softarm
-from softarm._core import Gains, Resolver
 from softarm.calibration.result import Calibration
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
-from softarm.harvest.actuator import SafeActuator, lead_gain
 from softarm.harvest.bush_world import BushGripper, BushScene, harvest_bush
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
-from softarm.harvest.controller import ResolverController
-from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
-from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_alpha
 from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.rig import ControlInputs, build_control_stack
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import ArmPlant
 from softarm.harvest.sim_vision import BASE_TAG_ID, SimCameras, look_at, sim_vision
@@ -43,7 +40,7 @@ from softarm.sim.render.world import world_for
 from softarm.units import MAX_PSI
 from softarm.vision import MarkerCube
 
-__all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "default_cameras"]
+__all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "control_inputs", "default_cameras"]
 
 
 @dataclass
@@ -83,6 +80,8 @@ class SimRigOptions:
     #: controller sweeps); "bush": the rendered bush, berries and canes found by
     #: perception (softarm.perception), the markerless harvest.
     world: str = "tags"
+    #: Resolver gain keywords (``--gains``) over every controller resolver's own.
+    gains: Mapping[str, Any] = field(default_factory=dict)
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -172,20 +171,13 @@ def build_sim_rig(
     options: SimRigOptions | None = None, controller: Controller | None = None
 ) -> SimRig:
     """A simulated rig for ``options`` (a fresh bush, plant and cameras from the seed);
-    ``controller`` defaults to the hybrid ``softarm.Resolver`` on the nominal arm model."""
+    ``controller`` defaults to the control stack's (:func:`~softarm.harvest.rig.
+    build_control_stack`, the same as the hardware's)."""
     o = options or SimRigOptions()
     cfg = o.config
     nominal = softarm.SoftArm.blackberry()
     model = nominal if o.calibration is None else o.calibration.arm
-    # softarm identify/calibrate --sim --seed S measure this same plant (seed S + 1000).
-    if o.plant.model == "cosserat":  # optional extra: pyelastica
-        from softarm.sim.cosserat import CosseratPlant
-
-        plant: ArmPlant = CosseratPlant(nominal, o.plant, seed=o.seed + 1000)
-    elif o.plant.model == "pcc":
-        plant = ArmPlant(SimulatedArm(nominal, o.plant, seed=o.seed + 1000))
-    else:
-        raise ParameterError(f"plant.model = {o.plant.model!r}: must be 'pcc' or 'cosserat'")
+    plant = _plant(o, nominal)
     cams = default_cameras(o.scale, o.noise_std)
     # The true actuators' range: 0-70 psi (or less if the regulators saturate lower)
     # through each one's true elongation per psi.
@@ -202,12 +194,7 @@ def build_sim_rig(
         scene = _bush_scene(bush, plant, cams)
     elif o.world != "tags":
         raise ParameterError(f"world = {o.world!r}: must be 'tags' or 'bush'")
-    if o.plant.model == "cosserat":  # the rod's centre line, not arcs
-        from softarm.sim.cosserat.clearance import RodClearance
-
-        watch = ArmWatch(plant, RodClearance(plant, canes, cfg.grasp_offset))  # type: ignore[arg-type]
-    else:
-        watch = ArmWatch(plant, Clearance(plant.arm, canes, cfg.grasp_offset))
+    watch = _watch(o, plant, canes)
     clock = SimClock([plant.advance, watch.sample])
     bank = SafePressureBank(
         SimulatedPressureBank(plant, plant.arm.n_actuators), MAX_PSI, 100.0, 0.5, clock.now,
@@ -224,74 +211,52 @@ def build_sim_rig(
         gripper = BushGripper(scene, plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
         # The planner, resolver and clearance avoid these.
         canes = scene.fit_canes(_rig_parts(model, cfg, cams), CANE_REACH)
-    # The plant's lag, measured by `softarm identify` when given, else declared by the
-    # plant description (its regulators' time constant, as a datasheet states it).
-    lag = o.plant.pressure_tau if o.identified is None else o.identified.lag_s
-    # Its play, alike: the band width the lag model puts between regulators and arm.
-    play = o.plant.play_m if o.identified is None else np.asarray(o.identified.play_m)
-    if o.lag_control not in ("predictor", "bound"):
-        raise ParameterError(f"lag_control = {o.lag_control!r}: must be 'predictor' or 'bound'")
-    predict = o.lag_control == "predictor"
-    # One period of measurement lag behind the regulators (MEASUREMENT_LAG_PERIODS: an
-    # over-estimate here, on purpose). Arrival (`in_flight`) reads the regulators alone.
-    sensor_lag = MEASUREMENT_LAG_PERIODS * cfg.period
-    actuator = SafeActuator(
-        bank,
-        None if o.calibration is None else o.calibration.pressure_map(),
-        lag=(lag, cfg.period) if predict else None,
-        now=clock.now,
-        sensor_lag_s=sensor_lag,
-        lead=lead_gain(lag, cfg.period) if predict else 0.0,
-        play_m=play if predict else 0.0,
-    )
-    # The model arm's gap to the mapped canes: the planner checks its plans with it, the
-    # controller keeps the lagging arm's way to each command clear with it.
-    model_clearance = Clearance(model, canes, cfg.grasp_offset)
-    if controller is None:
-
-        def hybrid(gains: Gains) -> Resolver:
-            if o.joint_limit_gain is not None:
-                gains = gains.replace(hybrid_gamma=o.joint_limit_gain)
-            return Resolver(model, mode="hybrid", gains=gains)
-
-        bounded = hybrid(Gains.for_lag(lag, cfg.period))
-        predicted = (lambda: actuator.plant_q) if predict else None
-        # With the lag model the closed loop on the berry is the lag-free iteration (a
-        # Smith predictor) at a gain cut as the lag grows (predicted_loop_alpha).
-        # Following a placement plan keeps the gain bounded by the whole lag, without
-        # the prediction: on a slow plant with play the predictor's gain swung the arm
-        # into a cane early in the move (docs/control.md, section 6). Without the model
-        # the bound is used throughout.
-        loop_alpha = predicted_loop_alpha(lag + sensor_lag)
-        resolver = hybrid(Gains().replace(hybrid_alpha=loop_alpha)) if predict else bounded
-        transport = bounded if predict else None
-        controller = ResolverController(
-            resolver,
-            canes if o.avoid_canes else (),
-            predicted,
-            transport,
-            model_clearance if o.avoid_canes else None,
-        )
+    stack = build_control_stack(cfg, control_inputs(o, model), canes, bank, clock.now)
     machine = HarvestMachine(
-        clock,
-        vision,
-        controller,
-        actuator,
-        gripper,
-        gripper,
-        n_actuators=model.n_actuators,
-        config=cfg,
-        log=HarvestLog(o.log_path),
-        ground_truth=gripper,
-        # The canes are known obstacles (mapped), as the curve obstacles of the planning paper.
-        planner=ModelIK(
-            planning_resolver(model),
-            cfg,
-            seed=o.seed,
-            clearance=model_clearance,
-        ),
-    )
+        clock, vision, controller or stack.controller, stack.actuator, gripper, gripper,
+        n_actuators=model.n_actuators, config=cfg, log=HarvestLog(o.log_path),
+        ground_truth=gripper, planner=stack.planner,
+    )  # fmt: skip
     return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine, scene)
+
+
+def control_inputs(o: SimRigOptions, model: softarm.SoftArm) -> ControlInputs:
+    """The control stack's inputs of ``o``: the plant's lag and play measured by
+    `softarm identify` when given, else declared by the plant description (its
+    regulators' time constant, as a datasheet states it)."""
+    declared = o.identified is None
+    return ControlInputs(
+        model,
+        None if o.calibration is None else o.calibration.pressure_map(),
+        lag_s=o.plant.pressure_tau if declared else o.identified.lag_s,  # type: ignore[union-attr]
+        play_m=o.plant.play_m if declared else np.asarray(o.identified.play_m),  # type: ignore[union-attr]
+        gains=dict(o.gains),
+        lag_control=o.lag_control,
+        joint_limit_gain=o.joint_limit_gain,
+        avoid_canes=o.avoid_canes,
+        seed=o.seed,
+    )
+
+
+def _plant(o: SimRigOptions, nominal: softarm.SoftArm) -> ArmPlant:
+    """The simulated plant of ``o``; softarm identify/calibrate --sim --seed S measure
+    this same plant (seed S + 1000)."""
+    if o.plant.model == "cosserat":  # optional extra: pyelastica
+        from softarm.sim.cosserat import CosseratPlant
+
+        return CosseratPlant(nominal, o.plant, seed=o.seed + 1000)
+    if o.plant.model == "pcc":
+        return ArmPlant(SimulatedArm(nominal, o.plant, seed=o.seed + 1000))
+    raise ParameterError(f"plant.model = {o.plant.model!r}: must be 'pcc' or 'cosserat'")
+
+
+def _watch(o: SimRigOptions, plant: ArmPlant, canes: list) -> ArmWatch:
+    """The true arm's clearance to the true ``canes``, sampled every tick."""
+    if o.plant.model == "cosserat":  # the rod's centre line, not arcs
+        from softarm.sim.cosserat.clearance import RodClearance
+
+        return ArmWatch(plant, RodClearance(plant, canes, o.config.grasp_offset))  # type: ignore[arg-type]
+    return ArmWatch(plant, Clearance(plant.arm, canes, o.config.grasp_offset))
 
 
 #: C2's image in the rendered bush is rendered at half size (320 x 240): the berry

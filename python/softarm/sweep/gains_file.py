@@ -15,8 +15,9 @@ import softarm
 from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError
 from softarm.files import load_toml, write_text
+from softarm.harvest.rig import gains_over
 
-__all__ = ["GAIN_KEYS", "apply_gains", "gains_from", "load_gains", "write_gains"]
+__all__ = ["GAIN_KEYS", "gains_from", "load_gains", "write_gains"]
 
 
 def gains_from(values: Mapping[str, Any]) -> softarm.Gains:
@@ -25,13 +26,7 @@ def gains_from(values: Mapping[str, Any]) -> softarm.Gains:
     Raises:
         ConfigError: an unknown key or a value the resolver refuses, named.
     """
-    for key in values:
-        if key not in GAIN_KEYS:
-            raise ConfigError(f"{key}: unknown gain (expected one of {', '.join(GAIN_KEYS)})")
-    try:
-        return softarm.Gains(**values)
-    except (ValueError, TypeError) as exc:
-        raise ConfigError(str(exc)) from None
+    return gains_over(softarm.Gains(), values)
 
 
 def load_gains(path: str | Path) -> dict[str, Any]:
@@ -69,21 +64,3 @@ def write_gains(path: str | Path, gains: softarm.Gains, header: str = "") -> Non
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     write_text(p, "\n".join(lines) + "\n", "gains file")
-
-
-def apply_gains(rig: Any, values: Mapping[str, Any]) -> None:
-    """Use ``values`` (gain keywords) in the closed-loop resolver of a built simulated rig,
-    over the gains it already has (so a rig-level joint-limit gain is kept unless
-    ``values`` sets ``hybrid_gamma``). The planner's resolver is left alone."""
-    if not values:
-        return
-    controller = rig.machine.servo.controller
-    resolver = getattr(controller, "resolver", None)
-    if resolver is None or not hasattr(resolver, "gains"):
-        raise ConfigError(
-            f"gains: the rig's controller {type(controller).__name__} has no resolver to tune"
-        )
-    gains_from(values)  # named errors before anything changes
-    controller.resolver = softarm.Resolver(
-        resolver.arm, resolver.mode, resolver.gains.replace(**values)
-    )

@@ -53,13 +53,13 @@ def run_trial(trial: TrialSpec) -> Any:
     """Build the simulated rig for ``trial`` and harvest its bush; returns the report."""
     from softarm.commands._signals import vents_on_stop
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
-    from softarm.sweep.gains_file import apply_gains
     from softarm.sweep.plant_keys import plant_config
 
     plant = plant_config(trial.plant)
-    options = SimRigOptions(n_berries=trial.berries, seed=trial.seed, plant=plant, **trial.rig)
+    options = SimRigOptions(
+        n_berries=trial.berries, seed=trial.seed, plant=plant, gains=trial.gains, **trial.rig
+    )
     rig = build_sim_rig(options)
-    apply_gains(rig, trial.gains)
     # A worker stopped mid-trial (Ray's SIGTERM handler exits, a cancel raises
     # KeyboardInterrupt) vents the arm and records why, as `softarm harvest` does.
     with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
