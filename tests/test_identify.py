@@ -132,7 +132,7 @@ def test_not_json(tmp_path: Path) -> None:
         (["--sim", "--budget", "500"], "argument --budget: must be in [30, 120]"),
         (["--sim", "--seed", "-1"], "argument --seed"),
         (["--sim"], "the following arguments are required: --out"),
-        (["--config", "absent.toml"], "does not exist"),
+        (["--config", "absent.toml"], "no such file"),
     ],
 )
 def test_cli_usage_errors_exit_2(
