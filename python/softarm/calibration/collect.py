@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -49,7 +50,15 @@ def settle_time(lag_s: float) -> float:
     return max(MIN_SETTLE_S, 5.0 * lag_s)
 
 
-def paced_for(lag_s: float, play_m: float = 0.0) -> dict[str, float]:
+class Pacing(TypedDict, total=False):
+    """:func:`collect`'s pacing keywords, as :func:`paced_for` sizes them."""
+
+    settle: float
+    approach: float
+    approach_hold: float
+
+
+def paced_for(lag_s: float, play_m: float = 0.0) -> Pacing:
     """:func:`collect`'s ``settle``, ``approach`` and ``approach_hold`` for a plant
     lagging ``lag_s`` (s) with ``play_m`` (m of elongation) of play hysteresis: hold
     :func:`settle_time`; dip at least twice the play below each command (so every
@@ -74,7 +83,7 @@ def _mean_pose(poses: list[F64]) -> F64:
 
 def collect(
     commands: F64,
-    send: Callable[[F64], None],
+    send: Callable[[F64], object],
     sleep: Callable[[float], None],
     measure: Callable[[], F64 | None],
     *,

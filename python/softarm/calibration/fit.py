@@ -174,7 +174,7 @@ class _Problem:
         )  # fmt: skip
 
 
-def _drop_outliers(problem: _Problem, c: F64, meas: F64, max_nfev: int) -> F64:
+def _drop_outliers(problem: _Problem, c: F64, meas: F64, max_nfev: int) -> npt.NDArray[np.int64]:
     """Indices of the samples a robust fit finds outlying (see
     :mod:`softarm.calibration.outliers`)."""
     robust = problem.solve(c, meas, max_nfev, loss="soft_l1")

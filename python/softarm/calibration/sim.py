@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
-from softarm.calibration.collect import collect, paced_for
+from softarm.calibration.collect import Pacing, collect, paced_for
 from softarm.calibration.excitation import excitation_set
 from softarm.calibration.fit import calibrate
 from softarm.calibration.result import Calibration
@@ -67,7 +67,7 @@ class PlantDriver:
         return self.last
 
 
-def _pace(config: PlantConfig, lag_s: float, settle: float | None) -> dict[str, float]:
+def _pace(config: PlantConfig, lag_s: float, settle: float | None) -> Pacing:
     """:func:`~softarm.calibration.collect.paced_for` a chain lagging ``lag_s`` with
     ``config``'s play; ``settle`` (s), when given, replaces the paced hold."""
     pace = paced_for(lag_s, config.play_m)

@@ -81,7 +81,7 @@ class Parser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", DefaultsFormatter)
         super().__init__(*args, **kwargs)
 
-    def _add_action(self, action: _A) -> _A:  # type: ignore[override]
+    def _add_action(self, action: _A) -> _A:
         # An option with a default but no help text would hide its default from --help.
         if action.help is None and action.option_strings and not _says_nothing(action.default):
             action.help = ""

@@ -11,10 +11,16 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from typing import TYPE_CHECKING
 
 from softarm.commands._args import add_quiet, config_file, non_negative_int, output_file
 from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
+
+if TYPE_CHECKING:
+    from softarm.commands._progress import Progress
+    from softarm.identification import IdentifiedPlant
+    from softarm.identification.record import Progress as OnProgress
 
 #: The longest excitation (s of arm time) the command runs.
 MAX_BUDGET_S = 120.0
@@ -89,13 +95,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _progress(quiet: bool, budget: float):  # type: ignore[no-untyped-def]
+def _progress(quiet: bool, budget: float) -> Progress:
     from softarm.commands._progress import Progress
 
     return Progress(round(budget), "identify", "s arm time", quiet)
 
 
-def _run_sim(args: argparse.Namespace):  # type: ignore[no-untyped-def]
+def _run_sim(args: argparse.Namespace) -> IdentifiedPlant:
     from softarm.identification import Design, SimIdentificationRig, identify
     from softarm.sim.arm import PlantConfig
     from softarm.sim.plant_file import load_plant_file
@@ -117,7 +123,7 @@ def _run_sim(args: argparse.Namespace):  # type: ignore[no-untyped-def]
             rig.close()
 
 
-def _run_hardware(args: argparse.Namespace):  # type: ignore[no-untyped-def]
+def _run_hardware(args: argparse.Namespace) -> IdentifiedPlant | None:
     from softarm._core import Section, SoftArm
     from softarm.config import load_config
     from softarm.identification import Design, identify
@@ -151,7 +157,7 @@ def _run_hardware(args: argparse.Namespace):  # type: ignore[no-untyped-def]
             rig.close()
 
 
-def _advance(bar):  # type: ignore[no-untyped-def]
+def _advance(bar: Progress) -> OnProgress:
     done = [0]
 
     def progress(t: float, budget: float, what: str) -> None:
@@ -164,7 +170,7 @@ def _advance(bar):  # type: ignore[no-untyped-def]
     return progress
 
 
-def _print(plant, quiet: bool) -> None:  # type: ignore[no-untyped-def]
+def _print(plant: IdentifiedPlant, quiet: bool) -> None:
     truth = plant.metadata.get("sim_truth")
     print(
         f"identified {plant.n_channels} channels from {plant.metadata['arm_time_s']:.1f} s "

@@ -6,7 +6,7 @@ from __future__ import annotations
 import csv
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -91,7 +91,7 @@ def plot_comparison(
 
 
 def plot_final_errors(
-    path: Path, title: str, labels: Sequence[str], errors: dict[str, Sequence[float]], unit: str
+    path: Path, title: str, labels: Sequence[str], errors: Mapping[str, Sequence[float]], unit: str
 ) -> None:
     """Final error per set-point for each controller (like Fig. 6)."""
     import matplotlib

@@ -12,6 +12,7 @@ fed with every command sent (ramps and holds included), for the lag-aware closed
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -24,6 +25,15 @@ from softarm.harvest.plant_model import MeasurementModel
 __all__ = ["SafeActuator", "lead_gain"]
 
 FloatArray = npt.NDArray[np.float64]
+
+
+class PressureMap(Protocol):
+    """Elongation (m) <-> psi, per actuator: an :class:`ElongationMap` or a calibration's
+    :class:`~softarm.calibration.result.GainMap`."""
+
+    def to_psi(self, elongation: npt.ArrayLike, *, clamp: bool = True) -> FloatArray: ...
+
+    def to_elongation(self, psi: npt.ArrayLike, *, clamp: bool = True) -> FloatArray: ...
 
 
 def lead_gain(tau_s: float, period_s: float, cap: float = 1.5) -> float:
@@ -67,7 +77,7 @@ class SafeActuator:
     def __init__(
         self,
         bank: SafePressureBank,
-        pressure_map: ElongationMap | None = None,
+        pressure_map: PressureMap | None = None,
         *,
         lag: tuple[float, float] | None = None,
         now: Callable[[], float] | None = None,
@@ -76,7 +86,7 @@ class SafeActuator:
         play_m: float | FloatArray = 0.0,
     ) -> None:
         self.bank = bank
-        self.pressure_map = pressure_map or ElongationMap(max_psi=bank.max_pressure)
+        self.pressure_map: PressureMap = pressure_map or ElongationMap(max_psi=bank.max_pressure)
         n = bank.channels
         if lag is not None and now is None:
             raise ParameterError("lag: needs the clock `now` to count periods")

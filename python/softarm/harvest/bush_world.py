@@ -38,7 +38,7 @@ TRUTH_MATCH = 0.03
 def draw_arm(world: RenderedBush, plant: ArmPlant) -> None:
     """Draw the TRUE arm (the plant's state) in the world: arcs for the constant-
     curvature plant, the rod's centre line for the Cosserat one."""
-    if hasattr(plant, "centreline"):
+    if hasattr(plant, "centreline") and hasattr(plant, "centreline_sections"):
         sections = polyline_sections(
             plant.centreline(), plant.centreline_sections(), plant.arm.n_sections
         )

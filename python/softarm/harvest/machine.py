@@ -257,7 +257,7 @@ class HarvestMachine:
             result.position_error_mm = 1e3 * position
             result.orientation_error_deg = float(np.degrees(pointing))
         result.steps = watch.steps
-        result.cameras = dict(watch.cameras)
+        result.cameras = dict(watch.cameras.items())
         result.final_state = self.state
         result.duration_s = self.clock.now() - start
         self.log.event("berry_result", **result.to_dict())

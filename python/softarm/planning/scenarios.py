@@ -102,7 +102,7 @@ def run_method(scenario: Scenario, points: int | None, repeats: int = 20) -> Res
     chain = scenario.chain
     if points is None:
         planner = _core.PotentialFieldPlanner(chain)
-        obstacles: list[object] = list(scenario.curves)
+        obstacles: list[_core.PolynomialCurve | _core.PointCloud] = list(scenario.curves)
     else:
         planner = _core.PotentialFieldPlanner(chain, arm_samples=ARM_POINTS_PER_SEGMENT)
         obstacles = [_core.PointCloud(c.sample(points)) for c in scenario.curves]

@@ -27,7 +27,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, overload
+from typing import Any, cast, overload
 
 import cv2
 import numpy as np
@@ -195,7 +195,7 @@ class SyntheticCamera:
     def _marker_plane(self, item: SceneMarker) -> tuple[TexturedPlane, Box | None]:
         """The marker's textured plane (one texel per sub-sample where it is nearest) and
         pixel box; kept for the next frame, where a marker that does not move reuses it."""
-        key = (item.marker_id, item.dictionary, item.marker_length, item.border)
+        key: tuple[object, ...] = (item.marker_id, item.dictionary, item.marker_length, item.border)
         key += (item.T_camera_marker.tobytes(),)
         hit = self._planes.get(key)
         if hit is not None:
@@ -303,7 +303,7 @@ class SyntheticCamera:
         maps = cv2.perspectiveTransform(rays, to_tex @ hinv)
         # Fixed-point maps: the same 1/32-texel rounding that remap applies to float maps
         # block by block, done in one pass.
-        fixed, frac = cv2.convertMaps(maps, None, cv2.CV_16SC2)
+        fixed, frac = cv2.convertMaps(maps, None, cv2.CV_16SC2)  # type: ignore[call-overload]  # map2 None is valid
         shade = self._shade(layer.normal)
         light = self.lighting
         ink = shade * light.black
@@ -348,7 +348,8 @@ class SyntheticCamera:
         b = self._offsets[None, :, None, None, None]  # along y
         top = c00[:, None, :, None] * (1 - a) + c01[:, None, :, None] * a
         bot = c10[:, None, :, None] * (1 - a) + c11[:, None, :, None] * a
-        return (top * (1 - b) + bot * b).reshape((y1 - y0) * s, (x1 - x0) * s, 2)
+        rays = (top * (1 - b) + bot * b).reshape((y1 - y0) * s, (x1 - x0) * s, 2)
+        return cast(npt.NDArray[np.float32], rays)  # float32 throughout; the stubs widen
 
     def _noise(self, height: int, width: int) -> tuple[npt.NDArray[np.float32], bool]:
         """(height, width) of N(0, 1) noise and whether to negate it: a random window of a

@@ -200,7 +200,7 @@ def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict | Non
 def _bar_callback(tune: Any, total: int, enabled: bool) -> Any:
     tqdm = require("tqdm").tqdm
 
-    class Bar(tune.Callback):  # type: ignore[misc, name-defined]
+    class Bar(tune.Callback):  # type: ignore[misc]
         """One tick per finished candidate, best score so far as the postfix."""
 
         def __init__(self) -> None:

@@ -14,7 +14,7 @@ and the detector then refuses it rather than report corners in the wrong place.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -59,7 +59,7 @@ class ImageCrop(np.ndarray):
 
     def __reduce__(self) -> tuple[Any, ...]:
         # ndarray pickles its pixels only: carry the window along.
-        ctor, args, state = super().__reduce__()[:3]
+        ctor, args, state = cast(tuple[Any, ...], super().__reduce__())[:3]
         return ctor, args, (state, self.origin, self.full_size)
 
     def __setstate__(self, state: Any) -> None:

@@ -72,7 +72,7 @@ def refine_marker_corners(
     # Profile sample positions (N, m, 2) in the neighbourhood's pixels.
     across = offsets[None, :, None] * normal[:, None, :]
     pts = ((centre_px - lo)[:, None, :] + across).astype(np.float32)
-    prof = cv2.remap(crop, pts, None, cv2.INTER_LINEAR)  # (N, m)
+    prof = cv2.remap(crop, pts, None, cv2.INTER_LINEAR)  # type: ignore[call-overload]  # (N, m); map2 None is valid, the stub wants an array
     # Signed gradient: for a box-filtered step sampled bilinearly its centroid is exactly the
     # step position (a squared or absolute gradient is biased by the sub-pixel phase or by
     # noise), and pixel noise adds zero-mean terms only.

@@ -313,7 +313,7 @@ def _weights_class(ea: Any) -> type:
     """A forcing with the true weights: every node's mass x gravity, and the moment of
     the gripper's and cube's weight about the tip (their lever along the tip's axis)."""
 
-    class _Weights(ea.NoForces):  # type: ignore[misc, name-defined]
+    class _Weights(ea.NoForces):  # type: ignore[misc]
         def __init__(self, mass: F64, gravity: F64, tip_weight: F64, lever: float) -> None:
             super().__init__()
             self.force = np.outer(np.asarray(gravity, dtype=float), mass)  # (3, n_nodes)

@@ -5,6 +5,8 @@ the map made once per camera)."""
 
 from __future__ import annotations
 
+from typing import cast
+
 import cv2
 import numpy as np
 import numpy.typing as npt
@@ -32,8 +34,9 @@ class Distorter:
         """The distorted colour image."""
         if self.identity:
             return image
-        return cv2.remap(image, self.map_x, self.map_y, cv2.INTER_LINEAR,
-                         borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
+        out = cv2.remap(image, self.map_x, self.map_y, cv2.INTER_LINEAR,
+                        borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
+        return cast(npt.NDArray[np.uint8], out)  # remap keeps the source dtype
 
     def nearest(self, image: npt.NDArray) -> npt.NDArray:
         """The distorted depth or label image (nearest pixel)."""

@@ -39,7 +39,7 @@ class BerryScore:
         for name, value in vars(other).items():
             setattr(self, name, getattr(self, name) + value)
 
-    def summary(self) -> dict[str, float]:
+    def summary(self) -> dict[str, float | tuple[float, float]]:
         """Precision, recall, ripeness accuracy, localisation median/p95 (mm), time."""
         e = np.asarray(self.errors_mm)
         return {
