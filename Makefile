@@ -10,11 +10,13 @@ export MPLBACKEND ?= Agg
 # Offscreen OpenGL for the rendered bush (MuJoCo): EGL, Mesa's software rasteriser without a GPU.
 export MUJOCO_GL ?= egl
 
-.PHONY: help venv dev dev-all install docs docs-site test test-rust test-python demo lint fmt bench clean
+.PHONY: help venv dev dev-all install docs docs-site test test-rust test-python wheel demo lint fmt bench clean
 
 help:
 	@echo "make demo   - simulated harvest with plots (no hardware, no test tools)"
-	@echo "make test   - set up .venv, build, run cargo test and pytest"
+	@echo "make test   - build the wheel once, cargo test, then pytest against the wheel installed"
+	@echo "              in a fresh $(WHEEL_VENV) with no Rust toolchain on the PATH"
+	@echo "make wheel  - the release abi3 wheel, into $(WHEEL_DIR)/ (pip install needs no cargo)"
 	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
 	@echo "make bench  - criterion and pytest-benchmark"
 	@echo "make docs   - regenerate the generated docs (docs/planning.md, docs/experiments.md and their figures)"
@@ -46,11 +48,37 @@ TEST_EXTRAS := test,sweep,cosserat,viz,render,ros
 dev-all: venv
 	$(VENV)/bin/maturin develop --release --extras $(TEST_EXTRAS) -q
 
+# pytest against the editable .venv (the source tree): the quick loop while developing.
 test-python: dev-all
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q $(PYTEST_ARGS)
 
-test: dev-all test-rust
-	$(PY) -m pytest -q
+# The release wheel users install: abi3 (one wheel for CPython >= 3.11, pyproject's
+# [tool.maturin] features), built once into $(WHEEL_DIR)/. It compiles the same crates in the
+# same target/release as `maturin develop --release` and `cargo test --release`.
+WHEEL_DIR := target/wheels
+wheel: venv
+	rm -f $(WHEEL_DIR)/softarm-*.whl
+	$(VENV)/bin/maturin build --release --out $(WHEEL_DIR)
+
+# `make test` tests what users install: the wheel with CI's extras, in a fresh virtual
+# environment whose PATH has no cargo or rustc (nor .venv), so that nothing can build from
+# source; pytest imports softarm from that environment's site-packages, never python/
+# (tests/test_installed_wheel.py checks both). PYTEST_ARGS picks tests: `make test
+# PYTEST_ARGS=tests/test_kinematics.py`.
+WHEEL_VENV ?= .venv-wheel
+PYTEST_ARGS ?=
+empty :=
+space := $(empty) $(empty)
+NO_RUST_PATH := $(abspath $(WHEEL_VENV))/bin:$(subst $(space),:,$(strip $(foreach d,$(subst :, ,$(PATH)),$(if $(filter $(abspath $(VENV))/bin,$(d))$(wildcard $(d)/cargo $(d)/rustc),,$(d)))))
+IN_WHEEL_VENV := env PATH="$(NO_RUST_PATH)" VIRTUAL_ENV=$(abspath $(WHEEL_VENV)) SOFTARM_WHEEL_VENV=$(abspath $(WHEEL_VENV))
+
+test: wheel test-rust
+	rm -rf $(WHEEL_VENV)
+	$(IN_WHEEL_VENV) python3 -m venv $(WHEEL_VENV)
+	$(IN_WHEEL_VENV) $(WHEEL_VENV)/bin/python -m pip install -q "$$(ls $(WHEEL_DIR)/softarm-*.whl)[$(TEST_EXTRAS)]"
+	@$(IN_WHEEL_VENV) sh -c '! command -v cargo && ! command -v rustc' >/dev/null || { echo "cargo or rustc is on the PATH of $(WHEEL_VENV)"; exit 1; }
+	$(IN_WHEEL_VENV) $(WHEEL_VENV)/bin/python -P -c 'import softarm; print("testing", softarm.__file__)'
+	$(IN_WHEEL_VENV) $(WHEEL_VENV)/bin/python -P -m pytest -q $(PYTEST_ARGS)
 
 # The generated docs: the planning paper's tables and figures, from the code that measures
 # them (tests/test_docs_current.py checks that their deterministic columns are current).
@@ -84,4 +112,4 @@ bench: dev
 	$(PY) -m pytest tests/benchmarks --benchmark-only --benchmark-columns=min,median,mean,ops,rounds -q
 
 clean:
-	rm -rf $(VENV) target
+	rm -rf $(VENV) $(WHEEL_VENV) target

@@ -64,7 +64,9 @@ def fake_drivers(monkeypatch: pytest.MonkeyPatch, present: bool) -> list[str]:
 
 
 def test_exits_zero_with_no_hardware_attached(tmp_path: Path) -> None:
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), *sys.path]))
+    # This interpreter's path: softarm from wherever the tests import it (the wheel that
+    # `make test` installs, or the editable .venv), never the checkout's python/ put first.
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.run(
         [sys.executable, str(SCRIPT), "--port", str(tmp_path / "ttyNONE")],
         capture_output=True,
