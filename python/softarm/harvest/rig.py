@@ -14,11 +14,11 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from softarm._core import Gains, Resolver, SoftArm
+from softarm._core import Gains, PolynomialCurve, Resolver, SoftArm
 from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.safety import SafePressureBank
-from softarm.harvest.actuator import SafeActuator, lead_gain
+from softarm.harvest.actuator import PressureMap, SafeActuator, lead_gain
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
@@ -47,7 +47,7 @@ class ControlInputs:
     """
 
     model: SoftArm
-    pressure_map: object | None = None
+    pressure_map: PressureMap | None = None
     lag_s: float | None = None
     play_m: Any = 0.0
     gains: Mapping[str, Any] = field(default_factory=dict)
@@ -90,7 +90,7 @@ def gains_over(base: Gains, values: Mapping[str, Any]) -> Gains:
 def build_control_stack(
     cfg: HarvestConfig,
     inputs: ControlInputs,
-    canes: Sequence[object],
+    canes: Sequence[PolynomialCurve],
     bank: SafePressureBank,
     now: Callable[[], float],
 ) -> ControlStack:
