@@ -13,7 +13,7 @@ sensor in the gripper keeps the last word at the grasp.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, cast
 
 import cv2
 import numpy as np
@@ -26,6 +26,8 @@ from softarm.vision.camera_model import CameraModel
 __all__ = ["BerryDetection", "DetectorSettings", "detect_berries", "fruit_mask"]
 
 Ripeness = Literal["ripe", "unripe"]
+# What OpenCV returns for a uint8 image (its stubs say any number array).
+_U8 = npt.NDArray[np.uint8]
 
 
 @dataclass(frozen=True)
@@ -84,7 +86,7 @@ def detect_berries(
     """
     s = settings or DetectorSettings()
     _check(image, depth)
-    hsv = cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV)
+    hsv = cast(_U8, cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV))
     ripe, unripe = _colour_masks(hsv, s)
     out = []
     for mask in (ripe, unripe):
@@ -114,9 +116,9 @@ def fruit_mask(
     """The pixels (0/255) of either fruit colour class in a BGR image, closed over the
     drupelet gaps: the silhouettes that stereo matches (:mod:`softarm.perception.stereo`)."""
     s = settings or DetectorSettings()
-    hsv = cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV)
+    hsv = cast(_U8, cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV))
     ripe, unripe = _colour_masks(hsv, s)
-    return _close(cv2.bitwise_or(ripe, unripe))
+    return _close(cast(_U8, cv2.bitwise_or(ripe, unripe)))
 
 
 def _colour_masks(
@@ -138,7 +140,7 @@ def _colour_masks(
 def _close(mask: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     """Bridge the gaps between drupelets and the highlights on them."""
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
-    return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+    return cast(_U8, cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel))
 
 
 def _blobs(mask: npt.NDArray[np.uint8], s: DetectorSettings) -> list[npt.NDArray[np.int32]]:
@@ -155,7 +157,7 @@ def _blobs(mask: npt.NDArray[np.uint8], s: DetectorSettings) -> list[npt.NDArray
             continue
         if max(a, b) > s.max_elongation * max(min(a, b), 1e-6):
             continue
-        out.append(c)
+        out.append(cast(npt.NDArray[np.int32], c))
     return out
 
 

@@ -20,6 +20,7 @@ about half a pixel of disparity noise per berry (±5 mm at 1 m).
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import cast
 
 import cv2
 import numpy as np
@@ -63,8 +64,8 @@ def locate_berries(
     matched in the right image is returned without a position."""
     rect = stereo.rectification
     mx, my = rect.maps[0]
-    L = cv2.remap(left, mx, my, cv2.INTER_LINEAR)
-    rect_cam = CameraModel(rect.P1[:3, :3], None, rect.size)
+    L = cast(npt.NDArray[np.uint8], cv2.remap(left, mx, my, cv2.INTER_LINEAR))
+    rect_cam = CameraModel(rect.P1[:3, :3], np.zeros(5), rect.size)  # no distortion
     detections = detect_berries(L, rect_cam, settings=settings)
     if not detections:
         return []
@@ -144,7 +145,10 @@ def _band(detections: list[BerryDetection], height: int) -> slice:
 
 
 def _rectified_rows(
-    image: npt.NDArray[np.uint8], maps: tuple, rows: slice, shape: tuple[int, ...]
+    image: npt.NDArray[np.uint8],
+    maps: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]],
+    rows: slice,
+    shape: tuple[int, ...],
 ) -> npt.NDArray[np.uint8]:
     """The rectified ``image`` on ``rows`` only, black elsewhere (the right eye is read
     only where the berries' rows are)."""
@@ -153,7 +157,7 @@ def _rectified_rows(
     return out
 
 
-def _grey(image: npt.NDArray[np.uint8], rows: slice) -> FloatArray:
+def _grey(image: npt.NDArray[np.uint8], rows: slice) -> npt.NDArray[np.float32]:
     out = np.zeros(image.shape[:2], np.float32)
     out[rows] = cv2.cvtColor(image[rows], cv2.COLOR_BGR2GRAY)
     return out
@@ -161,7 +165,7 @@ def _grey(image: npt.NDArray[np.uint8], rows: slice) -> FloatArray:
 
 def _silhouettes(
     image: npt.NDArray[np.uint8], rows: slice, settings: DetectorSettings | None
-) -> FloatArray:
+) -> npt.NDArray[np.float32]:
     """The fruit silhouettes of a rectified image's ``rows`` as a smooth [0, 1] image:
     what the two eyes match, so that neither the background behind a fruit nor the
     highlights on it (which move with the eye) pull the match."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import cast
 
 import cv2
 import numpy as np
@@ -66,11 +67,16 @@ class Rectification:
         )  # fmt: skip
         self.size = size
         self._left = L
-        self.R1, self.P1, self.P2, self.Q = R1, P1, P2, Q
+        # float64, as stereoRectify returns them (its stubs say any number array).
+        self.R1, self.P1 = cast(FloatArray, R1), cast(FloatArray, P1)
+        self.P2, self.Q = cast(FloatArray, P2), cast(FloatArray, Q)
         self.focal = float(P1[0, 0])
         self.baseline = stereo.baseline
         self.maps = [
-            cv2.initUndistortRectifyMap(c.matrix, c.distortion, r, p, size, cv2.CV_32FC1)
+            cast(
+                tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]],
+                cv2.initUndistortRectifyMap(c.matrix, c.distortion, r, p, size, cv2.CV_32FC1),
+            )
             for c, r, p in ((L, R1, P1), (Rm, R2, P2))
         ]
 
@@ -87,7 +93,8 @@ class Rectification:
         """(N, 2) distorted left-eye pixels → their rectified pixels."""
         pts = np.asarray(pixels, dtype=np.float64).reshape(-1, 1, 2)
         L = self._left
-        return cv2.undistortPoints(pts, L.matrix, L.distortion, R=self.R1, P=self.P1).reshape(-1, 2)
+        out = cv2.undistortPoints(pts, L.matrix, L.distortion, R=self.R1, P=self.P1)
+        return cast(FloatArray, out).reshape(-1, 2)
 
     def triangulate(self, left_px: FloatArray, disparity: FloatArray) -> FloatArray:
         """(N, 3) points in the (unrectified) left camera frame from rectified left pixels
