@@ -103,7 +103,7 @@ def test_hardware_run_stopped_by_sigterm_vents_closes_and_logs(
     config = tmp_path / "hw.toml"
     config.write_text(re.sub(r"(?m)^# ((T_C1_base|T_C2_EE|matrix) = )", r"\1", template()))
     rig = _FakeRig()
-    monkeypatch.setattr(hw_rig, "build_hardware_rig", lambda config, log, identified=None: rig)
+    monkeypatch.setattr(hw_rig, "build_hardware_rig", lambda *a, **k: rig)
     log = tmp_path / "run.jsonl"
     status = cli.main(["harvest", "--config", str(config), "--log", str(log)])
     assert status == 143

@@ -34,7 +34,8 @@ def add_plant_options(p: argparse.ArgumentParser, *, sim_only_flag: bool = True)
         "--model",
         type=config_file,
         help="a fitted arm model (`softarm calibrate` writes model.toml): the controller's "
-        "arm and the actuators' gains (--sim only)",
+        "arm and the actuators' gains (on hardware it replaces the config's arm and "
+        "channel gains)",
     )
 
 
@@ -56,9 +57,6 @@ def plant_options(args: argparse.Namespace) -> dict[str, Any]:
     if getattr(args, "identified", None) is not None:
         out["identified"] = load_identified(args.identified)
     if getattr(args, "model", None) is not None:
-        if not getattr(args, "sim", True):
-            # On hardware: paste model.toml's [[arm.sections]] into the config for now.
-            raise ParameterError("--model: works with --sim only")
         from softarm.calibration import load_calibration
 
         out["calibration"] = load_calibration(args.model)

@@ -328,8 +328,9 @@ def _hardware_rig(args: argparse.Namespace, log: HarvestLog) -> HardwareRig:
         if getattr(args, "identified", None) is not None
         else identified_from_config(config, args.config)
     )
+    calibration = plant_options(args).get("calibration")  # --model: the arm and its gains
     start_log(log, hardware_header(config, args))
-    return build_hardware_rig(config, log=log, identified=identified)
+    return build_hardware_rig(config, log=log, identified=identified, calibration=calibration)
 
 
 def line(i: int, n: int, r: Any, wall: float, retry: bool = False) -> str:
