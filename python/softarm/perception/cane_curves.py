@@ -7,13 +7,17 @@ the cubic through its inliers grows it along the cane, past gaps where leaves hi
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from softarm.checks import FloatArray
 
 __all__ = ["CurveSearch", "arc_length_cubic", "curve_points", "split_into_curves"]
+
+IndexArray = npt.NDArray[np.intp]
 
 DEGREE = 3
 DENSE = 200  # samples of a curve when points are matched to it
@@ -70,7 +74,7 @@ def arc_length_cubic(points: FloatArray, iterations: int = 3) -> FloatArray:
 
 def _least_squares(points: FloatArray, u: FloatArray) -> FloatArray:
     vander = np.vander(u, DEGREE + 1, increasing=True)
-    return np.linalg.lstsq(vander, points, rcond=None)[0].T
+    return cast(FloatArray, np.linalg.lstsq(vander, points, rcond=None)[0].T)
 
 
 def _arc_length_parameters(coeffs: FloatArray, points: FloatArray) -> FloatArray:
@@ -84,13 +88,13 @@ def _arc_length_parameters(coeffs: FloatArray, points: FloatArray) -> FloatArray
     return arc[nearest - lo] / max(float(arc[-1]), 1e-12)
 
 
-def split_into_curves(points: FloatArray, search: CurveSearch) -> list[FloatArray]:
+def split_into_curves(points: FloatArray, search: CurveSearch) -> list[IndexArray]:
     """Index arrays into ``points`` (n, 3), one per cane found. A proposed line that
     grows into no cane gives up its inliers (clutter, a leaf's edge), and the search
     ends after ``MAX_MISSES`` such lines in a row."""
     rng = np.random.default_rng(search.seed)
     remaining = np.arange(len(points))
-    canes: list[FloatArray] = []
+    canes: list[IndexArray] = []
     misses = 0
     while len(remaining) >= search.min_support and misses < MAX_MISSES:
         line = _best_line(points[remaining], search, rng)
@@ -104,7 +108,7 @@ def split_into_curves(points: FloatArray, search: CurveSearch) -> list[FloatArra
     return canes
 
 
-def _grow(points: FloatArray, line: FloatArray, search: CurveSearch) -> FloatArray | None:
+def _grow(points: FloatArray, line: IndexArray, search: CurveSearch) -> IndexArray | None:
     """The cane grown from the inliers ``line`` of a proposed line: alternately fit the
     cubic and take the points near it, in one run without long holes; None when it is
     too short or has too few points."""
@@ -122,7 +126,7 @@ def _grow(points: FloatArray, line: FloatArray, search: CurveSearch) -> FloatArr
 
 def _best_line(
     points: FloatArray, search: CurveSearch, rng: np.random.Generator
-) -> FloatArray | None:
+) -> IndexArray | None:
     """Inlier indices of the random two-point line (points 2–10 cm apart) with most
     points within ``line_tolerance``, scored on a subsample of the points."""
     tree = cKDTree(points)
@@ -138,7 +142,7 @@ def _best_line(
         count = int(np.sum(_line_distance(scored, points[a], direction) < search.line_tolerance))
         if count > best_count:
             best_direction, best_anchor, best_count = direction, points[a], count
-    if best_direction is None:
+    if best_direction is None or best_anchor is None:
         return None
     distance = _line_distance(points, best_anchor, best_direction)
     return np.flatnonzero(distance < search.line_tolerance)
@@ -150,7 +154,7 @@ def _line_distance(points: FloatArray, anchor: FloatArray, direction: FloatArray
     return np.linalg.norm(offset - np.outer(offset @ direction, direction), axis=1)
 
 
-def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> FloatArray:
+def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> IndexArray:
     """Indices of points within ``curve_tolerance`` of the curve extended by max_gap
     at both ends (so that a cane grows past where its points stopped)."""
     length = float(np.sum(np.linalg.norm(np.diff(curve_points(coeffs), axis=0), axis=1)))
@@ -160,7 +164,7 @@ def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> 
     return np.flatnonzero(distance < search.curve_tolerance)
 
 
-def _longest_run(points: FloatArray, members: FloatArray, max_gap: float) -> FloatArray:
+def _longest_run(points: FloatArray, members: IndexArray, max_gap: float) -> IndexArray:
     """The members along the principal axis, cut at holes longer than ``max_gap``;
     the run with most points."""
     chosen = points[members]

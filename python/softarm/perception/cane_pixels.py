@@ -11,12 +11,12 @@ berries and other blobs, which are taken out).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.checks import FloatArray
 from softarm.perception.stereo_camera import Rectification
 
 __all__ = ["CaneLook", "cane_mask", "half_width_px", "stereo_disparity"]
@@ -43,11 +43,12 @@ def cane_mask(bgr: npt.NDArray[np.uint8], look: CaneLook) -> BoolImage:
     h, s, v = cv2.split(hsv)
     colour = (h >= look.hue[0]) & (h <= look.hue[1]) & (s >= look.min_saturation)
     colour &= v >= look.min_value
-    colour &= _texture(cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)) >= look.min_texture
+    grey = cast(npt.NDArray[np.uint8], cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY))
+    colour &= _texture(grey) >= look.min_texture
     return _thin(colour.astype(np.uint8), look)
 
 
-def _texture(grey: npt.NDArray[np.uint8]) -> FloatArray:
+def _texture(grey: npt.NDArray[np.uint8]) -> npt.NDArray[np.float32]:
     """Local standard deviation of the grey level over 7×7 pixels."""
     g = grey.astype(np.float32)
     mean = cv2.boxFilter(g, -1, (7, 7))
@@ -63,7 +64,7 @@ def _thin(mask: npt.NDArray[np.uint8], look: CaneLook) -> BoolImage:
     return (kept > 0) & (blobs == 0)
 
 
-def half_width_px(mask: BoolImage) -> FloatArray:
+def half_width_px(mask: BoolImage) -> npt.NDArray[np.float32]:
     """At each mask pixel, half the local width of the mask (pixels): the largest
     distance to the mask's edge within 5×5 pixels, less half a pixel."""
     distance = cv2.distanceTransform(mask.astype(np.uint8), cv2.DIST_L2, 3)
@@ -77,7 +78,7 @@ def stereo_disparity(
     rect: Rectification,
     mask: BoolImage,
     depth_range: tuple[float, float],
-) -> FloatArray:
+) -> npt.NDArray[np.float32]:
     """Disparity (pixels, NaN where unknown) of the rectified ``left`` from
     ``right`` (OpenCV's StereoSGBM), computed only over the rows and columns that
     ``mask`` occupies, for depths within ``depth_range`` (m)."""
@@ -92,7 +93,7 @@ def stereo_disparity(
     y0, y1 = max(rows.min() - pad, 0), min(rows.max() + pad + 1, mask.shape[0])
     x1 = min(cols.max() + pad + 1, mask.shape[1])
     x0 = max(cols.min() - pad - d_min - n_disp, 0)
-    sgbm = cv2.StereoSGBM_create(
+    sgbm = cv2.StereoSGBM.create(
         minDisparity=d_min, numDisparities=n_disp, blockSize=3, P1=72, P2=288,
         uniquenessRatio=10, speckleWindowSize=100, speckleRange=2,
     )  # fmt: skip

@@ -96,7 +96,7 @@ class Rectification:
         out = cv2.undistortPoints(pts, L.matrix, L.distortion, R=self.R1, P=self.P1)
         return cast(FloatArray, out).reshape(-1, 2)
 
-    def triangulate(self, left_px: FloatArray, disparity: FloatArray) -> FloatArray:
+    def triangulate(self, left_px: FloatArray, disparity: npt.ArrayLike) -> FloatArray:
         """(N, 3) points in the (unrectified) left camera frame from rectified left pixels
         (N, 2) and their disparities (N,) in pixels: z = f B / d (the rectified frame),
         then turned back by R1ᵀ."""
