@@ -54,7 +54,7 @@ def table(seeds: Iterable[int]) -> str:
     return "\n".join(rows)
 
 
-def _row(name: str, s: dict) -> str:
+def _row(name: str, s: dict[str, float | tuple[float, float]]) -> str:
     return (
         f"| {name} | {s['precision']:.3f} | {s['recall']:.3f} | {s['ripeness_accuracy']:.3f} "
         f"| {s['ripe_in_view']} | {s['localised']} | {s['median_mm']:.2f} | {s['p95_mm']:.2f} |"

@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from softarm._core import PolynomialCurve
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 from softarm.harvest.interfaces import BerryTarget
@@ -77,7 +78,7 @@ class BushScene:
         left, right = self.world.c1()
         return self.bush_map.update(locate_berries(left.colour, right.colour, self.c1()))
 
-    def fit_canes(self, rig_parts: FloatArray, reach: float) -> list:
+    def fit_canes(self, rig_parts: FloatArray, reach: float) -> list[PolynomialCurve]:
         """The canes fitted from one C1 stereo view, without what is the rig's own: a fit
         that comes within SELF_MARGIN of ``rig_parts`` ((N, 3) points of the arm's
         model at the poses it looks from, its cube and the base tag) is the robot seen

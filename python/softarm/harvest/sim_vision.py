@@ -103,7 +103,9 @@ def sim_vision(
     # C1's berry tags stay put until picked: keep their (checked) scene markers.
     still: dict[tuple[int, bytes], SceneMarker] = {}
 
-    def tags(T_cam_base: FloatArray, memo: dict[tuple[int, bytes], SceneMarker]) -> list:
+    def tags(
+        T_cam_base: FloatArray, memo: dict[tuple[int, bytes], SceneMarker]
+    ) -> list[SceneMarker]:
         out = []
         for b in berries():
             pose = T_cam_base @ b.tag_pose()

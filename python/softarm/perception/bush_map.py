@@ -7,11 +7,15 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.perception.berries import BerryDetection, Ripeness
+
+if TYPE_CHECKING:
+    from softarm.perception.canes import CaneFit
 
 __all__ = ["FRUIT_RADIUS", "BushMap", "MappedBerry"]
 
@@ -44,7 +48,7 @@ class BushMap:
 
     merge_distance: float = 0.02
     berries: list[MappedBerry] = field(default_factory=list)
-    canes: list = field(default_factory=list)
+    canes: list[CaneFit] = field(default_factory=list)
 
     def update(self, detections: Iterable[BerryDetection]) -> int:
         """Merge one view's detections (positions in the base frame); the number of

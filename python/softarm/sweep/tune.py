@@ -181,7 +181,7 @@ def run_tune(
     return TuneOutcome(gains, metrics, baseline, candidates)
 
 
-def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict | None) -> str:
+def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict[str, Any] | None) -> str:
     lines = [
         f"softarm tune {spec.source}: {samples} candidates, Optuna TPE (seed {spec.tune.seed})",
         f"plants: {dict(spec.plant) or 'default'}; seeds {list(spec.seeds)}; "

@@ -5,7 +5,7 @@ the map made once per camera)."""
 
 from __future__ import annotations
 
-from typing import cast
+from typing import Any, cast
 
 import cv2
 import numpy as np
@@ -38,7 +38,7 @@ class Distorter:
                         borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
         return cast(npt.NDArray[np.uint8], out)  # remap keeps the source dtype
 
-    def nearest(self, image: npt.NDArray) -> npt.NDArray:
+    def nearest(self, image: npt.NDArray[Any]) -> npt.NDArray[Any]:
         """The distorted depth or label image (nearest pixel)."""
         if self.identity:
             return image

@@ -91,7 +91,9 @@ def score_berries(world: RenderedBush, detections: list[BerryDetection]) -> Berr
     return score
 
 
-def _rectified(mask: npt.NDArray[np.bool_], maps: tuple) -> npt.NDArray[np.bool_]:
+def _rectified(
+    mask: npt.NDArray[np.bool_], maps: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]
+) -> npt.NDArray[np.bool_]:
     """A left-eye mask on the rectified grid."""
     m = cv2.remap(mask.astype(np.uint8), maps[0], maps[1], cv2.INTER_NEAREST)
     return cv2.dilate(m, np.ones((5, 5), np.uint8)) > 0
