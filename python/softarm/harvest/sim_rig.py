@@ -250,7 +250,7 @@ def _plant(o: SimRigOptions, nominal: softarm.SoftArm) -> ArmPlant:
     raise ParameterError(f"plant.model = {o.plant.model!r}: must be 'pcc' or 'cosserat'")
 
 
-def _watch(o: SimRigOptions, plant: ArmPlant, canes: list) -> ArmWatch:
+def _watch(o: SimRigOptions, plant: ArmPlant, canes: list[softarm.PolynomialCurve]) -> ArmWatch:
     """The true arm's clearance to the true ``canes``, sampled every tick."""
     if o.plant.model == "cosserat":  # the rod's centre line, not arcs
         from softarm.sim.cosserat.clearance import RodClearance
