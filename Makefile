@@ -17,7 +17,7 @@ help:
 	@echo "make test   - build the wheel once, cargo test, then pytest against the wheel installed"
 	@echo "              in a fresh $(WHEEL_VENV) with no Rust toolchain on the PATH"
 	@echo "make wheel  - the release abi3 wheel, into $(WHEEL_DIR)/ (pip install needs no cargo)"
-	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy stubtest"
+	@echo "make lint   - cargo fmt --check, clippy -D warnings, ruff, mypy (strict) on python/softarm, mypy stubtest"
 	@echo "make bench  - criterion and pytest-benchmark"
 	@echo "make docs   - regenerate the generated docs (docs/planning.md, docs/experiments.md and their figures)"
 	@echo "make docs-site - the documentation site with its API reference, into site/ (the docs extra)"
@@ -100,6 +100,7 @@ lint: dev
 	cargo clippy --release --workspace --all-targets -- -D warnings
 	$(VENV)/bin/ruff check python tests examples
 	$(VENV)/bin/ruff format --check python tests examples
+	$(PY) -m mypy python/softarm
 	$(PY) -m mypy.stubtest softarm._core --allowlist .stubtest-allowlist
 
 fmt:

@@ -206,7 +206,8 @@ def _write_png(path: Path, image: npt.NDArray[Any]) -> None:
 
 def _depth_mm(depth: npt.NDArray[np.float32]) -> npt.NDArray[np.uint16]:
     mm = np.nan_to_num(depth * DEPTH_SCALE, nan=0.0)
-    return np.clip(np.round(mm), 0, 65535).astype(np.uint16)
+    out: npt.NDArray[np.uint16] = np.clip(np.round(mm), 0, 65535).astype(np.uint16)
+    return out
 
 
 def _image_record(
