@@ -156,6 +156,12 @@ class PressureActuator(Protocol):
         Raises HardwareError/SafetyError on a fault."""
         ...
 
+    @property
+    def sent(self) -> FloatArray:
+        """The elongations (m) last sent, after the safety layer's clamp and rate limit
+        (zero after a vent): the one copy of the command."""
+        ...
+
     def vent(self, reason: str) -> None:
         """Exhaust every channel now (the safe state)."""
         ...

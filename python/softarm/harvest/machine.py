@@ -100,9 +100,6 @@ class HarvestMachine:
         self.log = log or HarvestLog()
         self.ground_truth = ground_truth
         self.state = S.IDLE
-        #: Commanded elongations (m): the soft arm has no joint sensors, so the resolver's
-        #: Jacobian is evaluated at the command, and the measured pose closes the loop.
-        self.q: FloatArray = np.zeros(n_actuators)
         #: The ready pose between berries: straight, every actuator at ``home_elongation``,
         #: away from the lower limits where the resolver's steps would be clipped.
         self.home: FloatArray = np.full(n_actuators, self.config.home_elongation)
@@ -110,6 +107,14 @@ class HarvestMachine:
         self.planner = planner
         #: The approach axis of the current berry (a placement planner may tilt it).
         self.axis: FloatArray = self.config.approach_axis
+
+    @property
+    def q(self) -> FloatArray:
+        """Commanded elongations (m): what the safety layer last let through, the one
+        copy of the command (every stage goes on from it; a vent zeroes it). The soft
+        arm has no joint sensors, so the resolver's Jacobian is evaluated at the
+        command, and the measured pose closes the loop."""
+        return self.actuator.sent
 
     def run(self, berries: Sequence[BerryTarget]) -> HarvestReport:
         """Harvest ``berries`` in order; stop early after a fault in FAULTS_THAT_STOP."""
@@ -140,7 +145,7 @@ class HarvestMachine:
         try:
             self.vision.select(berry)
             idle_deadline = self.clock.now() + self.config.idle_timeout
-            self.q = servo.ramp(watch, self.state, self.q, self.home, idle_deadline)
+            servo.ramp(watch, self.state, self.q, self.home, idle_deadline)
             servo.wait_visible(watch, self.state, self.q)
             self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
             waypoints = self._reach(watch, berry)
@@ -151,7 +156,7 @@ class HarvestMachine:
             self._transition(S.GRASP, berry, "berry within the grasp workspace")
             self._grasp(result)
             self._transition(S.RETURN_HOME, berry, "grasp finished")
-            self.q = servo.go_home(
+            servo.go_home(
                 watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
             )
             if result.harvested:
@@ -207,10 +212,9 @@ class HarvestMachine:
             else:
                 grasp_within = c.grasp_workspace
             try:
-                placed = self.servo.place(watch, self.state, self.q, self.axis, waypoints)
-                self.q = placed.q
+                self.servo.place(watch, self.state, self.q, self.axis, waypoints)
                 self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
-                self.q = self.servo.fine(watch, self.state, self.q, self.axis, grasp_within).q
+                self.servo.fine(watch, self.state, self.q, self.axis, grasp_within)
                 return waypoints
             except Fault as fault:
                 if fault.retreat_from is None:
@@ -226,10 +230,9 @@ class HarvestMachine:
                     again, why, back_to = True, "back to the nearest attempt", nearest
                 else:
                     again, why = False, "backing out before the fault"
-                self.q = fault.retreat_from
                 self._transition(S.RETURN_HOME, berry, f"{why}: {fault}")
                 try:
-                    self.q = self.servo.go_home(
+                    self.servo.go_home(
                         watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
                     )
                 except Fault as failed:
@@ -307,7 +310,6 @@ class HarvestMachine:
         except Exception as exc:  # a dead driver must not hide the original fault
             self.log.event("vent_failed", error=repr(exc))
             vented = False
-        self.q = np.zeros_like(self.q)
         self.log.event("vent", t=self.clock.now(), reason=reason, ok=vented)
 
 

@@ -36,6 +36,11 @@ __all__ = ["Fault", "Servo"]
 #: period's step of the loop changes the gap by, so the loop is slowed there, not locked.
 WAY_SLACK = 0.001
 
+#: The most (m) the q the safety layer returns differs from the q commanded by rounding
+#: alone (m -> psi -> m, about 1e-18): far below what any regulator resolves, far below
+#: what a clamp or a rate limit takes off.
+SEND_ROUNDING = 1e-12
+
 
 def straight_step(q: FloatArray, goal: FloatArray, step: float) -> FloatArray:
     """The move (m) from ``q`` towards ``goal`` this period: along the straight line in
@@ -77,7 +82,7 @@ class Servo:
             watch.log_step(stage, seen, q, None, None, False)
             if seen.pose is not None and seen.fix is not None:
                 return
-            self._hold(q)
+            q = self._hold(q)
 
     def plan(
         self,
@@ -92,7 +97,7 @@ class Servo:
         is UNREACHABLE."""
         seen = watch.observe()
         while seen.pose is None or seen.fix is None:
-            self._hold(q)
+            q = self._hold(q)
             seen = watch.observe()
         plan = planner.plan(q, seen.fix.position, seen.pose, avoid)
         if plan is None:
@@ -228,7 +233,7 @@ class Servo:
             seen = self._look(watch, q, need_fix=False)
             if seen.pose is None:
                 watch.log_step(stage, seen, q, None, None, False)
-                self._hold(q)
+                q = self._hold(q)
                 continue
             on_plan_end = bool(np.all(nominal == q_way))
             err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
@@ -401,7 +406,7 @@ class Servo:
             elapsed = seen.t - start
             if seen.pose is None or seen.fix is None:
                 watch.log_step(stage, seen, q, None, None, False)
-                self._hold(q)
+                q = self._hold(q)
                 continue
             # The grasp point, not the end-effector origin, is servoed onto its goal
             # ``distance - grasp_offset`` short of the berry: a residual pointing error then
@@ -470,7 +475,17 @@ class Servo:
             q = self.actuator.send(q_next)
             self.clock.sleep(c.period)
 
-    def _hold(self, q: FloatArray) -> None:
-        """Keep commanding ``q`` (it also feeds the safety layer's watchdog) and wait."""
-        self.actuator.send(q)
+    def _hold(self, q: FloatArray) -> FloatArray:
+        """Keep commanding ``q`` (it also feeds the safety layer's watchdog) and wait;
+        returns the q sent, the one to go on from."""
+        q = self._send(q)
         self.clock.sleep(self.cfg.period)
+        return q
+
+    def _send(self, q: FloatArray) -> FloatArray:
+        """Command ``q``; returns the q to go on from: what the safety layer let through,
+        or ``q`` itself where that differs from it only by the rounding of the m -> psi
+        -> m round trip (``SEND_ROUNDING``): holding a q it let through must not drift it."""
+        sent = self.actuator.send(q)
+        rounding = float(np.max(np.abs(sent - q), initial=0.0)) <= SEND_ROUNDING
+        return np.asarray(q, dtype=np.float64) if rounding else sent
