@@ -23,14 +23,12 @@ from collections.abc import Callable
 from typing import TypedDict
 
 import numpy as np
-import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError, VisionError
 
 __all__ = ["collect", "paced_for", "settle_time"]
-
-F64 = npt.NDArray[np.float64]
 
 
 #: How far below each command every actuator first goes (m), at the least.

@@ -11,15 +11,14 @@ the gains from each other and from the geometry better than random draws.
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 from scipy.stats import qmc
 
 from softarm._core import SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError
 
 __all__ = ["MAX_POSES", "excitation_set"]
 
-F64 = npt.NDArray[np.float64]
 
 #: The most poses a calibration run drives the arm through.
 MAX_POSES = 100

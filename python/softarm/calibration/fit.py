@@ -49,6 +49,7 @@ from softarm.calibration.metrics import PoseErrorStats, rotation_residuals
 from softarm.calibration.model import ParameterMap
 from softarm.calibration.outliers import outlier_indices
 from softarm.calibration.result import Calibration
+from softarm.checks import FloatArray as F64
 from softarm.checks import numeric_array
 from softarm.errors import (
     InputError,
@@ -61,7 +62,6 @@ from softarm.errors import (
 
 __all__ = ["calibrate"]
 
-F64 = npt.NDArray[np.float64]
 
 _log = logging.getLogger(__name__)
 

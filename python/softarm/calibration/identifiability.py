@@ -17,11 +17,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
+
+from softarm.checks import FloatArray as F64
 
 __all__ = ["Identifiability", "identifiability"]
 
-F64 = npt.NDArray[np.float64]
 
 #: Below this fraction of the largest singular value a direction is not determined.
 MIN_RELATIVE_SINGULAR_VALUE = 1e-5

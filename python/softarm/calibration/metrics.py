@@ -5,12 +5,11 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
-__all__ = ["PoseErrorStats", "pose_errors", "rotation_residuals"]
+from softarm.checks import FloatArray as F64
 
-F64 = npt.NDArray[np.float64]
+__all__ = ["PoseErrorStats", "pose_errors", "rotation_residuals"]
 
 
 def rotation_residuals(predicted: F64, measured: F64) -> F64:

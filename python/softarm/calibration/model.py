@@ -40,13 +40,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import Section, SoftArm
+from softarm.checks import FloatArray as F64
 
 __all__ = ["GEOMETRY_NAMES", "ParameterMap"]
 
-F64 = npt.NDArray[np.float64]
 
 #: The geometric parameters of one section, in the order of the parameter vector.
 GEOMETRY_NAMES = ("radius", "rest_length", "offset", "twist")

@@ -15,9 +15,10 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray as F64
+
 __all__ = ["outlier_indices"]
 
-F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
 
 OUTLIER_FACTOR = 6.0

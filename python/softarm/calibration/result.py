@@ -29,13 +29,13 @@ import numpy.typing as npt
 from softarm._core import SoftArm
 from softarm.calibration.metrics import PoseErrorStats
 from softarm.calibration.model_file import FORMAT, SECTION_KEYS, model_fields
+from softarm.checks import FloatArray as F64
 from softarm.errors import NonFiniteError, ShapeError
 from softarm.files import load_toml, write_text
 from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["Calibration", "GainMap", "load_calibration", "load_model"]
 
-F64 = npt.NDArray[np.float64]
 
 _SECTION_KEYS = tuple(SECTION_KEYS)
 

@@ -8,20 +8,18 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import SoftArm
 from softarm.calibration.collect import Pacing, collect, paced_for
 from softarm.calibration.excitation import excitation_set
 from softarm.calibration.fit import calibrate
 from softarm.calibration.result import Calibration
+from softarm.checks import FloatArray as F64
 from softarm.sim.arm import PlantConfig
 from softarm.sim.tracker import PoseTracker
 from softarm.units import METRES_PER_PSI
 
 __all__ = ["PlantDriver", "build_plant", "calibrate_plant", "true_poses"]
-
-F64 = npt.NDArray[np.float64]
 
 
 def build_plant(model: SoftArm, config: PlantConfig, seed: int) -> object:

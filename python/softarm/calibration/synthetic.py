@@ -8,16 +8,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm._core import SoftArm
 from softarm.calibration.excitation import excitation_set
+from softarm.checks import FloatArray as F64
 from softarm.sim.arm import PlantConfig, perturbed_arm
 
 __all__ = ["SyntheticProblem", "noisy", "synthetic_problem"]
-
-F64 = npt.NDArray[np.float64]
 
 
 def noisy(poses: F64, rng: np.random.Generator, position: float, angle: float) -> F64:

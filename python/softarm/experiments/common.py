@@ -7,14 +7,12 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import Gains, Resolver
+from softarm.checks import FloatArray as F64
 from softarm.sim.arm import SimulatedArm
 from softarm.sim.pressure import to_psi
 from softarm.units import METRES_PER_PSI
-
-F64 = npt.NDArray[np.float64]
 
 #: Control period (s): one resolver step per tracker sample.
 CONTROL_PERIOD = 0.05

@@ -36,13 +36,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import Gains, LagModel, Resolver
+from softarm.checks import FloatArray as F64
 from softarm.experiments.common import CONTROL_PERIOD, bush_pressures, orientation_error
 from softarm.sim.arm import PlantConfig, SimulatedArm
-
-F64 = npt.NDArray[np.float64]
 
 #: Plant regulator time constants (s) measured; 1.0 s is 20 control periods of 50 ms.
 TAUS = (0.08, 0.3, 0.5, 1.0)

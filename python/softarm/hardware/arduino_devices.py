@@ -12,15 +12,14 @@ import math
 import re
 
 import numpy as np
-import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import HardwareError, OutOfRangeError, ParameterError
 from softarm.hardware.arduino import ArduinoLink
 from softarm.hardware.serial_protocol import FrameError
 
 __all__ = ["ArduinoGripper", "ArduinoPressureMonitor", "ArduinoRipenessSensor", "ReadingError"]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: Plain decimal numbers only: ``float()`` also takes ``" 1"``, ``"1_0"`` or ``"infinity"``.
 _NUMBER = re.compile(r"-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?")

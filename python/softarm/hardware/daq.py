@@ -18,14 +18,12 @@ from types import ModuleType
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import HardwareError, HardwareUnavailableError, ShapeError
 from softarm.hardware.pressure_map import VoltageMap
 
 __all__ = ["NidaqPressureBank", "import_nidaqmx"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 def import_nidaqmx() -> ModuleType:

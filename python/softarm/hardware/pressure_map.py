@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import NonFiniteError, OutOfRangeError, ParameterError
 from softarm.units import MAX_PSI, METRES_PER_PSI, PA_PER_PSI
 
@@ -39,7 +40,6 @@ __all__ = [
     "VoltageMap",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 ArrayLike = npt.ArrayLike
 
 # PA_PER_PSI and METRES_PER_PSI are defined once in softarm.units and re-exported here.

@@ -13,9 +13,9 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Camera", "Gripper", "PressureBank", "RipenessSensor"]
+from softarm.checks import FloatArray
 
-FloatArray = npt.NDArray[np.float64]
+__all__ = ["Camera", "Gripper", "PressureBank", "RipenessSensor"]
 
 
 @runtime_checkable

@@ -22,7 +22,7 @@ from types import TracebackType
 import numpy as np
 import numpy.typing as npt
 
-from softarm.checks import numeric_array
+from softarm.checks import FloatArray, numeric_array
 from softarm.errors import (
     HardwareError,
     NonFiniteError,
@@ -36,7 +36,6 @@ from softarm.hardware.watchdog import WatchdogThread
 
 __all__ = ["CommandResult", "SafePressureBank", "VentEvent"]
 
-FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
 
 _log = logging.getLogger(__name__)

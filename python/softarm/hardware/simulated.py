@@ -23,6 +23,7 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import HardwareError, HardwareUnavailableError, ShapeError
 from softarm.hardware.pressure_map import ITV1031_FULL_SCALE_PSI
 
@@ -36,7 +37,6 @@ __all__ = [
     "SimulatedRipenessSensor",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 Image = npt.NDArray[np.uint8]
 
 

@@ -17,14 +17,13 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import NonFiniteError, ParameterError
 from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.plant_model import MeasurementModel
 
 __all__ = ["SafeActuator", "lead_gain"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class PressureMap(Protocol):

@@ -12,16 +12,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import PolynomialCurve, SoftArm, closest
+from softarm.checks import FloatArray
 
 # The radii are defined once in softarm.geometry (the Cosserat plant uses them too).
 from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
 
 __all__ = ["ACTUATOR_RADIUS", "CANE_RADIUS", "GRIPPER_RADIUS", "Clearance"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class Clearance:

@@ -11,14 +11,12 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import Resolver
+from softarm.checks import FloatArray
 from softarm.harvest.clearance import Clearance
 
 __all__ = ["ResolverController"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class ResolverController:

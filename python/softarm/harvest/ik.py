@@ -18,9 +18,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import Resolver, SoftArm
+from softarm.checks import FloatArray
 from softarm.geometry import cone_axes
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.config import HarvestConfig
@@ -28,7 +28,6 @@ from softarm.harvest.targets import approach_pose
 
 __all__ = ["ModelIK", "cone_axes", "planning_resolver"]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: The planner's last pass: a via configuration off the approach line (:meth:`ModelIK._detour`).
 DETOUR = -1.0

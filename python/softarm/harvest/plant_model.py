@@ -24,11 +24,10 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import LagModel
+from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 
 __all__ = ["MEASUREMENT_LAG_PERIODS", "MeasurementModel", "predicted_loop_alpha"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 #: The measurement's own lag (control periods) the predictor puts behind the regulators:

@@ -10,14 +10,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.harvest.report import HarvestReport
 from softarm.harvest.sim_rig import SimRig
 from softarm.viz.arm import arm_line, clip_to_box
 from softarm.viz.gripper import gripper_polylines
 
 __all__ = ["berry_colours", "berry_paths", "plot_errors", "plot_run", "plot_scene"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 def berry_colours(tags: list[int]) -> dict[int, str]:

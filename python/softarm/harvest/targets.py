@@ -11,13 +11,11 @@ then exactly the pointing error.
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm import so3
+from softarm.checks import FloatArray
 
 __all__ = ["align_z", "approach_pose", "grasp_point", "pointing_error", "tool_pose"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 def align_z(rotation: FloatArray, axis: FloatArray) -> FloatArray:

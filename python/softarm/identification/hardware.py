@@ -13,8 +13,8 @@ from __future__ import annotations
 from contextlib import ExitStack
 
 import numpy as np
-import numpy.typing as npt
 
+from softarm.checks import FloatArray as F64
 from softarm.config import Config
 from softarm.errors import ConfigError
 from softarm.hardware.arduino import ArduinoLink
@@ -30,8 +30,6 @@ from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision
 
 __all__ = ["HardwareIdentificationRig"]
-
-F64 = npt.NDArray[np.float64]
 
 
 class HardwareIdentificationRig:

@@ -43,6 +43,7 @@ from scipy.optimize import least_squares
 from scipy.signal import lfilter
 
 from softarm._core import Section, SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.identification.record import Recording
 
 __all__ = [
@@ -54,7 +55,6 @@ __all__ = [
     "tracked",
 ]
 
-F64 = npt.NDArray[np.float64]
 
 #: Residual scales: the tracker's noise per axis (0.1 mm, 0.1 deg; paper III).
 SIGMA_POSITION = 1e-4

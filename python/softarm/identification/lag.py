@@ -19,13 +19,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 from scipy.optimize import least_squares
 from scipy.signal import lfilter
 
+from softarm.checks import FloatArray as F64
+
 __all__ = ["LagFit", "fit_lag", "simulate_lag"]
 
-F64 = npt.NDArray[np.float64]
 
 #: Bounds of the search (s): a time constant below dt/50 cannot be told from none at the
 #: control rate; a dead time beyond 1 s would mean a broken line.

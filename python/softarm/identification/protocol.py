@@ -24,13 +24,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError
 
 __all__ = ["Design", "Segment"]
-
-F64 = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -14,11 +14,11 @@ effector; 0.2 psi is a seventh of the 1.5 psi of play the simulated regulators h
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
+
+from softarm.checks import FloatArray as F64
 
 __all__ = ["HYSTERESIS_STD_PSI", "METRES_PER_PSI_REL_STD", "poor_estimates"]
 
-F64 = npt.NDArray[np.float64]
 
 #: The largest relative standard deviation of an elongation per psi.
 METRES_PER_PSI_REL_STD = 0.01

@@ -14,14 +14,13 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
-import numpy.typing as npt
 
+from softarm.checks import FloatArray as F64
 from softarm.identification.protocol import Segment
 from softarm.identification.rig import IdentificationRig
 
 __all__ = ["HoldWindow", "Recording", "run_experiment"]
 
-F64 = npt.NDArray[np.float64]
 
 #: ``progress(arm_time_s, budget_s, what)`` after every segment.
 Progress = Callable[[float, float, str], None]

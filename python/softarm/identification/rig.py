@@ -12,9 +12,9 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError
 from softarm.hardware.safety import SafePressureBank
 from softarm.hardware.simulated import SimulatedPressureBank
@@ -23,7 +23,6 @@ from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["IdentificationRig", "SimIdentificationRig", "sim_plant_seed"]
 
-F64 = npt.NDArray[np.float64]
 
 #: Safety limits of the simulated rig, the same as ``build_sim_rig``'s: 70 psi (the
 #: arm's 0.0333 m upper limit), 100 psi/s, 0.5 s watchdog.

@@ -13,15 +13,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm import _core
+from softarm.checks import FloatArray
 from softarm.planning.scenarios import COLLISION_DISTANCE, SUBSTEPS, Result, Scenario
 from softarm.viz.arm import clip_to_box
 
 __all__ = ["first_contact", "plot_plan", "snapshot_iterations"]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: Backbone samples per section.
 SAMPLES = 30

@@ -21,14 +21,13 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import Section, SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError, ShapeError
 from softarm.sim.hysteresis import PlayHysteresis
 from softarm.sim.plant_file import plant_from_mapping, validate_plant_value
 from softarm.sim.pressure import PressureDynamics, to_psi
 from softarm.sim.tracker import PoseTracker
 from softarm.units import MAX_PSI, METRES_PER_PSI
-
-F64 = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)

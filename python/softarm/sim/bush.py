@@ -15,15 +15,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import PolynomialCurve
+from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 from softarm.geometry import cone_axes
 
 __all__ = ["Berry", "Branch", "Bush"]
 
-FloatArray = npt.NDArray[np.float64]
 PLUS_Y = np.array([0.0, 1.0, 0.0])
 
 

@@ -7,15 +7,13 @@ implements the same five methods (``command_pressures``, ``pressures``, ``advanc
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import SoftArm
+from softarm.checks import FloatArray
 from softarm.sim.arm import SimulatedArm
 from softarm.units import METRES_PER_PSI
 
 __all__ = ["ArmPlant"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class ArmPlant:

@@ -9,14 +9,13 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError
 
 # The map's constants are defined once in softarm.units; re-exported here for the plant.
 from softarm.units import MAX_PSI, METRES_PER_PSI
 
 __all__ = ["MAX_PSI", "METRES_PER_PSI", "PressureDynamics", "to_metres", "to_psi"]
-
-F64 = npt.NDArray[np.float64]
 
 
 def to_psi(q: npt.ArrayLike, metres_per_psi: float = METRES_PER_PSI) -> F64:

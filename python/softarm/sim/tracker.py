@@ -7,12 +7,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm import so3
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError
-
-F64 = npt.NDArray[np.float64]
 
 
 class PoseTracker:

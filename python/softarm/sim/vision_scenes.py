@@ -4,10 +4,9 @@ berry tag close to an eye-in-hand camera. Used by tests, benchmarks and examples
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
-FloatArray = npt.NDArray[np.float64]
+from softarm.checks import FloatArray
 
 
 def random_cube_pose(

@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
+from softarm.checks import FloatArray
 
 
 def pose_from_rvec_tvec(rvec: npt.ArrayLike, tvec: npt.ArrayLike) -> FloatArray:

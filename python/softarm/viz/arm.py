@@ -8,8 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import ArcChain, SoftArm
-
-FloatArray = npt.NDArray[np.float64]
+from softarm.checks import FloatArray
 
 SECTION_COLOURS = ("tab:red", "tab:green", "tab:blue", "tab:purple", "tab:orange")
 

@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import ParameterError, ShapeError
 
 __all__ = ["gripper_outline", "gripper_polylines"]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: Half the palm's width (m): the open jaws clear a 2 cm berry with room to spare.
 HALF_PALM = 0.02

@@ -23,8 +23,8 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from softarm.checks import FloatArray
 from softarm.errors import InputError, ShapeError
 from softarm.harvest.states import HarvestState
 from softarm.viz.arm import arm_polylines
@@ -33,7 +33,6 @@ from softarm.viz.rerun_sdk import TIMELINE
 
 __all__ = ["STATE_INDEX", "ArmDrawer", "RecordLogger"]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: The states as numbers for the state plot, in the order of the workflow (fig. 4).
 STATE_INDEX: dict[str, int] = {s.value: i for i, s in enumerate(HarvestState)}

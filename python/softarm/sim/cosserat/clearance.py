@@ -12,14 +12,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import PolynomialCurve
+from softarm.checks import FloatArray as F64
 from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
 
 __all__ = ["RodClearance"]
-
-F64 = npt.NDArray[np.float64]
 
 
 def _point_segment_distances(points: F64, a: F64, b: F64) -> F64:

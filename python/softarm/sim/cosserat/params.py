@@ -28,14 +28,13 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-import numpy.typing as npt
 
 from softarm._core import SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.errors import ParameterError
 
 __all__ = ["RodParameters", "cantilever_sag", "design_stiffness"]
 
-F64 = npt.NDArray[np.float64]
 
 #: Muscles per section, proximal first (paper II-A: three pairs, three pairs, three).
 MUSCLES = (6, 6, 3)

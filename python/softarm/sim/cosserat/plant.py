@@ -16,14 +16,13 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.cosserat.params import RodParameters
 from softarm.sim.cosserat.rod import RodArm
 from softarm.sim.plant import ArmPlant
 
 __all__ = ["CosseratPlant"]
-
-F64 = npt.NDArray[np.float64]
 
 
 class CosseratPlant(ArmPlant):

@@ -42,6 +42,7 @@ import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm._core import SoftArm
+from softarm.checks import FloatArray as F64
 from softarm.errors import DivergenceError, NonFiniteError, ShapeError
 from softarm.geometry import ACTUATOR_RADIUS
 from softarm.sim.cosserat import require_elastica
@@ -49,7 +50,6 @@ from softarm.sim.cosserat.params import RodParameters
 
 __all__ = ["RodArm"]
 
-F64 = npt.NDArray[np.float64]
 
 #: The clamped stub below the base plane (m) and its element kind.
 _STUB = 0.01

@@ -16,11 +16,12 @@ from typing import Any
 
 import numpy as np
 
+from softarm.checks import FloatArray
 from softarm.errors import InputError
 from softarm.harvest.header import HEADER, find_header
 from softarm.viz.bag.markers import scene_markers
 from softarm.viz.bag.messages import Messages
-from softarm.viz.bag.scene import FloatArray, RunScene
+from softarm.viz.bag.scene import RunScene
 from softarm.viz.records import _LEVELS, _seconds, as_pose, as_vector
 
 __all__ = ["TOPICS", "Converter", "Message", "actuator_names"]

@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
 import softarm
+from softarm.checks import FloatArray
 from softarm.errors import InputError
 from softarm.harvest.header import FORMAT
 from softarm.sim.bush import Branch
@@ -21,7 +21,6 @@ from softarm.viz.records import as_pose, as_vector
 
 __all__ = ["BerryMark", "RunScene"]
 
-FloatArray = npt.NDArray[np.float64]
 #: Points along each cane's line strip.
 CANE_SAMPLES = 40
 
