@@ -10,6 +10,9 @@ from typing import Any
 import numpy as np
 import pytest
 
+from softarm import SoftArm
+from softarm.calibration.metrics import PoseErrorStats
+from softarm.calibration.result import Calibration, GainMap
 from softarm.config import GainsConfig
 from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest import hw_rig, rig, sim_rig
@@ -104,3 +107,14 @@ def test_without_an_identified_plant_the_hardware_gain_is_bounded_for_the_slowes
     assert not hw["predicts"] and hw["transport"] is None and hw["lead"] == 0.0
     assert hw["gains"]["lag_periods"] == rig.Gains().lag_periods
     assert hw["way_check"] and hw["planner_checks"]  # no canes known: checked all the same
+
+
+def test_a_fitted_model_replaces_the_configured_arm_and_channel_gains() -> None:
+    config = _config()
+    arm = SoftArm.blackberry()
+    poses = np.tile(np.eye(4), (2, 1, 1))
+    fit = Calibration(arm, np.full(N, 1.1), PoseErrorStats.of(poses, poses))
+    inputs = hw_rig.hardware_inputs(config, calibration=fit)
+    assert inputs.model is arm
+    assert isinstance(inputs.pressure_map, GainMap)
+    assert inputs.pressure_map.max_psi == config.channels.p_max
