@@ -47,4 +47,5 @@ def excitation_set(
         order.append(k)
         left.remove(k)
         here = pts[k]
-    return pts[order]
+    result: F64 = pts[order]
+    return result

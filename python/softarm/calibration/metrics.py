@@ -15,7 +15,8 @@ __all__ = ["PoseErrorStats", "pose_errors", "rotation_residuals"]
 def rotation_residuals(predicted: F64, measured: F64) -> F64:
     """Rotation vectors (N, 3) of ``R_pred R_meas^T`` (base frame, rad)."""
     rel = np.einsum("nij,nkj->nik", predicted[:, :3, :3], measured[:, :3, :3])
-    return Rotation.from_matrix(rel).as_rotvec()
+    result: F64 = Rotation.from_matrix(rel).as_rotvec()
+    return result
 
 
 def pose_errors(predicted: F64, measured: F64) -> tuple[F64, F64]:

@@ -100,7 +100,8 @@ class ParameterMap:
         if not self.bias:
             return np.zeros(self.n_actuators)
         b = x[4 * self.n_sections + self.n_actuators :].reshape(self.n_sections, 2)
-        return (BIAS_SCALE * b @ _BIAS_BASIS).ravel()
+        result: F64 = (BIAS_SCALE * b @ _BIAS_BASIS).ravel()
+        return result
 
     def offset_scales(self) -> F64:
         return np.array(

@@ -83,7 +83,8 @@ class Trace:
             return 0.0
         if above[-1] == len(e) - 1:
             return math.inf
-        return self.time[above[-1] + 1]
+        result: float = self.time[above[-1] + 1]
+        return result
 
 
 def closed_loop(

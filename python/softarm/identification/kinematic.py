@@ -178,7 +178,8 @@ def fit_kinematics(
     def predict(x: F64, z: F64) -> F64:
         geom, gain, w = unpack(x)
         q = m0 * gain * (pressure + 0.5 * z * w)
-        return tracked(_arm(nominal, geom), q, keep)[idx]
+        result: F64 = tracked(_arm(nominal, geom), q, keep)[idx]
+        return result
 
     def residual(x: F64, z: F64) -> F64:
         return pose_residual(predict(x, z), measured)

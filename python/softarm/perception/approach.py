@@ -67,7 +67,8 @@ class RayCrossing:
         if 1.0 - b * b < np.sin(MIN_CROSSING) ** 2:
             return None
         t = (b * float(self.c1_ray @ w) - float(ray @ w)) / (1.0 - b * b)
-        return local * t
+        result: FloatArray = local * t
+        return result
 
     def consistent(
         self, det: BerryDetection, T_base_camera: FloatArray, camera: CameraModel

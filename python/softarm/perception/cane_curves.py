@@ -85,7 +85,8 @@ def _arc_length_parameters(coeffs: FloatArray, points: FloatArray) -> FloatArray
     lo, hi = nearest.min(), nearest.max()
     steps = np.linalg.norm(np.diff(dense[lo : hi + 1], axis=0), axis=1)
     arc = np.concatenate([[0.0], np.cumsum(steps)])
-    return arc[nearest - lo] / max(float(arc[-1]), 1e-12)
+    result: FloatArray = arc[nearest - lo] / max(float(arc[-1]), 1e-12)
+    return result
 
 
 def split_into_curves(points: FloatArray, search: CurveSearch) -> list[IndexArray]:
@@ -151,7 +152,8 @@ def _best_line(
 def _line_distance(points: FloatArray, anchor: FloatArray, direction: FloatArray) -> FloatArray:
     """Distance of each point to the line through ``anchor`` along unit ``direction``."""
     offset = points - anchor
-    return np.linalg.norm(offset - np.outer(offset @ direction, direction), axis=1)
+    result: FloatArray = np.linalg.norm(offset - np.outer(offset @ direction, direction), axis=1)
+    return result
 
 
 def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> IndexArray:

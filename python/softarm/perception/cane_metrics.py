@@ -79,7 +79,8 @@ def _sampled(all_coeffs: Sequence[FloatArray]) -> FloatArray:
 def _inside(points: FloatArray, workspace: Workspace) -> FloatArray:
     if workspace is None or np.isscalar(workspace):
         reach = DEFAULT_REACH if workspace is None else float(workspace)  # type: ignore[arg-type]
-        return points[np.linalg.norm(points, axis=1) <= reach]
+        result: FloatArray = points[np.linalg.norm(points, axis=1) <= reach]
+        return result
     lower, upper = (np.asarray(b, dtype=np.float64) for b in workspace)  # type: ignore[union-attr]
     return points[np.all((points >= lower) & (points <= upper), axis=1)]
 

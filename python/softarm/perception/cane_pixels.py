@@ -61,7 +61,8 @@ def _thin(mask: npt.NDArray[np.uint8], look: CaneLook) -> BoolImage:
     kept = cv2.morphologyEx(mask, cv2.MORPH_OPEN, square)
     disk = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (look.blob, look.blob))
     blobs = cv2.morphologyEx(mask, cv2.MORPH_OPEN, disk)
-    return (kept > 0) & (blobs == 0)
+    result: BoolImage = (kept > 0) & (blobs == 0)
+    return result
 
 
 def half_width_px(mask: BoolImage) -> npt.NDArray[np.float32]:

@@ -403,7 +403,8 @@ class SyntheticCamera:
         r2 = ((xx - cx) ** 2 + (yy - cy) ** 2) / float(cx**2 + cy**2)
         table = (1.0 - amount * r2).astype(np.float32)
         self._vignette_cache = (amount, table)
-        return table
+        result: npt.NDArray[np.float32] = table
+        return result
 
 
 def _unit_outline() -> FloatArray:

@@ -119,4 +119,5 @@ def _fit_lines(points: FloatArray, side: npt.NDArray[np.intp]) -> FloatArray | N
         return None
     gap = centre - p1
     s = (gap[:, 0] * direction[:, 1] - gap[:, 1] * direction[:, 0]) / cross
-    return p1 + s[:, None] * d1
+    result: FloatArray = p1 + s[:, None] * d1
+    return result

@@ -28,7 +28,8 @@ def _point_segment_distances(points: F64, a: F64, b: F64) -> F64:
         / np.maximum(np.einsum("sk,sk->s", ab, ab), 1e-18)[:, None]
     )
     closest = a[:, None] + np.clip(t, 0.0, 1.0)[..., None] * ab[:, None]
-    return np.linalg.norm(points[None] - closest, axis=2)
+    result: F64 = np.linalg.norm(points[None] - closest, axis=2)
+    return result
 
 
 class RodClearance:

@@ -130,7 +130,8 @@ class RodParameters:
         if self.shear_stiffness is not None:
             return np.asarray(self.shear_stiffness, dtype=float)
         r = np.array([s.radius for s in arm.sections])
-        return (27.0 / 28.0) * (2.0 * self.stiffness(arm) / r**2) / 3.0
+        result: F64 = (27.0 / 28.0) * (2.0 * self.stiffness(arm) / r**2) / 3.0
+        return result
 
     def with_stiffness(self, arm: SoftArm) -> RodParameters:
         """A copy with the designed stiffness fixed (so perturbed arms keep it)."""
@@ -186,4 +187,5 @@ def design_stiffness(arm: SoftArm, p: RodParameters) -> F64:
     evaluation at unit scale gives the scale."""
     shape = np.array([n * s.radius**2 for n, s in zip(p.muscles, arm.sections, strict=True)])
     shape = shape / shape[0]
-    return shape * cantilever_sag(arm, p, shape) / p.design_sag
+    result: F64 = shape * cantilever_sag(arm, p, shape) / p.design_sag
+    return result

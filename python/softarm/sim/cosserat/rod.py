@@ -130,7 +130,8 @@ class RodArm:
         rvl = 0.5 * (lengths_a[1:] + lengths_a[:-1])
 
         def series(k: F64) -> F64:
-            return rvl / (0.5 * lengths_a[1:] / k[1:] + 0.5 * lengths_a[:-1] / k[:-1])
+            result: F64 = rvl / (0.5 * lengths_a[1:] / k[1:] + 0.5 * lengths_a[:-1] / k[:-1])
+            return result
 
         ei_v, gj_v = series(ei), series(gj)
         rod.bend_matrix[:] = 0.0
@@ -280,7 +281,8 @@ class RodArm:
 
     def centreline(self) -> F64:
         """Node positions (n_nodes, 3) of the rod from the base (origin) to the tip."""
-        return self.rod.position_collection[:, 1:].T.copy()
+        result: F64 = self.rod.position_collection[:, 1:].T.copy()
+        return result
 
     def node_sections(self) -> npt.NDArray[np.int64]:
         """Section index of every node of :meth:`centreline` (the node ending an element;

@@ -28,7 +28,8 @@ CATEGORIES: list[dict[str, Any]] = [
 
 def category_id(name: str) -> int:
     """The id of the category called ``name``."""
-    return next(c["id"] for c in CATEGORIES if c["name"] == name)
+    result: int = next(c["id"] for c in CATEGORIES if c["name"] == name)
+    return result
 
 
 def mask_bbox(mask: npt.NDArray[np.bool_]) -> list[int]:

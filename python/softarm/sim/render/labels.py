@@ -48,4 +48,7 @@ class GeomLabels:
         """Pixels of one object (a berry by tag id, a cane by index)."""
         g = np.maximum(geoms, 0)
         code = KINDS.index(kind)
-        return (geoms >= 0) & (self.kind[g] == code) & (self.instance[g] == instance)
+        result: npt.NDArray[np.bool_] = (
+            (geoms >= 0) & (self.kind[g] == code) & (self.instance[g] == instance)
+        )
+        return result

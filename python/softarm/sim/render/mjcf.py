@@ -123,7 +123,8 @@ def z_to(direction: FloatArray) -> FloatArray:
     if n < 1e-12:
         return np.eye(3)
     rot, _ = Rotation.align_vectors([direction / n], [[0.0, 0.0, 1.0]])
-    return rot.as_matrix()
+    result: FloatArray = rot.as_matrix()
+    return result
 
 
 def _capsule(name: str, a: FloatArray, b: FloatArray, radius: float, rgba: str) -> str:

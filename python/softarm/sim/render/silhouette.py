@@ -45,7 +45,8 @@ def _surface(model: Any, data: Any, geom: int) -> FloatArray:
     size = model.geom_size[geom]
     radii = size if model.geom_type[geom] == _ELLIPSOID else np.full(3, size[0])
     rotation = data.geom_xmat[geom].reshape(3, 3)
-    return data.geom_xpos[geom] + (_DIRECTIONS * radii) @ rotation.T
+    result: FloatArray = data.geom_xpos[geom] + (_DIRECTIONS * radii) @ rotation.T
+    return result
 
 
 def silhouette_area(
