@@ -11,9 +11,13 @@ from __future__ import annotations
 
 import importlib
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softarm.errors import SoftarmError
+
+if TYPE_CHECKING:  # imported lazily below (PyElastica is optional)
+    from softarm.sim.cosserat.plant import CosseratPlant
+    from softarm.sim.cosserat.rod import RodArm
 
 __all__ = ["CosseratPlant", "MissingDependencyError", "RodArm", "require_elastica"]
 
