@@ -39,6 +39,7 @@ from softarm.hardware.limits import (
 )
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
+from softarm.perception_config import PerceptionConfig, parse_perception
 from softarm.units import MAX_PSI, METRES_PER_PSI, PA_PER_PSI
 
 __all__ = [
@@ -49,6 +50,7 @@ __all__ = [
     "Config",
     "GainsConfig",
     "HarvestConfig",
+    "PerceptionConfig",
     "PlantModelConfig",
     "SectionConfig",
     "SerialConfig",
@@ -191,6 +193,8 @@ class Config:
     plant_model: PlantModelConfig | None = None
     #: ``[harvest]``: the state machine's tuning (:class:`softarm.harvest.HarvestConfig`).
     harvest: HarvestConfig = field(default_factory=HarvestConfig)
+    #: ``[perception]``: C1's stereo source for the markerless harvest (None: the tags).
+    perception: PerceptionConfig | None = None
 
 
 def load_config(path: str | Path) -> Config:
@@ -455,8 +459,9 @@ def _build(root: _Table) -> Config:
     se.done()
     plant_model = _plant_model(root.table("plant_model"), len(channels.names))
     harvest = _harvest(root.table("harvest"))
+    perception = parse_perception(root.table("perception"))
     root.done()
-    return Config(arm, gains, calibration, channels, serial, plant_model, harvest)
+    return Config(arm, gains, calibration, channels, serial, plant_model, harvest, perception)
 
 
 def _harvest(t: _Table) -> HarvestConfig:
@@ -585,4 +590,7 @@ def dump_config(config: Config) -> str:
     out += ["[harvest]", *_lines(asdict(config.harvest))]
     if config.plant_model is not None:
         out += ["", "[plant_model]", *_lines(asdict(config.plant_model))]
+    if config.perception is not None:
+        written = {k: v for k, v in asdict(config.perception).items() if k != "folder"}
+        out += ["", "[perception]", *_lines(written)]
     return "\n".join(out) + "\n"

@@ -55,6 +55,17 @@ source = 1
 
 """
 
+#: Appended to the template: the markerless harvest's stereo source, commented out (the
+#: harvest finds tagged berries with C1 alone without it).
+PERCEPTION = """\
+
+# [perception]  # C1 as a stereo camera: berries without tags, canes fitted from depth
+# stereo = "zed2"  # one side-by-side USB video device (a ZED2 without its SDK), or "pair"
+# device = 0  # the ZED2's OpenCV device index or a path; a "pair" takes left and right
+# calibration = "stereo.yml"  # from `softarm camera calibrate`, next to this file
+# berries = "markerless"  # or "tags"
+"""
+
 HEADER = """\
 # softarm hardware configuration, written by `softarm config init`.
 # 1. Fill in [calibration] below (the poses and both cameras' intrinsics).
@@ -70,7 +81,7 @@ def template() -> str:
     calibration entries to fill in."""
     shipped = resources.files("softarm.data").joinpath("blackberry.toml").read_text("utf-8")
     start, end = shipped.index("\n[calibration]") + 1, shipped.index("\n[channels]") + 1
-    return HEADER + shipped[:start] + CALIBRATION + shipped[end:]
+    return HEADER + shipped[:start] + CALIBRATION + shipped[end:] + PERCEPTION
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -131,9 +142,11 @@ def run_check(args: argparse.Namespace) -> int:
 
 def file_problems(config: Config, path: Path) -> list[str]:
     """One line per file the config names that cannot be opened or parsed, and per
-    inline value that the harvest would refuse: both cameras' intrinsics, the gains and
-    the identified plant (``[plant_model]``)."""
+    inline value that the harvest would refuse: both cameras' intrinsics, the gains,
+    the identified plant (``[plant_model]``) and the stereo calibration
+    (``[perception]``)."""
     from softarm._core import Gains
+    from softarm.perception_config import check_perception
     from softarm.vision.camera_model import camera_from_config
 
     checks: list[Callable[[], object]] = [
@@ -143,6 +156,7 @@ def file_problems(config: Config, path: Path) -> list[str]:
     ]
     checks.append(lambda: Gains(**config.gains.values))
     checks.append(lambda: _plant_model(config, path))
+    checks.append(functools.partial(check_perception, config.perception))
     return [p for p in map(_problem, checks) if p is not None]
 
 

@@ -85,7 +85,7 @@ def read_stereo(path: str | Path) -> StereoModel:
 
 def _mat(fs: Any, key: str, path: str | Path) -> np.ndarray:
     node = fs.getNode(key)
-    mat = None if node.isNone() else node.mat()
+    mat = None if node.isNone() or not node.isMap() else node.mat()
     if mat is None:
         raise ConfigError(f"stereo file {str(path)!r}: {key} is missing or not a matrix")
     return np.asarray(mat, dtype=np.float64)

@@ -1,0 +1,117 @@
+"""The ``[perception]`` table of hw.toml: where C1's stereo images come from and how
+they are calibrated, for the markerless harvest on the hardware (docs/hardware.md).
+
+``stereo = "zed2"`` is one side-by-side USB video device (``device``, an index or a
+path; the ZED2 without its SDK), split into its halves; ``stereo = "pair"`` is two
+OpenCV devices (``left``, ``right``). ``calibration`` is a ``stereo.yml`` written by
+``softarm camera calibrate`` (resolved against the config file's folder); ``berries``
+is ``"markerless"`` (found by perception, the default) or ``"tags"`` (ArUco tags).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from softarm.errors import ConfigError
+
+if TYPE_CHECKING:
+    from softarm.config import _Table
+
+__all__ = [
+    "BERRY_MODES",
+    "STEREO_SOURCES",
+    "PerceptionConfig",
+    "check_perception",
+    "parse_perception",
+]
+
+#: The stereo sources: one side-by-side device, or two devices.
+STEREO_SOURCES = ("zed2", "pair")
+#: How the berries are found: by perception, or by their ArUco tags.
+BERRY_MODES = ("markerless", "tags")
+
+
+@dataclass(frozen=True)
+class PerceptionConfig:
+    """``[perception]``: the stereo source, its calibration file and the berry mode;
+    ``folder`` is the config file's, which paths resolve against."""
+
+    stereo: str = "zed2"
+    calibration: str = "stereo.yml"
+    device: int | str | None = None
+    left: int | str | None = None
+    right: int | str | None = None
+    berries: str = "markerless"
+    folder: str | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def calibration_path(self) -> str:
+        """The ``stereo.yml``, resolved against the config file's folder."""
+        from softarm.config import resolve
+
+        return resolve(self.calibration, self.folder)
+
+    def devices(self) -> tuple[int | str, ...]:
+        """The OpenCV sources: (device,) for a ZED2, (left, right) for a pair; a
+        relative file name resolved against the config file's folder."""
+        raw = (self.device,) if self.stereo == "zed2" else (self.left, self.right)
+        return tuple(_device(d, self.folder) for d in raw if d is not None)
+
+
+def _device(source: int | str, folder: str | None) -> int | str:
+    from softarm.config import resolve
+
+    if isinstance(source, int) or "://" in source or "!" in source:
+        return source
+    return resolve(source, folder)
+
+
+def parse_perception(t: _Table) -> PerceptionConfig | None:
+    """``[perception]`` checked key by key (None when the table is absent)."""
+    if not t.data:
+        return None
+    stereo = _choice(t, "stereo", STEREO_SOURCES, "zed2")
+    calibration = t.get("calibration", "stereo.yml")
+    if not isinstance(calibration, str) or not calibration:
+        raise t.error("calibration", "must be a path string (a stereo.yml)")
+    wanted = ("device",) if stereo == "zed2" else ("left", "right")
+    unwanted = ("left", "right") if stereo == "zed2" else ("device",)
+    for name in unwanted:
+        if name in t.data:
+            raise t.error(name, f"is not a key of stereo = {stereo!r} (it takes {wanted})")
+    sources = {name: _source(t, name, 0 if name == "device" else None) for name in wanted}
+    berries = _choice(t, "berries", BERRY_MODES, "markerless")
+    config = PerceptionConfig(stereo, calibration, berries=berries, folder=t.folder, **sources)
+    t.done()
+    return config
+
+
+def _choice(t: _Table, name: str, allowed: tuple[str, ...], default: str) -> str:
+    value: Any = t.get(name, default)
+    if value not in allowed:
+        raise t.error(name, f"must be one of {', '.join(repr(a) for a in allowed)}")
+    return str(value)
+
+
+def _source(t: _Table, name: str, default: int | None) -> int | str:
+    value: Any = t.get(name, ... if default is None else default)
+    if isinstance(value, bool) or not isinstance(value, int | str) or value == "":
+        raise t.error(name, "must be a device index or a path/URL string")
+    return value
+
+
+def check_perception(perception: PerceptionConfig | None) -> None:
+    """Open and parse the calibration file (``config check``).
+
+    Raises:
+        ConfigError: it is missing or broken, named as ``perception.calibration``.
+    """
+    if perception is None:
+        return
+    from softarm.vision.stereo_files import read_stereo
+
+    try:
+        read_stereo(perception.calibration_path)
+    except ConfigError as exc:
+        raise ConfigError(f"perception.calibration: {exc}") from None
