@@ -16,9 +16,11 @@ from softarm._core import PolynomialCurve
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 from softarm.harvest.interfaces import BerryTarget
+from softarm.harvest.map_harvest import harvest_map
 from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.rig_parts import a_cane
 from softarm.harvest.sim_devices import SimGripper
-from softarm.perception.bush_map import BushMap
+from softarm.perception.bush_map import BushMap, MappedBerry
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.canes import fit_canes
 from softarm.perception.overlay import draw_bush_map
@@ -87,7 +89,7 @@ class BushScene:
         draw_arm(self.world, self.plant)
         left, right = self.world.c1()
         fits = fit_canes(left.colour, right.colour, self.c1())
-        self.bush_map.canes = [f for f in fits if _a_cane(f.points[:, :3], rig_parts, reach)]
+        self.bush_map.canes = [f for f in fits if a_cane(f.points[:, :3], rig_parts, reach)]
         return [c.curve for c in self.bush_map.canes]
 
     def frames(self) -> tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray]]:
@@ -133,16 +135,6 @@ class BushScene:
         return near if np.linalg.norm(near.position - entry.position) <= TRUTH_MATCH else None
 
 
-#: How near (m) a fitted curve may come to the rig's own parts and still be a cane.
-SELF_MARGIN = 0.06
-
-
-def _a_cane(points: FloatArray, rig_parts: FloatArray, reach: float) -> bool:
-    gaps = np.linalg.norm(points[:, None, :] - rig_parts[None, :, :], axis=2)
-    in_reach = np.linalg.norm(points, axis=1) <= reach
-    return bool(gaps.min() > SELF_MARGIN and in_reach.any())
-
-
 class BushGripper(SimGripper):
     """:class:`SimGripper` whose selected berry is a map entry: it closes on the true
     berry that entry stands for (ground truth, :meth:`BushScene.truth_of`)."""
@@ -162,19 +154,11 @@ def harvest_bush(
     delivered: list[int],
     on_berry: Callable[[int, BerryResult], None] | None = None,
 ) -> HarvestReport:
-    """Pick the map's ripe berries one by one, looking again with C1 each time the arm
-    is home (a berry the arm or a picked one hid may come into view), until no ripe
-    berry is left untried."""
+    """Pick the map's ripe berries one by one (:func:`~softarm.harvest.map_harvest.
+    harvest_map`, the loop the arm runs), each result judged against the true bush."""
     report = HarvestReport()
-    tried: set[int] = set()
-    for _ in range(len(scene.bush.berries) + 8):
-        scene.look()
-        todo = [b for b in scene.bush_map.ripe() if b.id not in tried]
-        if not todo:
-            break
-        entry = min(todo, key=lambda b: b.position[0])  # left to right
-        tried.add(entry.id)
-        result = run_berry(BerryTarget(entry.id, f"map berry {entry.id}"))
+
+    def judged(entry: MappedBerry, result: BerryResult) -> None:
         truth = scene.truth_of(entry.id)
         result.ripe = None if truth is None else bool(truth.ripeness >= 0.5)
         if truth is not None:
@@ -184,6 +168,8 @@ def harvest_bush(
         report.berries.append(result)
         if on_berry is not None:
             on_berry(len(report.berries) - 1, result)
+
+    harvest_map(scene.look, scene.bush_map, run_berry, len(scene.bush.berries) + 8, judged)
     report.extra.update(_bush_extra(scene, delivered))
     return report
 

@@ -26,6 +26,7 @@ from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
+from softarm.harvest.rig_parts import CANE_REACH, rig_parts
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_plant import ArmPlant
 from softarm.harvest.sim_vision import BASE_TAG_ID, SimCameras, look_at, sim_vision
@@ -210,7 +211,8 @@ def build_sim_rig(
         vision = _bush_vision(scene, cams, cfg.grasp_offset)
         gripper = BushGripper(scene, plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
         # The planner, resolver and clearance avoid these.
-        canes = scene.fit_canes(_rig_parts(model, cfg, cams), CANE_REACH)
+        parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
+        canes = scene.fit_canes(parts, CANE_REACH)
     stack = build_control_stack(cfg, control_inputs(o, model), canes, bank, clock.now)
     machine = HarvestMachine(
         clock, vision, controller or stack.controller, stack.actuator, gripper, gripper,
@@ -263,26 +265,6 @@ def _watch(o: SimRigOptions, plant: ArmPlant, canes: list[softarm.PolynomialCurv
 #: fills much of it in the last centimetres, and the software rasteriser's cost goes
 #: with the pixels.
 C2_SCALE = 0.5
-
-
-#: Canes farther than this (m) from the base cannot be touched by the arm (it is
-#: 0.56 m long); the map leaves them out.
-CANE_REACH = 0.75
-
-
-def _rig_parts(model: softarm.SoftArm, cfg: HarvestConfig, cams: SimCameras) -> np.ndarray:
-    """(N, 3) points of what C1 sees of the rig itself when it looks (the arm's model
-    at rest and at home, its cube, the base tag), in the base frame."""
-    parts = []
-    for q in (np.zeros(model.n_actuators), np.full(model.n_actuators, cfg.home_elongation)):
-        parts.append(model.backbone(q, 12))
-        cube = model.forward(q) @ cams.T_ee_cube
-        corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-        parts.append(cube[:3, 3] + 0.05 * corners @ cube[:3, :3].T)
-    tag = cams.T_base_tag
-    square = np.array([[x, y, 0.0] for x in (-1, 0, 1) for y in (-1, 0, 1)]) * 0.05
-    parts.append(tag[:3, 3] + square @ tag[:3, :3].T)
-    return np.vstack(parts)
 
 
 def _bush_scene(bush: Bush, plant: ArmPlant, cams: SimCameras) -> BushScene:

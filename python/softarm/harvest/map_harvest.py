@@ -1,0 +1,44 @@
+"""The markerless harvest's loop, the same in the rendered bush and on the arm: pick
+the bush map's ripe berries one by one, left to right, looking again with C1 each time
+the arm is home (a berry the arm or a picked one hid may come into view), until no ripe
+berry is left untried."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Collection
+
+from softarm.harvest.interfaces import BerryTarget
+from softarm.harvest.report import BerryResult
+from softarm.harvest.states import FaultReason
+from softarm.perception.bush_map import BushMap, MappedBerry
+
+__all__ = ["harvest_map"]
+
+
+def harvest_map(
+    look: Callable[[], object],
+    bush_map: BushMap,
+    run_berry: Callable[[BerryTarget], BerryResult],
+    rounds: int,
+    on_result: Callable[[MappedBerry, BerryResult], None] | None = None,
+    stop_on: Collection[FaultReason] = (),
+) -> list[BerryResult]:
+    """Each berry's result, in the order tried: at most ``rounds`` looks (``look``
+    merges one C1 view into ``bush_map``), each followed by the leftmost ripe berry not
+    tried yet; ``on_result(entry, result)`` after each; a fault in ``stop_on`` ends it."""
+    results: list[BerryResult] = []
+    tried: set[int] = set()
+    for _ in range(rounds):
+        look()
+        todo = [b for b in bush_map.ripe() if b.id not in tried]
+        if not todo:
+            break
+        entry = min(todo, key=lambda b: b.position[0])  # left to right
+        tried.add(entry.id)
+        result = run_berry(BerryTarget(entry.id, f"map berry {entry.id}"))
+        results.append(result)
+        if on_result is not None:
+            on_result(entry, result)
+        if result.fault in stop_on:
+            break
+    return results
