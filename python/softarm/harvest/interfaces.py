@@ -18,9 +18,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol
 
-import numpy as np
-import numpy.typing as npt
-
+from softarm.checks import FloatArray as FloatArray  # re-exported (machine, observe, servo)
 from softarm.errors import CapabilityError
 from softarm.hardware.protocols import Gripper, RipenessSensor
 from softarm.vision.observation import BerryFix, BerryTarget, CameraName, Observation
@@ -43,8 +41,6 @@ __all__ = [
     "Vision",
     "require_controller",
 ]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class Clock(Protocol):

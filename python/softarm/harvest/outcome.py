@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from softarm.harvest.interfaces import FloatArray
+from softarm.checks import FloatArray
 from softarm.harvest.states import FaultReason
 
 __all__ = ["Ending", "Fault", "StageOutcome"]

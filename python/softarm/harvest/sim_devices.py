@@ -7,8 +7,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from softarm.checks import FloatArray
 from softarm.harvest.clearance import Clearance
-from softarm.harvest.interfaces import BerryTarget, FloatArray
+from softarm.harvest.interfaces import BerryTarget
 from softarm.harvest.sim_plant import ArmPlant
 from softarm.sim.bush import Berry
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softarm.harvest.interfaces import FloatArray
+from softarm.checks import FloatArray
 from softarm.harvest.vision_loop import CameraVision, register_c1
 from softarm.sim.bush import Berry
 from softarm.sim.camera import SyntheticCamera
