@@ -260,7 +260,6 @@ def _gains(args: argparse.Namespace) -> dict[str, Any] | None:
 
 
 def _run_hardware(args: argparse.Namespace) -> int:
-    from softarm.harvest.interfaces import BerryTarget
     from softarm.harvest.log import HarvestLog
 
     log = HarvestLog(args.log)  # first of all: a stop during set-up is recorded in it
@@ -281,9 +280,10 @@ def _run_hardware(args: argparse.Namespace) -> int:
         log.close()
         raise
     try:
-        # On hardware the berries are the tags 10, 11, ... stuck to them (section IV-E).
+        # The tags 10, 11, ... stuck to the berries (section IV-E), or the map's ripe
+        # berries with markerless [perception].
         with vents_on_stop(rig.machine.actuator.vent, log):
-            report = rig.machine.run([BerryTarget(10 + i) for i in range(args.berries)])
+            report = rig.run(args.berries)
     finally:
         rig.close()  # vents and releases every device, whatever happened
         log.close()

@@ -27,14 +27,22 @@ from softarm.hardware.pressure_map import ElongationMap, VoltageMap
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.actuator import PressureMap
 from softarm.harvest.config import HarvestConfig
+from softarm.harvest.hw_perception import StereoC1, open_stereo, stereo_camera
+from softarm.harvest.interfaces import BerryTarget
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
+from softarm.harvest.map_harvest import harvest_map
+from softarm.harvest.report import HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
+from softarm.harvest.rig_parts import CANE_REACH, rig_parts
+from softarm.harvest.states import FAULTS_THAT_STOP
 from softarm.harvest.vision_loop import CameraVision
 from softarm.identified_plant import IdentifiedPlant
-from softarm.vision import MarkerCube
+from softarm.perception.bush_vision import BushVision
+from softarm.vision import CameraModel, MarkerCube
 from softarm.vision.camera_model import camera_from_config
 from softarm.vision.poses import invert
+from softarm.vision.two_cameras import Frame
 
 __all__ = ["HardwareRig", "MonotonicClock", "build_hardware_rig", "hardware_inputs"]
 
@@ -45,10 +53,30 @@ class HardwareRig:
 
     machine: HarvestMachine
     devices: ExitStack
+    #: C1 as the ``[perception]`` stereo source and its bush map; None: C1 alone.
+    c1: StereoC1 | None = None
+    #: The berries come from the map (``berries = "markerless"``), not from tags.
+    markerless: bool = False
 
     def close(self) -> None:
         """Vent the arm and release every device."""
         self.devices.close()
+
+    def run(self, berries: int) -> HarvestReport:
+        """Harvest ``berries``: the tags 10, 11, ... stuck to them (section IV-E), or
+        with markerless perception at most that many of the map's ripe berries, by the
+        loop the rendered bush runs (:func:`~softarm.harvest.map_harvest.harvest_map`)."""
+        if not self.markerless or self.c1 is None:
+            return self.machine.run([BerryTarget(10 + i) for i in range(berries)])
+        report = HarvestReport()
+        c1, machine = self.c1, self.machine
+        report.berries = harvest_map(
+            c1.look, c1.bush_map, machine.run_berry, berries, stop_on=FAULTS_THAT_STOP
+        )
+        last = report.berries[-1].fault if report.berries else None
+        report.stopped = last if last in FAULTS_THAT_STOP else None
+        machine.log.event("run_done", success_rate=report.success_rate)
+        return report
 
 
 def build_hardware_rig(
@@ -66,7 +94,8 @@ def build_hardware_rig(
     the loop corrects the motion still in flight (docs/control.md); without it the
     resolver's gain is bounded for the slowest plant (the defaults' 20 periods). The
     ``calibration`` (``--model``) replaces the configured arm and pressure map; the
-    ``canes`` (none unless given) are avoided by planner, resolver and way check.
+    ``canes`` are avoided by planner, resolver and way check: with ``[perception]``
+    (and none given) the ones fitted from C1's stereo at start, else none unless given.
 
     Raises:
         HardwareUnavailableError: a device (or its driver) is absent.
@@ -84,7 +113,10 @@ def build_hardware_rig(
             s.port, s.baud, s.timeout_s, s.retries, startup_delay_s=s.startup_delay_s
         )
         stack.callback(link.close)
-        vision = _vision(config, cfg, stack)
+        c1 = _stereo_c1(config, stack)
+        if c1 is not None and not canes:
+            canes = _perceived_canes(c1, config, cfg, inputs.model)
+        vision = _vision(config, cfg, stack, c1)
         gripper = ArduinoGripper(link)
         clock = MonotonicClock()
         control = build_control_stack(cfg, inputs, canes, bank, clock.now)
@@ -93,7 +125,8 @@ def build_hardware_rig(
             ArduinoRipenessSensor(link), inputs.model.n_actuators, cfg, log,
             planner=control.planner,
         )  # fmt: skip
-        return HardwareRig(machine, stack.pop_all())
+        markerless = isinstance(vision, BushVision)
+        return HardwareRig(machine, stack.pop_all(), c1, markerless)
     raise AssertionError("unreachable")  # pragma: no cover  (the with block returns)
 
 
@@ -130,15 +163,54 @@ def _pressure_bank(config: Config, stack: ExitStack) -> SafePressureBank:
     return bank
 
 
-def _vision(config: Config, cfg: HarvestConfig, stack: ExitStack) -> CameraVision:
-    """Both cameras, opened and closed by ``stack``, and the vision loop on them."""
+def _stereo_c1(config: Config, stack: ExitStack) -> StereoC1 | None:
+    """C1 as the ``[perception]`` stereo source (its devices closed by ``stack``), its
+    first view in the map; None without the table."""
+    perception = config.perception
+    if perception is None:
+        return None
+    T_base_c1 = invert(np.array(config.calibration.T_C1_base))
+    stereo = stereo_camera(perception, T_base_c1)
+    c1 = StereoC1(stereo, open_stereo(perception, OpenCVCamera, stack))
+    c1.look()
+    return c1
+
+
+def _perceived_canes(
+    c1: StereoC1, config: Config, cfg: HarvestConfig, model: SoftArm
+) -> list[PolynomialCurve]:
+    """The canes fitted from C1's stereo, the arm and its cube left out (the base tag's
+    pose is not configured: its fit, if any, lies beyond the arm's gap)."""
+    parts = rig_parts(model, cfg, np.array(config.calibration.T_EE_cube), None)
+    return c1.fit_canes(parts, CANE_REACH)
+
+
+def _vision(
+    config: Config, cfg: HarvestConfig, stack: ExitStack, c1: StereoC1 | None
+) -> CameraVision:
+    """Both cameras, opened and closed by ``stack``, and the vision loop on them: with
+    ``c1`` the stereo source's left eye is C1, and the berries come from its map unless
+    ``[perception]`` asks for tags."""
     cal = config.calibration
-    model1, model2 = camera_from_config(cal.c1, "c1"), camera_from_config(cal.c2, "c2")
-    cam1, cam2 = OpenCVCamera(cal.c1.source), OpenCVCamera(cal.c2.source)
-    stack.callback(cam1.close)
+    frame1, model1 = _c1(config, stack, c1)
+    cam2 = OpenCVCamera(cal.c2.device)
     stack.callback(cam2.close)
-    return CameraVision(
-        lambda t: cam1.read(), lambda t: cam2.read(), model1, model2,
+    args = (
+        frame1, lambda t: cam2.read(), model1, camera_from_config(cal.c2, "c2"),
         invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)),
         np.array(cal.T_EE_cube), MarkerCube.standard(), cal.berry_tag, cfg.grasp_offset,
     )  # fmt: skip
+    perception = config.perception
+    if c1 is not None and perception is not None and perception.berries == "markerless":
+        return BushVision(*args, bush_map=c1.bush_map)
+    return CameraVision(*args)
+
+
+def _c1(config: Config, stack: ExitStack, c1: StereoC1 | None) -> tuple[Frame, CameraModel]:
+    """C1's frames and intrinsics: the stereo source's left eye, or the C1 camera."""
+    if c1 is not None:
+        return c1.left, c1.stereo.left
+    cal = config.calibration
+    cam1 = OpenCVCamera(cal.c1.device)
+    stack.callback(cam1.close)
+    return (lambda t: cam1.read()), camera_from_config(cal.c1, "c1")
