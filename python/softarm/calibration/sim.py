@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,10 +20,13 @@ from softarm.sim.arm import PlantConfig
 from softarm.sim.tracker import PoseTracker
 from softarm.units import METRES_PER_PSI
 
+if TYPE_CHECKING:
+    from softarm.sim.plant import ArmPlant
+
 __all__ = ["PlantDriver", "build_plant", "calibrate_plant", "true_poses"]
 
 
-def build_plant(model: SoftArm, config: PlantConfig, seed: int) -> object:
+def build_plant(model: SoftArm, config: PlantConfig, seed: int) -> ArmPlant:
     """The simulated plant of ``config.model`` ("pcc" or "cosserat") drawn from ``seed``
     (the harvest rig uses ``seed + 1000``), starting vented."""
     if config.model == "cosserat":
@@ -40,7 +44,7 @@ class PlantDriver:
     """``send``/``sleep``/``measure`` of :func:`~softarm.calibration.collect.collect` on
     a simulated plant (anything with ``command_pressures``, ``advance`` and ``pose``)."""
 
-    plant: object
+    plant: ArmPlant
     tracker: PoseTracker | None
 
     def __post_init__(self) -> None:
@@ -49,16 +53,16 @@ class PlantDriver:
 
     def send(self, q: F64) -> None:
         self.sent = np.asarray(q, dtype=np.float64)
-        self.plant.command_pressures(self.sent / METRES_PER_PSI)  # type: ignore[attr-defined]
+        self.plant.command_pressures(self.sent / METRES_PER_PSI)
 
     def vent(self) -> None:
         """Command 0 psi on every channel that was driven (the regulators' vent)."""
         if self.sent is not None:
-            self.plant.command_pressures(np.zeros_like(self.sent))  # type: ignore[attr-defined]
+            self.plant.command_pressures(np.zeros_like(self.sent))
 
     def sleep(self, dt: float) -> None:
-        self.plant.advance(dt)  # type: ignore[attr-defined]
-        pose = self.plant.pose()  # type: ignore[attr-defined]
+        self.plant.advance(dt)
+        pose = self.plant.pose()
         self.last = pose if self.tracker is None else self.tracker.measure(pose, dt)
 
     def measure(self) -> F64 | None:
@@ -75,7 +79,7 @@ def _pace(config: PlantConfig, lag_s: float, settle: float | None) -> Pacing:
 
 
 def calibrate_plant(
-    plant: object,
+    plant: ArmPlant,
     config: PlantConfig,
     nominal: SoftArm,
     *,
@@ -111,7 +115,7 @@ def calibrate_plant(
 
 
 def true_poses(
-    plant: object, commands: F64, config: PlantConfig, settle: float | None = None
+    plant: ArmPlant, commands: F64, config: PlantConfig, settle: float | None = None
 ) -> F64:
     """The plant's noise-free settled poses at ``commands``, driven as in the fit: paced
     for ``config``'s regulator lag and play (no tracker, so no filter lag); ``settle``

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softarm._core import Gains, LagModel, Resolver
+from softarm._core import Gains, LagModel, Resolver, SoftArm
 from softarm.checks import FloatArray as F64
 from softarm.experiments.common import CONTROL_PERIOD, bush_pressures, orientation_error
 from softarm.sim.arm import PlantConfig, SimulatedArm
@@ -71,7 +71,7 @@ class Run:
     on_model: bool = True
 
 
-def controller(name: str, model: object, tau_total: float, period: float) -> Resolver:
+def controller(name: str, model: SoftArm, tau_total: float, period: float) -> Resolver:
     """The hybrid resolver of one controller (see the module docs)."""
     if name == "today":
         # Before the lag bound and the closed-loop damping.
@@ -90,7 +90,7 @@ def controller(name: str, model: object, tau_total: float, period: float) -> Res
         gains = Gains(lag_periods=0.0)
     else:
         raise ValueError(f"controller = {name!r}: unknown")
-    return Resolver(model, "hybrid", gains)  # type: ignore[arg-type]
+    return Resolver(model, "hybrid", gains)
 
 
 def run_one(

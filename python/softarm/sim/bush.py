@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from softarm._core import PolynomialCurve
+from softarm._core import PolynomialCurve, SoftArm
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 from softarm.geometry import cone_axes
@@ -78,7 +78,7 @@ class Bush:
     @classmethod
     def generate(
         cls,
-        arm: object,
+        arm: SoftArm,
         n_berries: int,
         seed: int,
         *,
@@ -111,7 +111,7 @@ class Bush:
         if not 1 <= n_berries <= 40:
             raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
         rng = np.random.default_rng(seed)
-        lo, hi = limits or (arm.lower, arm.upper)  # type: ignore[attr-defined]
+        lo, hi = limits or (arm.lower, arm.upper)
         lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         # Feasible with room: 10 % of the range off each limit (the paper's actuators work
         # at 10-60 of 70 psi), so the controller's model, a few % off, can reach them too.
@@ -119,7 +119,7 @@ class Bush:
         berries: list[Berry] = []
         for _ in range(200):
             qs = rng.uniform(lower, upper, size=(4000, lower.size))
-            poses = arm.forward_batch(qs)  # type: ignore[attr-defined]
+            poses = arm.forward_batch(qs)
             ok = poses[:, :3, 2] @ PLUS_Y > np.cos(np.radians(max_tilt_deg))
             for i in np.flatnonzero(ok):
                 pos = poses[i, :3, 3] + grasp_offset * poses[i, :3, 2]

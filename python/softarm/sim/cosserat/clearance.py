@@ -10,12 +10,16 @@ rod's shape depends on gravity and its history, not on q alone, so ``gap`` ignor
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from softarm._core import PolynomialCurve
 from softarm.checks import FloatArray as F64
 from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
+
+if TYPE_CHECKING:
+    from softarm.sim.cosserat.plant import CosseratPlant
 
 __all__ = ["RodClearance"]
 
@@ -37,10 +41,10 @@ class RodClearance:
     as it is now and the canes; the interface of ``Clearance`` (``gap``, ``path_gap``)."""
 
     def __init__(
-        self, plant: object, canes: Sequence[PolynomialCurve], grasp_offset: float
+        self, plant: CosseratPlant, canes: Sequence[PolynomialCurve], grasp_offset: float
     ) -> None:
         self.plant, self.canes, self.offset = plant, list(canes), grasp_offset
-        sections = plant.arm.sections  # type: ignore[attr-defined]
+        sections = plant.arm.sections
         self.radii = np.array([s.radius + ACTUATOR_RADIUS + CANE_RADIUS for s in sections])
         self.plate = sections[-1].offset
         self.points = (
@@ -53,11 +57,11 @@ class RodClearance:
         """Smallest surface gap (m) now; inf without canes; < 0 means contact."""
         if not self.canes:
             return float("inf")
-        line = self.plant.centreline()  # type: ignore[attr-defined]
-        sec = self.plant.centreline_sections()[1:]  # type: ignore[attr-defined]
+        line = self.plant.centreline()
+        sec = self.plant.centreline_sections()[1:]
         d = _point_segment_distances(self.points, line[:-1], line[1:]).min(axis=1)
         body = float((d - self.radii[sec]).min())
-        ee = self.plant.pose()  # type: ignore[attr-defined]
+        ee = self.plant.pose()
         tip = ee[:3, 3] + np.outer(np.linspace(-self.plate, self.offset, 6), ee[:3, 2])
         dg = np.linalg.norm(tip[:, None, :] - self.points[None], axis=2).min()
         return min(body, float(dg) - GRIPPER_RADIUS - CANE_RADIUS)

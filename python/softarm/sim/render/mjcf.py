@@ -19,7 +19,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
-from softarm.sim.bush import Bush
+from softarm.sim.bush import Berry, Bush
 from softarm.sim.render.look import BushLook
 from softarm.vision.dictionaries import get_dictionary
 
@@ -158,10 +158,10 @@ def _cane(index: int, points: FloatArray, look: BushLook) -> str:
     )
 
 
-def _berry(berry: object, look: BushLook, rng: np.random.Generator) -> str:
+def _berry(berry: Berry, look: BushLook, rng: np.random.Generator) -> str:
     """A fruit hanging down: an ellipsoid core and drupelets on its surface."""
-    tag, pos = berry.tag_id, berry.position  # type: ignore[attr-defined]
-    ripe = berry.ripeness >= 0.5  # type: ignore[attr-defined]
+    tag, pos = berry.tag_id, berry.position
+    ripe = berry.ripeness >= 0.5
     half = BERRY_HALF * rng.uniform(*look.berry_scale)
     colour = look.ripe_colour if ripe else look.unripe_colour(rng)
     spec = 'material="glossy"' if ripe else 'material="waxy"'
