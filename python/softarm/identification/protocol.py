@@ -90,19 +90,19 @@ class Design:
         """The schedule; the random phase never ends (the runner stops it on budget)."""
         base = np.full(self.n, self.base)
         yield Segment(base, "hold", 3.0, 1.0, phase="settle", fit=True)
-        hold = dict(kind="hold", duration=self.hold_max, min_duration=self.hold_min)
+        hold = ("hold", self.hold_max, self.hold_min)  # kind, duration, min_duration
         for i in range(self.n):
             up, down = base.copy(), base.copy()
             up[i] += self.amplitude
             down[i] -= self.amplitude
-            yield Segment(up, **hold, phase="channel", channel=i)  # type: ignore[arg-type]
-            yield Segment(base, **hold, phase="channel", channel=i)  # type: ignore[arg-type]
+            yield Segment(up, *hold, phase="channel", channel=i)
+            yield Segment(base, *hold, phase="channel", channel=i)
             yield Segment(
                 down, "ramp", 2 * self.amplitude / self.ramp_rate, phase="channel",
                 channel=i, fit=False,
             )  # fmt: skip
-            yield Segment(down, **hold, phase="channel", channel=i)  # type: ignore[arg-type]
-            yield Segment(base, **hold, phase="channel", channel=i)  # type: ignore[arg-type]
+            yield Segment(down, *hold, phase="channel", channel=i)
+            yield Segment(base, *hold, phase="channel", channel=i)
         rng = np.random.default_rng(self.seed)
         while True:
-            yield Segment(rng.uniform(self.lo, self.hi, self.n), **hold)  # type: ignore[arg-type]
+            yield Segment(rng.uniform(self.lo, self.hi, self.n), *hold)
