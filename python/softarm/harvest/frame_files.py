@@ -55,7 +55,11 @@ class FrameRecorder:
         if image is not None:
             entry["file"] = f"{camera}_{n:06d}.png"
             _cv2().imwrite(str(self.folder / entry["file"]), np.asarray(image))
-            if isinstance(image, ImageCrop) and image.origin is not None:
+            if (
+                isinstance(image, ImageCrop)
+                and image.origin is not None
+                and image.full_size is not None
+            ):
                 entry["origin"], entry["full_size"] = list(image.origin), list(image.full_size)
         self.entries.append(entry)
 
