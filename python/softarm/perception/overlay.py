@@ -40,5 +40,7 @@ def draw_bush_map(
     return out
 
 
-def _to_camera(points: npt.NDArray[np.float64], T_camera_base: npt.NDArray[np.float64]):  # type: ignore[no-untyped-def]
+def _to_camera(
+    points: npt.NDArray[np.float64], T_camera_base: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
     return points @ T_camera_base[:3, :3].T + T_camera_base[:3, 3]
