@@ -186,10 +186,11 @@ def _detection(
     purity = (n_ripe + n_unripe) / m["m00"]
     solidity = m["m00"] / max(cv2.contourArea(cv2.convexHull(contour)), 1.0)
     ripeness: Ripeness = "ripe" if p_ripe >= 0.5 else "unripe"
+    bx, by, bw, bh = cv2.boundingRect(contour)
     return BerryDetection(
         center=(float(cx), float(cy)),
         radius=radius,
-        box=tuple(int(v) for v in cv2.boundingRect(contour)),  # type: ignore[arg-type]
+        box=(int(bx), int(by), int(bw), int(bh)),
         mask=inside,
         score=float(np.clip(purity * solidity, 0.0, 1.0)),
         ripeness=ripeness,

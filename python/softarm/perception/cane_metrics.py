@@ -21,6 +21,7 @@ Both sides are centre lines, so a perfect map scores 0 whatever the cane radius.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -36,9 +37,16 @@ SPACING = 0.001  # m between samples of a centre line
 Workspace = float | tuple[FloatArray, FloatArray] | None
 
 
+class _Curve(Protocol):
+    """A cubic cane: a CaneFit, or the sim's Branch."""
+
+    @property
+    def coeffs(self) -> FloatArray: ...
+
+
 def cane_map_error(
-    fits: Sequence[object],
-    true_branches: Sequence[object],
+    fits: Sequence[_Curve],
+    true_branches: Sequence[_Curve],
     workspace: Workspace = None,
     covered_within: float = 0.010,
 ) -> dict[str, float]:
@@ -49,8 +57,8 @@ def cane_map_error(
     (3,)) in the base frame; None is a ``DEFAULT_REACH`` radius. With no true cane in
     the workspace, coverage is 1 and the distances 0; with no fit, coverage is 0 and
     the distances NaN."""
-    truth = _inside(_sampled([b.coeffs for b in true_branches]), workspace)  # type: ignore[attr-defined]
-    fitted = _inside(_sampled([f.coeffs for f in fits]), workspace)  # type: ignore[attr-defined]
+    truth = _inside(_sampled([b.coeffs for b in true_branches]), workspace)
+    fitted = _inside(_sampled([f.coeffs for f in fits]), workspace)
     if len(truth) == 0:
         return _scores(
             np.zeros(1), np.ones(1, bool), _precision(fitted, truth, covered_within), 0.0

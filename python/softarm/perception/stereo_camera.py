@@ -84,10 +84,11 @@ class Rectification:
         self, left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8]
     ) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
         """Both images resampled onto the rectified grid."""
-        return tuple(  # type: ignore[return-value]
-            cv2.remap(img, mx, my, cv2.INTER_LINEAR) for img, (mx, my) in zip(
-                (left, right), self.maps, strict=True)
-        )  # fmt: skip
+        (mx_l, my_l), (mx_r, my_r) = self.maps
+        return (
+            cast(npt.NDArray[np.uint8], cv2.remap(left, mx_l, my_l, cv2.INTER_LINEAR)),
+            cast(npt.NDArray[np.uint8], cv2.remap(right, mx_r, my_r, cv2.INTER_LINEAR)),
+        )
 
     def to_rectified_pixels(self, pixels: FloatArray) -> FloatArray:
         """(N, 2) distorted left-eye pixels → their rectified pixels."""
