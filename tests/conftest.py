@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -9,6 +10,9 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
+# The rendered bush draws offscreen through EGL (Mesa's software rasteriser without a
+# GPU), set before anything imports MuJoCo; `make test` exports the same.
+os.environ.setdefault("MUJOCO_GL", "egl")
 
 import softarm
 

@@ -62,6 +62,15 @@ class BushScene:
     #: base-tag registration (eq. 22), as the cube tracking places it. The world's own
     #: C1 pose is the truth, which only the renderer uses.
     stereo: StereoCamera | None = None
+    _drawn: bytes = b""
+
+    def _draw(self) -> None:
+        """Draw the arm as it is, unless it is drawn so already (C1 and C2 read the
+        same control period's state)."""
+        key = self.plant.q().tobytes() + self.plant.pose().tobytes()
+        if key != self._drawn:
+            draw_arm(self.world, self.plant)
+            self._drawn = key
 
     def registered(self, T_base_c1: FloatArray) -> None:
         """Place C1 where the registration found it."""
@@ -76,7 +85,7 @@ class BushScene:
     def look(self) -> int:
         """One C1 stereo view with the arm where it truly is, merged into the map; the
         number of berries new to it."""
-        draw_arm(self.world, self.plant)
+        self._draw()
         left, right = self.world.c1()
         return self.bush_map.update(locate_berries(left.colour, right.colour, self.c1()))
 
@@ -86,7 +95,7 @@ class BushScene:
         model at the poses it looks from, its cube and the base tag) is the robot seen
         by its own camera, the robot self-filter of any point-cloud pipeline; a fit
         wholly beyond ``reach`` (m) of the base cannot be touched. The map keeps them."""
-        draw_arm(self.world, self.plant)
+        self._draw()
         left, right = self.world.c1()
         fits = fit_canes(left.colour, right.colour, self.c1())
         self.bush_map.canes = [f for f in fits if a_cane(f.points[:, :3], rig_parts, reach)]
@@ -98,11 +107,11 @@ class BushScene:
         def c1(t: float) -> np.ndarray:
             # The window around the cube (where it truly is, as the tag world's
             # render_crop does); the cube is all the tracking looks for in C1.
-            draw_arm(self.world, self.plant)
+            self._draw()
             return self.world.c1_left_window(self._cube_pixel())
 
         def c2(t: float) -> np.ndarray:
-            draw_arm(self.world, self.plant)
+            self._draw()
             return self.world.c2_frame().colour
 
         return c1, c2
@@ -110,7 +119,7 @@ class BushScene:
     def c1_whole(self, t: float) -> np.ndarray:
         """C1's whole left image with the arm as it is (registration finds the base tag
         in it)."""
-        draw_arm(self.world, self.plant)
+        self._draw()
         return self.world.c1_left().colour
 
     def _cube_pixel(self) -> tuple[float, float]:

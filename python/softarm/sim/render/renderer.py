@@ -27,7 +27,6 @@ from softarm.sim.render.mjcf import (
     SceneSpec,
     scene_xml,
 )
-from softarm.sim.render.mjcf import z_to as _z_to
 
 #: The sensor pixel pitch (m) the scene's cameras are declared with (mjcf._camera).
 PIXEL = 1e-6
@@ -107,7 +106,7 @@ class BushRenderer:
         k = 0
         for points in sections:
             for a, b in itertools.pairwise(points):
-                self._place(f"arm_seg{k}", 0.5 * (a + b), _z_to(b - a))
+                self._place_quat(f"arm_seg{k}", 0.5 * (a + b), _quat_z_to(b - a))
                 self.model.geom_size[self._seg_geoms[k], 1] = max(
                     0.5 * float(np.linalg.norm(b - a)), 1e-4
                 )
@@ -115,7 +114,7 @@ class BushRenderer:
         ends = [s[0] for s in sections] + [sections[-1][-1]]
         tangents = [s[1] - s[0] for s in sections] + [sections[-1][-1] - sections[-1][-2]]
         for i, (p, t) in enumerate(zip(ends, tangents, strict=True)):
-            self._place(f"arm_plate{i}", p, _z_to(t))
+            self._place_quat(f"arm_plate{i}", p, _quat_z_to(t))
         self._place("arm_ee", T_base_ee[:3, 3], T_base_ee[:3, :3])
         self._arm_set = True
 
@@ -207,7 +206,24 @@ class BushRenderer:
         return self._renderers[(w, h)]
 
     def _place(self, body: str, pos: FloatArray, R: FloatArray) -> None:
+        x, y, z, w = Rotation.from_matrix(R).as_quat()
+        self._place_quat(body, pos, np.array([w, x, y, z]))
+
+    def _place_quat(self, body: str, pos: FloatArray, quat: FloatArray) -> None:
         i = self._mocap[body]
         self.data.mocap_pos[i] = pos
-        x, y, z, w = Rotation.from_matrix(R).as_quat()
-        self.data.mocap_quat[i] = (w, x, y, z)
+        self.data.mocap_quat[i] = quat
+
+
+def _quat_z_to(direction: FloatArray) -> FloatArray:
+    """The quaternion (w, x, y, z) turning +z onto ``direction`` the shortest way: half
+    way between them, [1 + z·d, z × d] normalised (a closed form: the arm is placed
+    every frame, and a general rotation fit cost a third of the frame)."""
+    n = float(np.linalg.norm(direction))
+    if n < 1e-12:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    d = direction / n
+    if d[2] < -1.0 + 1e-9:  # straight down: any half-turn about a horizontal axis
+        return np.array([0.0, 1.0, 0.0, 0.0])
+    q = np.array([1.0 + d[2], -d[1], d[0], 0.0])
+    return q / np.linalg.norm(q)
