@@ -179,3 +179,43 @@ def test_custom_arm_round_trips_sections() -> None:
     assert arm.n_sections == 2 and arm.n_actuators == 6
     assert arm.sections == secs
     np.testing.assert_allclose(arm.upper, 0.02)
+
+
+def test_elongations_without_geometry_are_rejected_by_name() -> None:
+    from softarm.errors import InputError, ParameterError
+
+    q = np.full(9, -0.2)  # every section's arc length 0.15 - 0.2 < 0
+    calls = (
+        ARM.forward,
+        ARM.jacobian,
+        ARM.forward_jacobian,
+        ARM.frames,
+        ARM.backbone,
+        ARM.configuration,
+        lambda q: ARM.point(q, 1, 0.5),
+    )
+    for call in calls:
+        with pytest.raises(ParameterError) as info:
+            call(q)
+        e = info.value
+        assert isinstance(e, InputError) and isinstance(e, ValueError)
+        assert e.argument == "q[0..3]" and e.value < 0 and "arc length" in e.expected
+    rows = np.stack([np.zeros(9), q])
+    for batch in (ARM.forward_batch, ARM.jacobian_batch):
+        with pytest.raises(ParameterError) as info:
+            batch(rows)
+        assert info.value.argument == "qs[1, 0..3]"
+    # Only the third section without geometry: named by its elongations.
+    last = np.r_[np.zeros(6), [-0.2] * 3]
+    with pytest.raises(ParameterError, match=r"q\[6\.\.9\]"):
+        ARM.forward(last)
+
+
+def test_outside_the_limits_but_with_geometry_is_still_computed() -> None:
+    below = ARM.lower - 0.01  # past the limits, arc lengths still positive
+    above = ARM.upper + 0.01
+    for q in (below, above):
+        t = ARM.forward(q)
+        assert np.all(np.isfinite(t)) and np.allclose(t[3], [0, 0, 0, 1])
+        assert np.all(np.isfinite(ARM.jacobian(q)))
+    assert "positive arc length" in (softarm.SoftArm.__doc__ or "")

@@ -46,6 +46,7 @@ def test_section_and_arms_round_trip() -> None:
         assert s == section and type(s) is softarm.Section
     for arm in round_trips(ARM):
         assert type(arm) is softarm.SoftArm and arm.sections == ARM.sections
+        assert arm == ARM and hash(arm) == hash(ARM) and repr(arm) == repr(ARM)
         assert np.array_equal(arm.forward_batch(Q[None]), ARM.forward_batch(Q[None]))
         assert np.array_equal(arm.jacobian(Q), ARM.jacobian(Q))
     for chain in round_trips(CHAIN):
@@ -116,3 +117,14 @@ def test_resolver_pickles_and_steps_identically() -> None:
     target = arm.forward(np.full(arm.n_actuators, 0.01))[:3, 3]
     assert back.mode == "position" and back.gains == res.gains
     np.testing.assert_array_equal(back.step(q, target).q, res.step(q, target).q)
+
+
+def test_soft_arm_repr_shows_its_geometry_and_equality_is_by_value() -> None:
+    text = repr(ARM)
+    assert text.startswith("SoftArm([Section(radius=") and text.count("Section(") == 3
+    s = ARM.sections[0]
+    assert f"rest_length={s.rest_length}" in text and f"upper={s.upper}" in text
+    rebuilt = eval(text, {"SoftArm": softarm.SoftArm, "Section": softarm.Section})
+    assert rebuilt == ARM and rebuilt is not ARM and len({rebuilt, ARM}) == 1
+    other = softarm.SoftArm(ARM.sections[:2])
+    assert other != ARM and ARM != "SoftArm" and ARM != ARM.sections

@@ -62,9 +62,10 @@ def test_solution_round_trips(max_steps: int) -> None:
     for copied in round_trips(sol):
         assert type(copied) is _core.Solution
         assert np.array_equal(copied.q, sol.q)
-        assert (copied.converged, copied.steps, copied.termination) == (
+        assert (copied.converged, copied.steps, copied.best_step, copied.termination) == (
             sol.converged,
             sol.steps,
+            sol.best_step,
             sol.termination,
         )
         assert (copied.position_error, copied.orientation_error) == (

@@ -222,3 +222,29 @@ def test_every_input_error_is_typed_and_named(arm: softarm.SoftArm) -> None:
         Resolver(arm, "position").step(Q, [0.0, np.inf, 0.4])
     with pytest.raises(ValueError):
         res.step(Q, skew)
+
+
+def test_solve_help_shows_its_defaults() -> None:
+    import inspect
+
+    params = inspect.signature(Resolver.solve).parameters
+    assert params["max_steps"].default == 1000
+    assert params["position_tolerance"].default == 1e-4
+    assert params["orientation_tolerance"].default == pytest.approx(math.radians(0.1))
+    assert params["obstacles"].kind is inspect.Parameter.KEYWORD_ONLY
+    assert "max_steps=1000" in (Resolver.solve.__text_signature__ or "")
+
+
+def test_solution_steps_counts_the_steps_run(arm: softarm.SoftArm) -> None:
+    far = np.eye(4)
+    far[1, 3] = 2.0
+    for max_steps in (0, 1, 7, 60):
+        sol = Resolver(arm).solve(MID, far, max_steps=max_steps)
+        assert sol.termination == "step_limit" and sol.steps == max_steps, sol
+        assert 0 <= sol.best_step <= sol.steps
+    sol = Resolver(arm).solve(MID, arm.forward(GOAL))
+    assert sol.converged and sol.steps == sol.best_step > 0
+    assert f"best_step={sol.best_step}" in repr(sol)
+    # The default max_steps is the one help() shows: a step limit of 1000 steps run.
+    long = Resolver(arm).solve(MID, far)
+    assert long.termination in ("step_limit", "stuck") and long.steps <= 1000

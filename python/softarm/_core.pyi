@@ -56,7 +56,16 @@ class _Kinematics:
     @property
     def upper(self) -> _F64: ...
     def forward(self, q: _ArrayLike) -> _F64:
-        """End-effector pose (4, 4) in the base frame (eq. 3)."""
+        """End-effector pose (4, 4) in the base frame (eq. 3).
+
+        ``q`` outside the limits ``lower``/``upper`` is still computed (the model
+        extrapolates; a resolver never commands it) as long as every section keeps a
+        positive arc length. A ``q`` that gives a section a non-positive arc length (for
+        the blackberry arm, ``[-0.2] * 9``) has no geometry: it raises
+        :class:`softarm.errors.ParameterError` with ``argument`` ``"q[3i..3i+3]"`` (the
+        section's elongations), ``value`` the arc length and ``expected`` the reason. The
+        same holds for every kinematic call (``jacobian``, ``point``, ``frames``,
+        ``backbone``, ``configuration``; a batch names ``"qs[row, 3i..3i+3]"``)."""
     def jacobian(self, q: _ArrayLike) -> _F64:
         """Analytic Jacobian (6, n), rows [vx, vy, vz, wx, wy, wz] (eq. 4-6)."""
     def forward_jacobian(self, q: _ArrayLike) -> tuple[_F64, _F64]:
@@ -74,7 +83,13 @@ class _Kinematics:
 
 @final
 class SoftArm(_Kinematics):
-    """A pneumatic continuum arm in actuator space; q = actuator elongations (m)."""
+    """A pneumatic continuum arm in actuator space; q = actuator elongations (m).
+
+    A ``q`` outside the limits ``lower``/``upper`` is still computed by every kinematic
+    call (the model extrapolates) as long as each section keeps a positive arc length; one
+    that gives a section a non-positive arc length (``[-0.2] * 9`` for the blackberry arm)
+    has no geometry and raises ``ParameterError`` naming ``q[3i..3i+3]``. ``repr`` shows
+    the sections; two arms with equal sections compare equal (a pickled copy does)."""
 
     def __new__(cls, sections: list[Section]) -> SoftArm: ...
     @staticmethod
@@ -90,6 +105,9 @@ class SoftArm(_Kinematics):
     def configuration(self, q: _ArrayLike) -> _F64:
         """Eq. (1) per section: (arc length, bending angle, bending direction)."""
     def __reduce__(self) -> tuple[type[SoftArm], tuple[list[Section]]]: ...
+    def __eq__(self, value: object, /) -> bool:
+        """Equal when every section is (a pickled or deep copy compares equal)."""
+    def __hash__(self) -> int: ...
 
 @final
 class ArcChain(_Kinematics):
@@ -283,7 +301,13 @@ class Solution:
     @property
     def converged(self) -> bool: ...
     @property
-    def steps(self) -> int: ...
+    def steps(self) -> int:
+        """Steps run: the last configuration evaluated is q0 after ``steps`` steps (at
+        most ``max_steps``)."""
+    @property
+    def best_step(self) -> int:
+        """The step at which ``q`` was reached (q0 after ``best_step`` steps, at most
+        ``steps``)."""
     @property
     def position_error(self) -> float:
         """||e_p|| at q (m)."""
@@ -294,7 +318,7 @@ class Solution:
     def termination(self) -> str:
         """Why the iteration stopped: "converged", "stuck" (a step left q unchanged, e.g.
         the straight rest pose in position mode) or "step_limit"."""
-    def __reduce__(self) -> tuple[object, tuple[_F64, bool, int, float, float, str]]: ...
+    def __reduce__(self) -> tuple[object, tuple[_F64, bool, int, float, float, str, int]]: ...
 
 def _rebuild_solution(
     q: _ArrayLike,
@@ -303,6 +327,7 @@ def _rebuild_solution(
     position_error: float,
     orientation_error: float,
     termination: str,
+    best_step: int | None = None,
 ) -> Solution:
     """Unpickler of ``Solution``."""
 
@@ -346,16 +371,18 @@ class Resolver:
         self,
         q0: _ArrayLike,
         target: _ArrayLike,
-        max_steps: int | None = None,
-        position_tolerance: float | None = None,
-        orientation_tolerance: float | None = None,
+        max_steps: int | None = 1000,
+        position_tolerance: float | None = 0.0001,
+        orientation_tolerance: float | None = 0.0017453292519943296,
         *,
         obstacles: object | None = None,
     ) -> Solution:
-        """Steps on the model until the controlled errors are within tolerance (m, rad;
-        None means the defaults: 0.1 mm and 0.1 deg) or ``max_steps`` (None: 1000); an
-        unreachable target returns ``converged=False`` with the best error. Releases the
-        GIL."""
+        """Steps on the model from ``q0`` until the controlled errors are within tolerance
+        (``position_tolerance`` in m, default 0.1 mm; ``orientation_tolerance`` in rad,
+        default 0.1 deg; None also means the default) or ``max_steps`` steps have run;
+        an unreachable target returns ``converged=False`` with the best error.
+        ``Solution.steps`` is the number of steps run, ``Solution.best_step`` the one
+        that reached ``q``. Releases the GIL."""
 
 @final
 class LagModel:

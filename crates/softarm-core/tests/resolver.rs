@@ -313,6 +313,35 @@ fn unreachable_target_ends_unconverged_with_the_best_error() {
 }
 
 #[test]
+fn solution_counts_the_steps_run_and_the_step_of_the_best() {
+    let arm = SoftArm::blackberry();
+    let res = Resolver::new(arm.clone(), Mode::Hybrid, Gains::blackberry()).unwrap();
+    let mut t = Matrix4::identity();
+    t[(1, 3)] = 2.0;
+    for max_steps in [0, 1, 5, 50] {
+        let opts = SolveOptions {
+            max_steps,
+            ..SolveOptions::default()
+        };
+        let sol = res.solve(&[0.01; 9], &Target::Pose(t), &opts).unwrap();
+        // Unreachable: every step allowed is run, whatever step gave the best error.
+        assert_eq!(sol.steps, max_steps, "{sol:?}");
+        assert!(sol.best_step <= sol.steps);
+    }
+    let goal = arm
+        .forward(&[0.02, 0.0, 0.01, 0.0, 0.03, 0.0, 0.01, 0.0, 0.02])
+        .unwrap();
+    let sol = res
+        .solve(&[0.01; 9], &Target::Pose(goal), &SolveOptions::default())
+        .unwrap();
+    // Converged: it stops at the step that reached tolerance, which is the best.
+    assert!(
+        sol.converged && sol.steps > 0 && sol.steps == sol.best_step,
+        "{sol:?}"
+    );
+}
+
+#[test]
 fn straight_configuration_is_regular_no_nan_no_jump() {
     let arm = SoftArm::blackberry();
     let mut t = arm

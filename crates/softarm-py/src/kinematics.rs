@@ -14,6 +14,15 @@ use crate::convert::{
 };
 use crate::errors::{fielded, InputError, IntoPyResult};
 
+/// `q` as a vector of the model's length that gives every section a geometry: finite,
+/// bounded, and a positive arc length (a non-positive one is a `ParameterError` naming
+/// `q[3i..3i+3]`). Values outside the actuator limits that still have a geometry pass.
+fn geometric_q<M: SectionModel>(model: &M, q: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let q = vector(q, "q", model.n_dofs())?;
+    softarm_core::chain::check_q_arcs(model, &q).py()?;
+    Ok(q)
+}
+
 /// Converts a Python section index, rejecting negative and too large values by name.
 fn section_index<M: SectionModel>(model: &M, section: &Bound<'_, PyAny>) -> PyResult<usize> {
     count(section, "section", 0, model.n_sections().saturating_sub(1))
@@ -64,6 +73,19 @@ fn sections_arg(obj: &Bound<'_, PyAny>) -> PyResult<Vec<core::Section>> {
 fn batch_input<M: SectionModel>(model: &M, qs: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     let (flat, _) = array(qs, "qs", &[None, Some(model.n_dofs())])?;
     core::error::check_bounded("qs", &flat, core::error::MAX_COORDINATE).py()?;
+    for (k, q) in flat.chunks_exact(model.n_dofs()).enumerate() {
+        // A row without geometry is named as qs[row, 3i..3i+3].
+        softarm_core::chain::check_q_arcs(model, q)
+            .map_err(|e| match e {
+                core::Error::Parameter { arg, value, reason } => core::Error::Parameter {
+                    arg: format!("qs[{k}, {}", arg.trim_start_matches("q[")),
+                    value,
+                    reason,
+                },
+                other => other,
+            })
+            .py()?;
+    }
     Ok(flat)
 }
 
@@ -98,15 +120,19 @@ macro_rules! kinematic_methods {
             }
 
             /// End-effector pose (4, 4) in the base frame.
+            ///
+            /// A `q` outside the limits is still computed while every section keeps a
+            /// positive arc length; one without (a non-positive arc length) raises
+            /// `ParameterError` naming `q[3i..3i+3]`, as every kinematic call does.
             fn forward<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-                let q = vector(q, "q", self.inner.n_dofs())?;
+                let q = geometric_q(&self.inner, q)?;
                 let t = self.inner.forward(&q).py()?;
                 Ok(mat4_out(py, &t))
             }
 
             /// Jacobian (6, n): rows vx, vy, vz, wx, wy, wz in the base frame.
             fn jacobian<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-                let q = vector(q, "q", self.inner.n_dofs())?;
+                let q = geometric_q(&self.inner, q)?;
                 let j = self.inner.jacobian(&q).py()?;
                 Ok(dmatrix_out(py, &j))
             }
@@ -117,7 +143,7 @@ macro_rules! kinematic_methods {
                 py: Python<'py>,
                 q: &Bound<'py, PyAny>,
             ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-                let q = vector(q, "q", self.inner.n_dofs())?;
+                let q = geometric_q(&self.inner, q)?;
                 let (t, j) = self.inner.forward_jacobian(&q).py()?;
                 Ok((mat4_out(py, &t), dmatrix_out(py, &j)))
             }
@@ -131,7 +157,7 @@ macro_rules! kinematic_methods {
                 section: &Bound<'py, PyAny>,
                 s: &Bound<'py, PyAny>,
             ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
-                let q = vector(q, "q", self.inner.n_dofs())?;
+                let q = geometric_q(&self.inner, q)?;
                 let section = section_index(&self.inner, section)?;
                 let s = real(s, "s")?;
                 let (p, j) = self.inner.point(&q, section, s).py()?;
@@ -140,7 +166,7 @@ macro_rules! kinematic_methods {
 
             /// Base frame of every section, then the end effector: (n_sections + 1, 4, 4).
             fn frames<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-                let q = vector(q, "q", self.inner.n_dofs())?;
+                let q = geometric_q(&self.inner, q)?;
                 let frames = self.inner.frames(&q).py()?;
                 let out = PyArray3::<f64>::zeros(py, [frames.len(), 4, 4], false);
                 {
@@ -157,7 +183,7 @@ macro_rules! kinematic_methods {
             /// (n_sections * samples, 3).
             #[pyo3(signature = (q, samples = None), text_signature = "(self, q, samples=20)")]
             fn backbone<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>, samples: Option<&Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-                let q = vector(q, "q", self.inner.n_dofs())?;
+                let q = geometric_q(&self.inner, q)?;
                 let samples = match samples {
                     Some(v) => count(v, "samples", 2, core::error::MAX_SAMPLES)?,
                     None => 20,
@@ -342,7 +368,7 @@ kinematic_methods!(SoftArm, {
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let q = vector(q, "q", self.inner.n_dofs())?;
+        let q = geometric_q(&self.inner, q)?;
         let cfg = self.inner.polar_configs(&q).py()?;
         let flat: Vec<f64> = cfg
             .iter()
@@ -363,8 +389,35 @@ kinematic_methods!(SoftArm, {
         (slf.get_type(), (sections,))
     }
 
+    /// `SoftArm([Section(...), ...])`: its geometry, section by section.
     fn __repr__(&self) -> String {
-        format!("SoftArm(n_sections={})", self.inner.n_sections())
+        let sections: Vec<String> = self
+            .inner
+            .sections()
+            .iter()
+            .map(|&inner| Section { inner }.__repr__())
+            .collect();
+        format!("SoftArm([{}])", sections.join(", "))
+    }
+
+    /// Equal when the sections are (a pickled or deep copy compares equal).
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<SoftArm>()
+            .is_ok_and(|o| o.get().inner.sections() == self.inner.sections())
+    }
+
+    /// Consistent with `__eq__`: hashes the bits of every section parameter (0.0 and -0.0
+    /// hash alike, as they compare equal).
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for s in self.inner.sections() {
+            for v in [s.radius, s.rest_length, s.lower, s.upper, s.offset, s.twist] {
+                (v + 0.0).to_bits().hash(&mut h);
+            }
+        }
+        h.finish()
     }
 });
 

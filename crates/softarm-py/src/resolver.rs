@@ -278,10 +278,15 @@ impl Solution {
     fn converged(&self) -> bool {
         self.inner.converged
     }
-    /// Steps taken to reach `q`.
+    /// Steps run: the last configuration evaluated is `q0` after `steps` steps.
     #[getter]
     fn steps(&self) -> usize {
         self.inner.steps
+    }
+    /// The step at which `q` was reached (`q0` after `best_step` steps).
+    #[getter]
+    fn best_step(&self) -> usize {
+        self.inner.best_step
     }
     /// ‖e_p‖ at `q` (m).
     #[getter]
@@ -313,6 +318,7 @@ impl Solution {
             f64,
             f64,
             &'static str,
+            usize,
         ),
     )> {
         let f = py.import("softarm._core")?.getattr("_rebuild_solution")?;
@@ -326,15 +332,17 @@ impl Solution {
                 s.position_error,
                 s.orientation_error,
                 s.termination.name(),
+                s.best_step,
             ),
         ))
     }
     fn __repr__(&self) -> String {
         format!(
-            "Solution(converged={}, steps={}, position_error={:.3e}, orientation_error={:.3e}, \
-             termination={:?})",
+            "Solution(converged={}, steps={}, best_step={}, position_error={:.3e}, \
+             orientation_error={:.3e}, termination={:?})",
             self.inner.converged,
             self.inner.steps,
+            self.inner.best_step,
             self.inner.position_error,
             self.inner.orientation_error,
             self.inner.termination.name()
@@ -498,7 +506,9 @@ impl Resolver {
 
     /// Iterates steps on the model to tolerance. Releases the GIL.
     #[pyo3(signature = (q0, target, max_steps = None, position_tolerance = None,
-                        orientation_tolerance = None, *, obstacles = None))]
+                        orientation_tolerance = None, *, obstacles = None),
+           text_signature = "(self, q0, target, max_steps=1000, position_tolerance=0.0001, \
+                             orientation_tolerance=0.0017453292519943296, *, obstacles=None)")]
     #[allow(clippy::too_many_arguments)]
     fn solve(
         &self,
@@ -696,8 +706,11 @@ fn _rebuild_step_result(
     })
 }
 
-/// Rebuilds a `Solution` from its fields (the unpickler of `Solution.__reduce__`).
+/// Rebuilds a `Solution` from its fields (the unpickler of `Solution.__reduce__`); a
+/// pickle from before `best_step` existed rebuilds with `best_step = steps`.
 #[pyfunction]
+#[pyo3(signature = (q, converged, steps, position_error, orientation_error, termination,
+                    best_step = None))]
 fn _rebuild_solution(
     q: &Bound<'_, PyAny>,
     converged: bool,
@@ -705,6 +718,7 @@ fn _rebuild_solution(
     position_error: f64,
     orientation_error: f64,
     termination: &str,
+    best_step: Option<usize>,
 ) -> PyResult<Solution> {
     let termination = [
         core::SolveTermination::Converged,
@@ -719,6 +733,7 @@ fn _rebuild_solution(
             q: pickled_vector(q, "q")?,
             converged,
             steps,
+            best_step: best_step.unwrap_or(steps),
             position_error,
             orientation_error,
             termination,

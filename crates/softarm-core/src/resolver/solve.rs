@@ -60,8 +60,11 @@ pub struct Solution {
     pub q: Vec<f64>,
     /// Whether every controlled error is within its tolerance at `q`.
     pub converged: bool,
-    /// Steps taken to reach `q`.
+    /// Steps run: the last configuration evaluated is `q0` after `steps` steps (at most
+    /// `max_steps`).
     pub steps: usize,
+    /// The step at which `q` was reached (`q0` after `best_step` steps; at most `steps`).
+    pub best_step: usize,
     /// ‖e_p‖ at `q` (m).
     pub position_error: f64,
     /// Masked ‖e_ζ‖ at `q` (rad); 0 for a point target.
@@ -133,7 +136,9 @@ impl<K: Kinematics> Resolver<K> {
             ..StepInput::default()
         };
         let mut termination = SolveTermination::StepLimit;
+        let mut steps = 0;
         for k in 0..=opts.max_steps {
+            steps = k;
             let info = self.step_input_into(&mut ws, &q, target, &input, &mut next)?;
             let s = score(info.position_error, info.orientation_error);
             if s < best_score || best.is_none() {
@@ -142,6 +147,7 @@ impl<K: Kinematics> Resolver<K> {
                     q: q.clone(),
                     converged: s <= 1.0,
                     steps: k,
+                    best_step: k,
                     position_error: info.position_error,
                     orientation_error: info.orientation_error,
                     termination,
@@ -155,10 +161,14 @@ impl<K: Kinematics> Resolver<K> {
                 termination = SolveTermination::Stuck;
                 break;
             }
+            if k == opts.max_steps {
+                break;
+            }
             std::mem::swap(&mut q, &mut next);
         }
         let mut sol =
             best.ok_or_else(|| Error::parameter("max_steps", 0.0, "no step was taken"))?;
+        sol.steps = steps;
         sol.termination = if sol.converged {
             SolveTermination::Converged
         } else {
