@@ -7,7 +7,14 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ["rounded"]
+__all__ = ["plural", "rounded"]
+
+
+def plural(n: int, noun: str) -> str:
+    """``1 berry``, ``2 berries``, ``0 seeds``: a count and its noun, singular for one."""
+    if n == 1:
+        return f"{n} {noun}"
+    return f"{n} {noun[:-1]}ies" if noun.endswith("y") else f"{n} {noun}s"
 
 
 def rounded(value: Any, digits: int = 6) -> Any:

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -22,6 +24,7 @@ from softarm.commands._args import (
     non_negative_int,
     output_file,
 )
+from softarm.commands._format import plural
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
 from softarm.commands._run_info import (
@@ -33,6 +36,7 @@ from softarm.commands._run_info import (
 )
 from softarm.commands._signals import drives_arm, vents_on_stop
 from softarm.errors import ConfigError, HardwareUnavailableError
+from softarm.harvest_config import HarvestConfig
 
 if TYPE_CHECKING:
     from softarm.config import Config
@@ -155,7 +159,7 @@ def run_sim(
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
     if not quiet:
-        print(f"simulated harvest: {berries} berries, seed {seed}", flush=True)
+        print(f"simulated harvest: {plural(berries, 'berry')}, seed {seed}", flush=True)
     rig_options = SimRigOptions(
         n_berries=berries, seed=seed, log_path=log_path, gains=gains or {}, **options
     )
@@ -172,7 +176,7 @@ def run_sim(
         if viewer is not None:
             viewer.close()  # the recording complete, even after a stop
     report.header = rig.machine.log.records[0]
-    print(summary(report.to_dict()))
+    print(summary(report.to_dict(), Tolerance.of(rig.machine.config)))
     if report_path is not None:
         report.save(report_path)
         print(f"report: {report_path}")
@@ -206,13 +210,14 @@ def _save_image(image: Any, path: Path) -> None:
 def _harvest(rig: SimRig, n: int, quiet: bool) -> HarvestReport:
     seen: set[int] = set()
     last = time.monotonic()
+    tol = Tolerance.of(rig.machine.config)
     with Progress(n, "harvest", "berry", quiet) as bar:
 
         def on_berry(i: int, result: object) -> None:
             nonlocal last
             now = time.monotonic()
             retry = i in seen
-            bar.line(line(i, n, result, now - last, retry))
+            bar.line(line(i, n, result, now - last, retry, tol))
             last = now
             if not retry:
                 seen.add(i)
@@ -288,7 +293,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         rig.close()  # vents and releases every device, whatever happened
         log.close()
     report.header = log.records[0]
-    print(summary(report.to_dict()))
+    print(summary(report.to_dict(), Tolerance.of(rig.machine.config)))
     if args.report:
         report.save(args.report)
         print(f"report: {args.report}")
@@ -333,30 +338,82 @@ def _hardware_rig(args: argparse.Namespace, log: HarvestLog) -> HardwareRig:
     return build_hardware_rig(config, log=log, identified=identified, calibration=calibration)
 
 
-def line(i: int, n: int, r: Any, wall: float, retry: bool = False) -> str:
-    """One line per berry: its outcome, its error, and its own simulated and wall time."""
+@dataclass(frozen=True)
+class Tolerance:
+    """What a grasp must reach to count as within tolerance: fine positioning's position
+    tolerance (mm) and the pointing tolerance (deg), ``[harvest]`` ``fine_tolerance`` and
+    ``angle_tolerance_deg``."""
+
+    position_mm: float = 1e3 * HarvestConfig.fine_tolerance
+    angle_deg: float = HarvestConfig.angle_tolerance_deg
+
+    @classmethod
+    def of(cls, config: HarvestConfig) -> Tolerance:
+        return cls(1e3 * config.fine_tolerance, config.angle_tolerance_deg)
+
+
+def _number(v: Any) -> float | None:
+    return None if v is None or not math.isfinite(v) else float(v)
+
+
+def grasp_errors(d: dict[str, Any]) -> tuple[float | None, float | None]:
+    """A berry's (position mm, orientation deg) errors: against ground truth where known
+    (simulation), else as measured; None where not recorded."""
+    pos = _number(d.get("true_position_error_mm"))
+    if pos is None:
+        pos = _number(d.get("position_error_mm"))
+    ang = _number(d.get("true_orientation_error_deg"))
+    if ang is None:
+        ang = _number(d.get("orientation_error_deg"))
+    return pos, ang
+
+
+def outside(d: dict[str, Any], tol: Tolerance) -> list[str]:
+    """Why a harvested berry's grasp is outside tolerance (empty if it is not)."""
+    pos, ang = grasp_errors(d)
+    why = []
+    if pos is not None and pos > tol.position_mm:
+        why.append(f"position > {tol.position_mm:g} mm")
+    if ang is not None and ang > tol.angle_deg:
+        why.append(f"orientation > {tol.angle_deg:g} deg")
+    return why
+
+
+def line(
+    i: int, n: int, r: Any, wall: float, retry: bool = False, tol: Tolerance | None = None
+) -> str:
+    """One line per berry: its outcome, its position and orientation errors (flagged
+    when outside ``tol``), and its own simulated and wall time."""
     d = r.to_dict()
-    err = d.get("true_position_error_mm") or d.get("position_error_mm")
+    pos, ang = grasp_errors(d)
     what = "harvested" if d["harvested"] else (d["fault"] or "skipped (unripe)")
-    err_s = f"{err:.2f} mm" if err is not None else "-"
+    pos_s = f"{pos:.2f} mm" if pos is not None else "-"
+    ang_s = f"{ang:.1f} deg" if ang is not None else "-"
     tag = f"tag {d['tag_id']}, retry" if retry else f"tag {d['tag_id']}"
+    why = outside(d, tol or Tolerance()) if d["harvested"] else []
+    flag = f"  OUTSIDE TOLERANCE ({', '.join(why)})" if why else ""
     return (
-        f"berry {i + 1}/{n} ({tag}): {what:<16} error {err_s:>9}  "
-        f"took {d['duration_s']:.1f} s simulated, {wall:.1f} s wall"
+        f"berry {i + 1}/{n} ({tag}): {what:<16} error {pos_s:>9}, {ang_s:>8}  "
+        f"took {d['duration_s']:.1f} s simulated, {wall:.1f} s wall{flag}"
     )
 
 
-def summary(d: dict[str, Any]) -> str:
-    """The run summary line."""
-    errs = [
-        b.get("true_position_error_mm") or b["position_error_mm"]
-        for b in d["berries"]
-        if b["harvested"]
-    ]
-    mean = f"{sum(errs) / len(errs):.2f} mm" if errs else "-"
+def summary(d: dict[str, Any], tol: Tolerance | None = None) -> str:
+    """The run summary line: mean position and orientation errors of the harvested
+    berries, and how many were grasped outside ``tol``."""
+    tol = tol or Tolerance()
+    harvested = [b for b in d["berries"] if b["harvested"]]
+    errs = [grasp_errors(b) for b in harvested]
+    pos = [p for p, _ in errs if p is not None]
+    ang = [a for _, a in errs if a is not None]
+    mean = f"{sum(pos) / len(pos):.2f} mm" if pos else "-"
+    mean_ang = f"{sum(ang) / len(ang):.1f} deg" if ang else "-"
     extra = ""
+    off = sum(1 for b in harvested if outside(b, tol))
+    if off:
+        extra += f", {plural(off, 'berry')} OUTSIDE TOLERANCE"
     if "min_branch_gap_m" in d:
-        extra = (
+        extra += (
             f", min cane gap {1e3 * d['min_branch_gap_m']:.1f} mm, "
             f"{d['branch_contact_steps']} contact steps"
         )
@@ -364,5 +421,5 @@ def summary(d: dict[str, Any]) -> str:
         extra += f", {d['sim_time_s']:.1f} s simulated"
     return (
         f"harvested {d['harvested']}/{d['attempted']} ({100 * d['success_rate']:.0f} %), "
-        f"mean fine-positioning error {mean}{extra}"
+        f"mean fine-positioning error {mean}, {mean_ang}{extra}"
     )

@@ -7,6 +7,8 @@ import shutil
 import sys
 from pathlib import Path
 
+from softarm.commands._format import plural
+
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register the ``sweep`` subcommand."""
@@ -44,8 +46,9 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--cpus: must be >= 1, got {args.cpus}")
     trials = spec.trials()
     print(
-        f"sweep: {len(trials)} trials ({len(spec.plant_points())} plant points x "
-        f"{len(spec.seeds)} seeds), {len(trials) * spec.berries} berries -> {args.out}",
+        f"sweep: {plural(len(trials), 'trial')} ({plural(len(spec.plant_points()), 'plant point')}"
+        f" x {plural(len(spec.seeds), 'seed')}), {plural(len(trials) * spec.berries, 'berry')}"
+        f" -> {args.out}",
         flush=True,
     )
     outcome = run_sweep(
