@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -54,13 +55,31 @@ def _says_nothing(default: object) -> bool:
     return default is None or default is False or default is argparse.SUPPRESS
 
 
+_LITERAL = re.compile(r"``([^`]+)``")
+_ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
+_SAYS_DEFAULT = re.compile(r"\(default:?\s+[^)\s]", re.IGNORECASE)  # "(default 80)"
+
+
+def plain(text: str) -> str:
+    """``text`` without reST markup (double backquotes, :role:`x`), for the terminal:
+    command docstrings are also help text."""
+    return _ROLE.sub(r"\1", _LITERAL.sub(r"\1", text))
+
+
 class DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """Shows ``(default: X)`` after every option's help, except where the default says
-    nothing (None, False: a flag that is off, an option that is absent)."""
+    nothing (None, False: a flag that is off, an option that is absent) or the help
+    already says it; reST markup of descriptions and help is dropped."""
+
+    def _format_text(self, text: str) -> str:
+        return super()._format_text(plain(text))
+
+    def _expand_help(self, action: argparse.Action) -> str:
+        return plain(super()._expand_help(action))
 
     def _get_help_string(self, action: argparse.Action) -> str | None:
         help_ = action.help or ""
-        if _says_nothing(action.default) or "%(default)" in help_:
+        if _says_nothing(action.default) or "%(default)" in help_ or _SAYS_DEFAULT.search(help_):
             return help_
         if not action.option_strings and action.nargs not in ("?", "*"):
             return help_

@@ -48,11 +48,13 @@ class Progress:
             if bar is not None:
                 bar.refresh()
 
-    def line(self, text: str) -> None:
-        """Print a result line above the bar (nothing when quiet)."""
+    def line(self, text: str, stderr: bool = False) -> None:
+        """Print a result line above the bar (nothing when quiet); ``stderr``: a note
+        that must stay off stdout (a command whose stdout is JSON)."""
         if not self.quiet:
-            tqdm.write(text, file=sys.stdout)
-            sys.stdout.flush()
+            out = sys.stderr if stderr else sys.stdout
+            tqdm.write(text, file=out)
+            out.flush()
 
     def advance(self, n: int = 1) -> None:
         """Count ``n`` more items done."""

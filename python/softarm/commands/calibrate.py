@@ -9,7 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from softarm.commands._args import config_file, int_range, non_negative_int, output_file
+from softarm.commands._args import add_quiet, config_file, int_range, non_negative_int, output_file
 from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
 
@@ -48,7 +48,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         action="store_true",
         help="also fit a constant bending bias per section (the gravity-aware term)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    add_quiet(p)
     p.set_defaults(run=run)
 
 

@@ -1,6 +1,7 @@
 """``softarm experiment NAME``: the paper's benchtop experiments (IV-B, IV-C, IV-D) and
 the gain-schedule comparison on the simulated arm. Prints the summaries as JSON (floats
-rounded to 6 significant digits; the files in --out keep full precision)."""
+rounded to 6 significant digits; the files in --out keep full precision) on stdout, and
+nothing else there: progress goes to stderr."""
 
 from __future__ import annotations
 
@@ -44,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
             bar.describe(name)
             start = time.monotonic()
             results.update(run_experiment(name, args.out, seed=args.seed, quick=args.quick))
-            bar.line(f"{name}: done in {time.monotonic() - start:.1f} s")
+            # stdout is the JSON alone: the progress notes go to stderr.
+            bar.line(f"{name}: done in {time.monotonic() - start:.1f} s", stderr=True)
             bar.advance()
     print(json.dumps(rounded(results), indent=2, default=str))
     if args.report is not None:

@@ -117,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     check_bag(args.bag)
+    check_view(args.view, args.record)
     configure_logging(args.quiet)
     options = plant_options(args)
     gains = _gains(args)
@@ -128,6 +129,15 @@ def run(args: argparse.Namespace) -> int:
             gains=gains, view=args.view, record=args.record, bag=args.bag, args=args, **options,
         )  # fmt: skip
     return _run_hardware(args)
+
+
+def check_view(view: bool, record: Path | None) -> None:
+    """Before any work (no banner, no log file): ``--view``/``--record`` need rerun-sdk,
+    the ``viz`` extra (a one-line :class:`MissingDependencyError` naming it)."""
+    if view or record is not None:
+        from softarm.viz.rerun_sdk import require_rerun
+
+        require_rerun()
 
 
 def configure_logging(quiet: bool) -> None:
@@ -158,6 +168,7 @@ def run_sim(
     ``bag``: the run as a ROS 2 bag."""
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
+    check_view(view, record)  # demo's path too: before the banner and the log
     if not quiet:
         print(f"simulated harvest: {plural(berries, 'berry')}, seed {seed}", flush=True)
     rig_options = SimRigOptions(

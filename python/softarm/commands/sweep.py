@@ -7,6 +7,7 @@ import shutil
 import sys
 from pathlib import Path
 
+from softarm.commands._args import add_quiet
 from softarm.commands._format import plural
 
 
@@ -26,6 +27,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--resume", action="store_true", help="complete the table in --out")
     p.add_argument("--gains", type=Path, help="resolver gains file ([gains], e.g. from tune)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_quiet(p)
     p.set_defaults(run=run)
 
 
@@ -45,15 +47,17 @@ def run(args: argparse.Namespace) -> int:
     if args.cpus is not None and args.cpus < 1:
         raise ConfigError(f"--cpus: must be >= 1, got {args.cpus}")
     trials = spec.trials()
-    print(
-        f"sweep: {plural(len(trials), 'trial')} ({plural(len(spec.plant_points()), 'plant point')}"
-        f" x {plural(len(spec.seeds), 'seed')}), {plural(len(trials) * spec.berries, 'berry')}"
-        f" -> {args.out}",
-        flush=True,
-    )
+    if not args.quiet:
+        points, seeds = len(spec.plant_points()), len(spec.seeds)
+        grid = f"{plural(points, 'plant point')} x {plural(seeds, 'seed')}"
+        print(
+            f"sweep: {plural(len(trials), 'trial')} ({grid}), "
+            f"{plural(len(trials) * spec.berries, 'berry')} -> {args.out}",
+            flush=True,
+        )
     outcome = run_sweep(
         spec, args.out, address=args.address, resume=args.resume, cpus=args.cpus,
-        progress=not args.no_progress,
+        progress=not (args.no_progress or args.quiet),
     )  # fmt: skip
     args.out.mkdir(parents=True, exist_ok=True)
     if args.spec.resolve() != (args.out / "spec.toml").resolve():

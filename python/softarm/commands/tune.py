@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from softarm.commands._args import add_quiet
+
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register the ``tune`` subcommand."""
@@ -23,6 +25,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--address", help="join this Ray cluster (default: start Ray on this machine)")
     p.add_argument("--cpus", type=int, help="cores of the local Ray (default: all)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_quiet(p)
     p.set_defaults(run=run)
 
 
@@ -40,13 +43,14 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--cpus: must be >= 1, got {args.cpus}")
     outcome = run_tune(
         spec, args.out, address=args.address, cpus=args.cpus, samples=args.samples,
-        progress=not args.no_progress,
+        progress=not (args.no_progress or args.quiet),
     )  # fmt: skip
     keys = [k for k in outcome.candidates[0] if k not in ("score", "success", "cycle_s",
                                                           "mean_error_mm")]  # fmt: skip
+    shown = 1 if args.quiet else 5  # --quiet: the best alone
     print("best candidates (score = harvested fraction - 1e-4 x mean s / berry):")
     print("  " + "  ".join(f"{k:>12}" for k in [*keys, "harvested", "s/berry", "score"]))
-    for c in outcome.candidates[:5]:
+    for c in outcome.candidates[:shown]:
         vals = [f"{c[k]:12.4g}" if isinstance(c[k], float) else f"{c[k]!s:>12}" for k in keys]
         vals += [f"{100 * c['success']:11.1f}%", f"{c['cycle_s']:12.2f}", f"{c['score']:12.4f}"]
         print("  " + "  ".join(vals))
