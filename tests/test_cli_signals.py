@@ -89,6 +89,9 @@ class _FakeRig:
     def close(self) -> None:
         self.closed = True
 
+    def run(self, berries: object) -> object:
+        return self.machine.run(berries)  # the hardware rig's harvest loop, stopped mid-run
+
 
 def test_hardware_run_stopped_by_sigterm_vents_closes_and_logs(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
