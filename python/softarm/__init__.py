@@ -12,7 +12,7 @@ np.float64(0.534)
 import importlib
 import importlib.metadata
 import pkgutil
-from types import ModuleType
+from typing import Any
 
 from softarm import _core
 from softarm._core import (
@@ -82,6 +82,7 @@ __all__ = [
     "__version__",
     "calibrate",
     "closest",
+    "simulate_harvest",
 ]
 
 try:
@@ -110,13 +111,20 @@ def _attach_python_side() -> None:
 _attach_python_side()
 
 
-#: Functions and classes re-exported lazily: their subpackage imports scipy.optimize.
-_LAZY_NAMES = {"calibrate": "softarm.calibration", "Calibration": "softarm.calibration"}
+#: Functions and classes re-exported lazily, name -> (module, its name there): their
+#: subpackages import scipy.optimize, OpenCV and the simulator.
+_LAZY_NAMES = {
+    "calibrate": ("softarm.calibration", "calibrate"),
+    "Calibration": ("softarm.calibration", "Calibration"),
+    # The simulated harvest, softarm.harvest.simulate: a report from one call.
+    "simulate_harvest": ("softarm.harvest.simulated", "simulate"),
+}
 
 
-def __getattr__(name: str) -> ModuleType:
+def __getattr__(name: str) -> Any:
     if name in _LAZY_NAMES:
-        return getattr(importlib.import_module(_LAZY_NAMES[name]), name)  # type: ignore[no-any-return]
+        module, attr = _LAZY_NAMES[name]
+        return getattr(importlib.import_module(module), attr)
     if name in _LAZY_SUBPACKAGES:
         return importlib.import_module(f"softarm.{name}")
     raise AttributeError(f"module 'softarm' has no attribute {name!r}")

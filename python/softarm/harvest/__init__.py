@@ -18,6 +18,7 @@ from softarm.harvest.interfaces import (
 from softarm.harvest.log import HarvestLog, read_log
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.simulated import simulate
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
 
 __all__ = [
@@ -41,4 +42,5 @@ __all__ = [
     "SafeActuator",
     "Vision",
     "read_log",
+    "simulate",
 ]

@@ -80,9 +80,11 @@ def error_row(trial: TrialSpec, error: str, wall_s: float = math.nan) -> dict[st
     return row
 
 
-def run_trial_rows(trial: TrialSpec) -> list[dict[str, Any]]:
-    """One row per berry of ``trial`` (see :data:`BERRY_COLUMNS`), or one error row."""
-    _single_threaded()
+def run_trial_rows(trial: TrialSpec, single_threaded: bool = True) -> list[dict[str, Any]]:
+    """One row per berry of ``trial`` (see :data:`BERRY_COLUMNS`), or one error row;
+    ``single_threaded``: OpenCV on one thread (a Ray worker, one trial per core)."""
+    if single_threaded:
+        _single_threaded()
     start, cpu_start = time.perf_counter(), time.process_time()
     try:
         report = run_trial(trial).to_dict()

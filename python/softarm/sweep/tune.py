@@ -131,6 +131,10 @@ def run_tune(
 
     # Tune's own console tables and Optuna's per-trial log lines: the bar says enough.
     os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
+    # Ctrl-C stops the search: Ray Tune's own SIGINT handler would instead end it quietly
+    # and return the candidates so far (a gains file from a cut search, or exit 2 with
+    # none); KeyboardInterrupt reaches the command line, which exits 130, no gains written.
+    os.environ.setdefault("TUNE_DISABLE_SIGINT_HANDLER", "1")
     require("optuna").logging.set_verbosity(require("optuna").logging.WARNING)
     started = init_ray(address, cpus)
     storage = Path(tempfile.mkdtemp(prefix="softarm-tune-"))
