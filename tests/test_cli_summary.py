@@ -44,3 +44,11 @@ def test_summary_gives_both_means_and_counts_the_berries_outside() -> None:
 def test_one_berry_is_singular() -> None:
     assert plural(1, "berry") == "1 berry"
     assert plural(2, "berry") == "2 berries" and plural(0, "seed") == "0 seeds"
+
+
+def test_the_tolerance_is_the_rigs_config() -> None:
+    from softarm.harvest import HarvestConfig
+
+    assert Tolerance.of(None) == Tolerance() == Tolerance(0.5, 5.0)
+    t = Tolerance.of(HarvestConfig(fine_tolerance=0.002, angle_tolerance_deg=9.0))
+    assert t == Tolerance(2.0, 9.0)

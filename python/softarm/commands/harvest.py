@@ -187,7 +187,7 @@ def run_sim(
         if viewer is not None:
             viewer.close()  # the recording complete, even after a stop
     report.header = rig.machine.log.records[0]
-    print(summary(report.to_dict(), Tolerance.of(rig.machine.config)))
+    print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
     if report_path is not None:
         report.save(report_path)
         print(f"report: {report_path}")
@@ -221,7 +221,7 @@ def _save_image(image: Any, path: Path) -> None:
 def _harvest(rig: SimRig, n: int, quiet: bool) -> HarvestReport:
     seen: set[int] = set()
     last = time.monotonic()
-    tol = Tolerance.of(rig.machine.config)
+    tol = Tolerance.of(getattr(rig.machine, "config", None))
     with Progress(n, "harvest", "berry", quiet) as bar:
 
         def on_berry(i: int, result: object) -> None:
@@ -304,7 +304,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         rig.close()  # vents and releases every device, whatever happened
         log.close()
     report.header = log.records[0]
-    print(summary(report.to_dict(), Tolerance.of(rig.machine.config)))
+    print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
     if args.report:
         report.save(args.report)
         print(f"report: {args.report}")
@@ -359,7 +359,10 @@ class Tolerance:
     angle_deg: float = HarvestConfig.angle_tolerance_deg
 
     @classmethod
-    def of(cls, config: HarvestConfig) -> Tolerance:
+    def of(cls, config: HarvestConfig | None) -> Tolerance:
+        """The tolerance of a rig's ``[harvest]`` settings (None: the defaults)."""
+        if not isinstance(config, HarvestConfig):
+            return cls()
         return cls(1e3 * config.fine_tolerance, config.angle_tolerance_deg)
 
 
