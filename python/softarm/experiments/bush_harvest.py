@@ -21,7 +21,11 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
     """Pooled figures over ``reports`` (one per bush)."""
     ripe = sum(r["ripe_in_reach"] for r in reports)
     errors = [b["true_position_error_mm"] for r in reports for b in r["berries"] if b["harvested"]]
+    # A bush whose canes in reach were all missed has no distances (None): its coverage
+    # still counts.
     maps = [r["cane_map"] for r in reports]
+    medians = [m["median_mm"] for m in maps if m["median_mm"] is not None]
+    p95s = [m["p95_mm"] for m in maps if m["p95_mm"] is not None]
     return {
         "bushes": len(reports),
         "ripe_in_reach": ripe,
@@ -31,8 +35,8 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
         "unripe_picked": sum(r["unripe_picked"] for r in reports),
         "mean_true_fine_error_mm": statistics.fmean(errors) if errors else float("nan"),
         "contact_steps": sum(r["branch_contact_steps"] for r in reports),
-        "cane_median_mm": statistics.median(m["median_mm"] for m in maps),
-        "cane_p95_mm": statistics.median(m["p95_mm"] for m in maps),
+        "cane_median_mm": statistics.median(medians) if medians else float("nan"),
+        "cane_p95_mm": statistics.median(p95s) if p95s else float("nan"),
         "cane_coverage": statistics.fmean(m["coverage"] for m in maps),
         "sim_s_per_berry": sum(r["sim_time_s"] for r in reports)
         / max(sum(len(r["berries"]) for r in reports), 1),

@@ -20,7 +20,7 @@ from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
 from softarm.errors import SoftarmError
-from softarm.sim.render.labels import GeomLabels
+from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.mjcf import (
     ARM_SEGMENTS_PER_SECTION,
     CameraSpec,
@@ -28,6 +28,8 @@ from softarm.sim.render.mjcf import (
     scene_xml,
 )
 
+#: Where what is out of the picture is put.
+FAR_AWAY = np.array([0.0, -50.0, 0.0])
 #: The sensor pixel pitch (m) the scene's cameras are declared with (mjcf._camera).
 PIXEL = 1e-6
 #: The geom group of everything that can hide a berry (leaves, canes, clutter, the arm).
@@ -98,6 +100,20 @@ class BushRenderer:
         ]
         self.n_sections = spec.n_sections
         self._arm_set = False
+        self._leaves = np.flatnonzero(self.labels.kind == KINDS.index("leaf"))
+        self._leaf_home = self.model.geom_pos[self._leaves].copy()
+        self._leaf_half = self.model.geom_size[self._leaves, 0].copy()
+
+    def push_leaves(self, body: FloatArray, radius: FloatArray) -> None:
+        """Move aside every leaf that the arm's body (spheres at ``body`` (N, 3) with
+        ``radius`` (N,)) would pass through: a real leaf is pushed by the arm, a
+        rendered one would otherwise stay inside it and hide the cube from C1 and the
+        fruit from C2 as no leaf on a bush can. A leaf is in the way when its centre lies
+        within the body's radius plus half the leaf's half-length."""
+        gaps = np.linalg.norm(self._leaf_home[:, None, :] - body[None, :, :], axis=2)
+        inside = (gaps - radius[None, :] < 0.5 * self._leaf_half[:, None]).any(axis=1)
+        self.model.geom_pos[self._leaves] = self._leaf_home
+        self.model.geom_pos[self._leaves[inside]] = FAR_AWAY
 
     def set_arm(self, sections: Sequence[FloatArray], T_base_ee: FloatArray) -> None:
         """Draw the arm: ``sections`` are (ARM_SEGMENTS_PER_SECTION + 1, 3) points along
@@ -123,9 +139,11 @@ class BushRenderer:
         self._place("arm_cube", T_base_cube[:3, 3], T_base_cube[:3, :3])
 
     def hide_arm(self) -> None:
-        """Move the arm out of sight (an empty bush, as at registration or a dataset)."""
+        """Move the arm out of sight (an empty bush, as at registration or a dataset),
+        the leaves back where they grow."""
         for name in self._mocap:
-            self._place(name, np.array([0.0, -50.0, 0.0]), np.eye(3))
+            self._place(name, FAR_AWAY, np.eye(3))
+        self.model.geom_pos[self._leaves] = self._leaf_home
         self._arm_set = False
 
     def render(

@@ -9,6 +9,7 @@ the right eye sits ``baseline`` along its +x, as the ZED2's do.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from typing import Any
 
@@ -22,7 +23,12 @@ from softarm.sim.bush import PLUS_Y, Bush
 from softarm.sim.render.distortion import Distorter
 from softarm.sim.render.labels import GeomLabels
 from softarm.sim.render.look import BushLook
-from softarm.sim.render.mjcf import ARM_SEGMENTS_PER_SECTION, CameraSpec, SceneSpec
+from softarm.sim.render.mjcf import (
+    ARM_SEGMENTS_PER_SECTION,
+    ARM_TUBE_RADIUS,
+    CameraSpec,
+    SceneSpec,
+)
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
@@ -31,6 +37,9 @@ __all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
 
 #: The ZED2's stereo baseline (m).
 ZED2_BASELINE = 0.12
+#: The cube's and the gripper's reach (m) from their centres, for the leaves they push.
+CUBE_REACH = 0.07
+GRIPPER_REACH = 0.04
 #: Side (px) of the C1 window rendered around the marker cube while tracking it; the
 #: pinhole window rendered for it is WINDOW_MARGIN px larger (the distortion's shift).
 WINDOW = 256
@@ -123,7 +132,14 @@ class RenderedBush:
         """Draw the arm along ``sections`` (see :func:`arm_sections`) with its end
         effector, gripper, C2 and cube at ``T_base_ee``."""
         self.renderer.set_arm(sections, T_base_ee)
-        self.renderer.set_cube(T_base_ee @ self.T_ee_cube)
+        cube = T_base_ee @ self.T_ee_cube
+        self.renderer.set_cube(cube)
+        body = [_densified(s) for s in sections] + [cube[None, :3, 3], T_base_ee[None, :3, 3]]
+        radius = [np.full(len(b), ARM_TUBE_RADIUS) for b in body[:-2]] + [
+            np.array([CUBE_REACH]),
+            np.array([GRIPPER_REACH]),
+        ]
+        self.renderer.push_leaves(np.vstack(body), np.concatenate(radius))
 
     def hide_arm(self) -> None:
         """An empty view of the bush (no arm)."""
@@ -183,6 +199,13 @@ class RenderedBush:
             None if f.depth is None else d.nearest(f.depth),
             None if f.geoms is None else d.nearest(f.geoms),
         )
+
+
+def _densified(points: FloatArray, per_segment: int = 3) -> FloatArray:
+    """``points`` with ``per_segment`` - 1 more between each pair."""
+    t = np.linspace(0.0, 1.0, per_segment, endpoint=False)
+    dense = [a + np.outer(t, b - a) for a, b in itertools.pairwise(points)]
+    return np.vstack([*dense, points[-1:]])
 
 
 def _spec(name: str, pose: FloatArray, camera: CameraModel) -> CameraSpec:
