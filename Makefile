@@ -36,7 +36,8 @@ dev: venv
 
 # The same build with the runtime dependencies only: what a user of `make demo` needs.
 install: venv
-	$(VENV)/bin/maturin develop --release -q
+	@echo "building the Rust extension (release, about two minutes on a first build)..."
+	$(VENV)/bin/maturin develop --release
 
 test-rust:
 	cargo test --release -p softarm-core
