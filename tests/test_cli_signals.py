@@ -15,6 +15,8 @@ from pathlib import Path
 
 import pytest
 
+from child_signals import default_signals
+
 #: Generous: the run must have started stepping before the signal, on a loaded CI box.
 START_TIMEOUT_S = 180.0
 
@@ -42,6 +44,7 @@ def test_signal_vents_logs_and_exits(sig: signal.Signals, status: int, tmp_path:
         stderr=subprocess.PIPE,
         text=True,
         env=env,
+        preexec_fn=default_signals,
     )
     try:
         deadline = time.monotonic() + START_TIMEOUT_S

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from child_signals import default_signals
 from softarm import cli
 from softarm.commands import calibrate, demo, harvest, identify
 from softarm.commands._signals import Interrupted, stop_arm
@@ -46,7 +47,7 @@ def test_calibrate_stopped_by_a_signal_says_so_and_exits_128_plus_n(
     proc = subprocess.Popen(
         [sys.executable, "-m", "softarm", "calibrate", "--sim", "--poses", "100", "--out",
          str(out)],
-        stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+        stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, preexec_fn=default_signals,
     )  # fmt: skip
     try:
         assert proc.stderr is not None

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+from child_signals import default_signals
+
 pytest.importorskip("ray")
 pytest.importorskip("pyarrow")
 import pyarrow.parquet as pq
@@ -60,8 +62,10 @@ def test_a_stop_keeps_finished_trials_and_stops_ray(tmp_path: Path, sig: signal.
     script = tmp_path / "driver.py"
     script.write_text(DRIVER)
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, str(script), str(out)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, str(script), str(out)], stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True, preexec_fn=default_signals,
+    )  # fmt: skip
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline()  # blocks until the first trial is written

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from child_signals import default_signals
+
 pytest.importorskip("ray.tune")
 pytest.importorskip("optuna")
 
@@ -48,7 +50,7 @@ def test_ctrl_c_exits_130_without_gains(tmp_path: Path) -> None:
     gains = tmp_path / "gains.toml"
     proc = subprocess.run(
         [sys.executable, str(script), str(spec), str(gains)],
-        capture_output=True, text=True, timeout=240,
+        capture_output=True, text=True, timeout=240, preexec_fn=default_signals,
     )  # fmt: skip
     assert proc.returncode == 128 + signal.SIGINT, proc.stderr[-3000:]
     assert "interrupted" in proc.stderr
