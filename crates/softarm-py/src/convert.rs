@@ -10,7 +10,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt};
 use softarm_core::{Frame, Mat4, Vec3};
 
-use crate::errors::{fielded, range_err, Given, InputError, ShapeError};
+use crate::errors::{fielded, given_text, range_err, Given, InputError, ShapeError};
 
 static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
 static CONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
@@ -169,6 +169,14 @@ pub fn count(obj: &Bound<'_, PyAny>, arg: &str, min: usize, max: usize) -> PyRes
 pub fn shape_err(arg: &str, expected: String, got: String) -> PyErr {
     let msg = format!("{arg}: expected {expected}, got {got}");
     fielded(ShapeError::new_err(msg), arg, Given::Text(got), &expected)
+}
+
+/// The [`InputError`] "`arg`: expected `expected`, got <type of `obj`>", its fields set:
+/// an argument of the wrong kind of object.
+pub fn wrong_type(obj: &Bound<'_, PyAny>, arg: &str, expected: &str) -> PyErr {
+    let value = type_of(obj);
+    let msg = format!("{arg}: expected {expected}, got {}", given_text(&value));
+    fielded(InputError::new_err(msg), arg, value, expected)
 }
 
 /// Shape of an array as a readable string, e.g. `(3, 4)`.

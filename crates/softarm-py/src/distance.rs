@@ -9,7 +9,7 @@ use softarm_core::chain::SectionModel;
 use softarm_core::distance::{self as dist, Obstacle};
 use softarm_core::{self as core, Vec3};
 
-use crate::convert::{array, count, points_out, real, reshape, type_of, vec3_out, vector};
+use crate::convert::{array, count, points_out, real, reshape, vec3_out, vector, wrong_type};
 use crate::errors::{fielded, Given, InputError, IntoPyResult};
 use crate::kinematics::{ArcChain, SoftArm};
 
@@ -30,14 +30,7 @@ impl Model {
         if let Ok(c) = obj.cast::<ArcChain>() {
             return Ok(Model::Chain(c.get().inner.clone()));
         }
-        let expected = "a SoftArm or an ArcChain";
-        let msg = format!("{arg}: expected {expected}, got {}", obj.get_type().name()?);
-        Err(fielded(
-            InputError::new_err(msg),
-            arg,
-            type_of(obj),
-            expected,
-        ))
+        Err(wrong_type(obj, arg, "a SoftArm or an ArcChain"))
     }
 
     /// Number of coordinates.
@@ -387,16 +380,11 @@ pub fn obstacle_from(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Obstacle> {
     // every obstacle form), like every obstacle the core receives.
     match vector(obj, arg, 3) {
         Ok(v) => Ok(Obstacle::Point(Vec3::new(v[0], v[1], v[2]))),
-        Err(_) => {
-            let expected = "a PolynomialCurve, Segment, PointCloud, TriangleMesh or a point (3,)";
-            let msg = format!("{arg}: expected {expected}, got {}", obj.get_type().name()?);
-            Err(fielded(
-                InputError::new_err(msg),
-                arg,
-                type_of(obj),
-                expected,
-            ))
-        }
+        Err(_) => Err(wrong_type(
+            obj,
+            arg,
+            "a PolynomialCurve, Segment, PointCloud, TriangleMesh or a point (3,)",
+        )),
     }
 }
 

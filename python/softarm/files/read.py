@@ -12,10 +12,12 @@ against its declared range (:mod:`softarm.files.ranges`).
 from __future__ import annotations
 
 import codecs
+import contextlib
 import json
 import os
 import stat
 import tomllib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -94,30 +96,38 @@ def _first_line(exc: BaseException) -> str:
 
 def parse_toml(text: str, source: str) -> dict[str, Any]:
     """The TOML document of ``text``, its depth and integers checked."""
-    try:
+    with _parse_errors(source, "TOML", tomllib.TOMLDecodeError):
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: not valid TOML ({_first_line(exc)})") from None
-    except RecursionError:
-        raise ConfigError(f"{source}: nested too deeply to parse") from None
-    except ValueError as exc:  # an integer past Python's digit limit for str -> int
-        raise ConfigError(f"{source}: a number is too long ({_first_line(exc)})") from None
     check_document(data, source)
     return data
 
 
 def parse_json(text: str, source: str) -> Any:
     """The JSON document of ``text``, its depth and integers checked."""
-    try:
+    with _parse_errors(source, "JSON", json.JSONDecodeError):
         data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    except RecursionError:
-        raise ConfigError(f"{source}: nested too deeply to parse") from None
-    except ValueError as exc:  # an integer past Python's digit limit for str -> int
-        raise ConfigError(f"{source}: a number is too long ({_first_line(exc)})") from None
     check_document(data, source)
     return data
+
+
+@contextlib.contextmanager
+def _parse_errors(source: str, form: str, syntax: type[ValueError]) -> Iterator[None]:
+    """A parser's failures as one ConfigError line naming ``source``: bad syntax, a
+    document nested too deeply, an integer past Python's digit limit for str -> int."""
+    try:
+        yield
+    except syntax as exc:
+        raise ConfigError(f"{source}: not valid {form} ({_syntax_message(exc)})") from None
+    except RecursionError:
+        raise ConfigError(f"{source}: nested too deeply to parse") from None
+    except ValueError as exc:
+        raise ConfigError(f"{source}: a number is too long ({_first_line(exc)})") from None
+
+
+def _syntax_message(exc: ValueError) -> str:
+    if isinstance(exc, json.JSONDecodeError):
+        return f"{exc.msg} at line {exc.lineno}"
+    return _first_line(exc)
 
 
 def load_toml(path: str | Path, what: str) -> dict[str, Any]:
