@@ -1,7 +1,7 @@
 """``--plant FILE``, ``--identified id.json`` and ``--model model.toml``, shared by every
 command that builds the simulated rig (``harvest --sim``, ``demo``): the simulated plant's
 ``[plant]`` table (:mod:`softarm.sim.plant_file`), the plant ``softarm identify`` measured
-(:mod:`softarm.identification.result`) and the model ``softarm calibrate`` fitted
+(:mod:`softarm.identified_plant`) and the model ``softarm calibrate`` fitted
 (:mod:`softarm.calibration.result`). Both files are read and checked before the run
 starts; a bad one is a one-line error naming the key (exit status 2)."""
 
@@ -46,7 +46,7 @@ def plant_options(args: argparse.Namespace) -> dict[str, Any]:
         ParameterError: ``--plant`` without ``--sim``.
         ConfigError: a file is unreadable or holds a bad key or value.
     """
-    from softarm.identification.result import load_identified
+    from softarm.identified_plant import load_identified
     from softarm.sim.plant_file import load_plant_file
 
     out: dict[str, Any] = {}

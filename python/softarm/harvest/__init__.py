@@ -2,7 +2,6 @@
 III-D, fig. 4)."""
 
 from softarm.harvest.actuator import SafeActuator
-from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryFix,
     BerryTarget,
@@ -20,6 +19,7 @@ from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.simulated import simulate
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+from softarm.harvest_config import HarvestConfig
 
 __all__ = [
     "FAULTS_THAT_STOP",

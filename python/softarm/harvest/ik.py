@@ -23,8 +23,8 @@ from softarm._core import Resolver, SoftArm
 from softarm.checks import FloatArray
 from softarm.geometry import cone_axes
 from softarm.harvest.clearance import Clearance
-from softarm.harvest.config import HarvestConfig
 from softarm.harvest.targets import approach_pose
+from softarm.harvest_config import HarvestConfig
 
 __all__ = ["ModelIK", "cone_axes", "planning_resolver"]
 

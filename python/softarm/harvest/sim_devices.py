@@ -10,8 +10,8 @@ import numpy as np
 from softarm.checks import FloatArray
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.interfaces import BerryTarget
-from softarm.harvest.sim_plant import ArmPlant
 from softarm.sim.bush import Berry
+from softarm.sim.plant import ArmPlant
 
 __all__ = ["ArmWatch", "SimClock", "SimGripper"]
 

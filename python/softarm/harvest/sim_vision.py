@@ -1,7 +1,7 @@
 """Synthetic cameras for the simulated harvest: C1 (eye-to-hand) renders the base tag, the
 end-effector marker cube and the berry tags; C2 (eye-in-hand) renders the berry tags in
 front of the gripper. The images go through the real pipeline of
-:class:`~softarm.harvest.vision_loop.CameraVision`.
+:class:`~softarm.vision.two_cameras.CameraVision`.
 """
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.harvest.vision_loop import CameraVision, register_c1
 from softarm.sim.bush import Berry
 from softarm.sim.camera import SyntheticCamera
 from softarm.sim.markers import SceneMarker, cube_scene_markers
 from softarm.vision import CameraModel, MarkerCube
 from softarm.vision.poses import invert
+from softarm.vision.two_cameras import CameraVision, register_c1
 
 __all__ = ["BASE_TAG_ID", "SimCameras", "look_at", "sim_vision"]
 

@@ -10,9 +10,9 @@ hysteresis, per channel (``softarm identify``; docs/identification.md).
 from softarm.identification.estimate import estimate
 from softarm.identification.protocol import Design, Segment
 from softarm.identification.record import Recording, run_experiment
-from softarm.identification.result import IdentifiedPlant, identified_from_config, load_identified
 from softarm.identification.rig import IdentificationRig, SimIdentificationRig, sim_plant_seed
 from softarm.identification.run import identify
+from softarm.identified_plant import IdentifiedPlant, identified_from_config, load_identified
 
 __all__ = [
     "Design",

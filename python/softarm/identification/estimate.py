@@ -18,7 +18,7 @@ from softarm.identification.kinematic import fit_kinematics
 from softarm.identification.lag import fit_lag, simulate_lag
 from softarm.identification.quality import poor_estimates
 from softarm.identification.record import Recording
-from softarm.identification.result import IdentifiedPlant
+from softarm.identified_plant import IdentifiedPlant
 
 __all__ = ["estimate"]
 

@@ -8,8 +8,8 @@ from softarm._core import SoftArm
 from softarm.identification.estimate import estimate
 from softarm.identification.protocol import Design
 from softarm.identification.record import Progress, run_experiment
-from softarm.identification.result import IdentifiedPlant
 from softarm.identification.rig import IdentificationRig
+from softarm.identified_plant import IdentifiedPlant
 
 __all__ = ["identify"]
 
