@@ -174,6 +174,23 @@ def test_shipped_defaults_are_the_harvest_defaults() -> None:
     assert c.calibration.T_EE_cube[2][3] == -0.05  # the cube 5 cm behind the gripper frame
 
 
+def test_template_shows_every_harvest_key_at_its_default() -> None:
+    """The shipped file's commented ``[harvest]`` block names every HarvestConfig field
+    with the default the dataclass declares (the one declaration of each value)."""
+    import dataclasses
+    import tomllib
+
+    block = DEFAULT.split("\n[harvest]", 1)[1].split("\n[", 1)[0]
+    shown = {}
+    for line in block.splitlines():
+        m = re.match(r"# (\w+ = .*?)(?:  #.*)?$", line)
+        if m:
+            shown.update(tomllib.loads(m.group(1)))
+    defaults = HarvestConfig()
+    expected = {f.name: getattr(defaults, f.name) for f in dataclasses.fields(HarvestConfig)}
+    assert {k: tuple(v) if isinstance(v, list) else v for k, v in shown.items()} == expected
+
+
 HARVEST_BAD = [
     ("periodd = 0.1", "unknown key 'harvest.periodd'"),
     ("period = -0.1", "harvest.period must be finite and > 0, got -0.1"),

@@ -1,5 +1,6 @@
 """Body geometry shared by the simulation and the harvest layer: the radii of the arm's
-surfaces and the cane, and the fan of approach axes around a direction.
+surfaces and the cane, and the fan of approach axes around a direction and how wide it
+opens by default.
 
 This module imports only numpy, so :mod:`softarm.sim` (the bush generator, the Cosserat
 clearance) and :mod:`softarm.harvest` (clearance, placement) both take these from below
@@ -11,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["ACTUATOR_RADIUS", "CANE_RADIUS", "GRIPPER_RADIUS", "cone_axes"]
+__all__ = ["ACTUATOR_RADIUS", "APPROACH_CONE_DEG", "CANE_RADIUS", "GRIPPER_RADIUS", "cone_axes"]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -21,6 +22,11 @@ ACTUATOR_RADIUS = 0.008
 GRIPPER_RADIUS = 0.025
 #: Radius (m) of a blackberry cane.
 CANE_RADIUS = 0.005
+#: How far (deg) a placement plan may tilt the approach from its axis: the default of
+#: ``HarvestConfig.approach_cone_deg``, and the cone the simulated bush keeps its canes
+#: out of (``softarm.sim.bush.Bush.generate``), so that every axis the planner may choose
+#: is clear of the canes.
+APPROACH_CONE_DEG = 20.0
 
 
 def cone_axes(axis: FloatArray, cone_deg: float, rings: int = 2, per_ring: int = 8) -> FloatArray:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from softarm.errors import ParameterError
+from softarm.geometry import APPROACH_CONE_DEG
 
 __all__ = ["HarvestConfig"]
 
@@ -71,7 +72,7 @@ class HarvestConfig:
 
     period: float = 0.05
     approach: tuple[float, float, float] = (0.0, 1.0, 0.0)
-    approach_cone_deg: float = 20.0
+    approach_cone_deg: float = APPROACH_CONE_DEG
     grasp_offset: float = 0.03
     standoff: float = 0.05
     placement_tolerance: float = 0.01

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from softarm._core import LagModel
+from softarm._core import Gains, LagModel
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 
@@ -46,8 +46,9 @@ MEASUREMENT_LAG_PERIODS = 1.0
 #: at the 0.6 it was tuned at.
 PREDICTED_ALPHA_MAX = 0.9
 PREDICTED_ALPHA_LAG_S = 0.21
-#: The mode's own gain (``Gains().hybrid_alpha``): the floor on any plant.
-PREDICTED_ALPHA_MIN = 0.3
+#: The mode's own gain, the floor on any plant: read from the core's default gains, so
+#: that it follows ``hybrid_alpha`` rather than copying it.
+PREDICTED_ALPHA_MIN = Gains().hybrid_alpha
 
 
 def predicted_loop_alpha(lag_s: float) -> float:
@@ -58,7 +59,8 @@ def predicted_loop_alpha(lag_s: float) -> float:
     and any ``0 < α < 1`` converges without overshoot whatever the lag (docs/control.md,
     section 2). What the model leaves out (the play, the measurement's true lag, an error in
     τ) acts for a time that grows with the lag, so the gain is cut as the lag grows:
-    ``α = PREDICTED_ALPHA_LAG_S / lag_s`` between the mode's 0.3 and 0.9. Measured on
+    ``α = PREDICTED_ALPHA_LAG_S / lag_s`` between the mode's own gain
+    (``PREDICTED_ALPHA_MIN``, 0.3) and 0.9. Measured on
     seeds 0–3 at 5 psi of play: 0.6 shortens fine positioning by a third at τ = 0.08 and
     0.3 s against 0.3; at τ = 0.08 s 0.9 is quicker again (3.2 → 2.8 s per berry), at
     τ = 0.3 s 0.69 was less accurate than 0.6; at τ = 1 s both 0.45 and 0.6 were slower

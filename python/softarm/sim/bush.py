@@ -19,7 +19,7 @@ import numpy as np
 from softarm._core import PolynomialCurve, SoftArm
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
-from softarm.geometry import cone_axes
+from softarm.geometry import APPROACH_CONE_DEG, cone_axes
 
 __all__ = ["Berry", "Branch", "Bush"]
 
@@ -89,7 +89,7 @@ class Bush:
         branch_clearance: float = 0.045,
         first_tag: int = 10,
         unripe_fraction: float = 0.0,
-        cone_deg: float = 20.0,
+        cone_deg: float = APPROACH_CONE_DEG,
         view_point: FloatArray | None = None,
         min_view_angle_deg: float = 3.0,
         limits: tuple[FloatArray, FloatArray] | None = None,
@@ -103,10 +103,12 @@ class Bush:
         ``branch_clearance`` (centre line to centre line: the 25 mm gripper and a 5 mm cane
         leave 15 mm) away from every berry's approach corridor (``corridor``
         m in front of the berry to 2 cm behind it, along +Y and every axis within
-        ``cone_deg`` of it). With a ``view_point`` (the eye-to-hand camera), no two berries
-        are within ``min_view_angle_deg`` of each other as seen from it: none hides
-        another's tag, so every berry can be found. ``limits`` (lower, upper) overrides
-        the arm's own elongation limits (e.g. the true actuators' range at 0–70 psi).
+        ``cone_deg`` of it: by default the harvest's default ``approach_cone_deg``,
+        ``softarm.geometry.APPROACH_CONE_DEG``). With a ``view_point`` (the eye-to-hand
+        camera), no two berries are within ``min_view_angle_deg`` of each other as seen
+        from it: none hides another's tag, so every berry can be found. ``limits``
+        (lower, upper) overrides the arm's own elongation limits (e.g. the true actuators'
+        range at 0–70 psi).
         """
         if not 1 <= n_berries <= 40:
             raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
