@@ -16,6 +16,12 @@ from softarm.units import METRES_PER_PSI
 
 #: Control period (s): one resolver step per tracker sample.
 CONTROL_PERIOD = 0.05
+#: The paper's start: every actuator at this pressure (psi), give or take
+#: ``START_SPREAD_PSI``.
+START_PSI = 35.0
+START_SPREAD_PSI = 0.5
+#: Samples at the end of a run whose errors are averaged as its final error (1 s).
+FINAL_WINDOW = 20
 
 
 def declared_gains(plant: SimulatedArm, period: float = CONTROL_PERIOD) -> Gains:
@@ -35,9 +41,9 @@ def orientation_error(judge: Resolver, q: F64, target: F64, pose: F64) -> float:
     return judge.step(q, target, pose).orientation_error
 
 
-def start_configuration(rng: np.random.Generator, n: int, psi: float = 35.0) -> F64:
+def start_configuration(rng: np.random.Generator, n: int, psi: float = START_PSI) -> F64:
     """The paper's start: a small feasible pressure with a small perturbation (m)."""
-    return (psi + rng.uniform(-0.5, 0.5, n)) * METRES_PER_PSI
+    return (psi + rng.uniform(-START_SPREAD_PSI, START_SPREAD_PSI, n)) * METRES_PER_PSI
 
 
 def bush_pressures(
@@ -68,7 +74,7 @@ class Trace:
     infeasible: int = 0  # commands with a pressure below 0 or above the maximum
     saturated: int = 0  # steps whose command the resolver clamped
 
-    def final(self, window: int = 20) -> tuple[float, float]:
+    def final(self, window: int = FINAL_WINDOW) -> tuple[float, float]:
         """Mean true errors over the last ``window`` samples."""
         return (
             float(np.mean(self.position_error[-window:])),

@@ -11,15 +11,20 @@ from typing import Any
 import numpy as np
 
 from softarm._core import Gains, Resolver
-from softarm.experiments.common import closed_loop, declared_gains, start_configuration
-from softarm.experiments.output import (
-    mean_std,
-    plot_comparison,
-    plot_final_errors,
-    write_csv,
-    write_json,
-)
-from softarm.sim.arm import SimulatedArm
+from softarm.experiments.common import Trace, start_configuration
+from softarm.experiments.output import mean_std, plot_final_errors, write_csv, write_json
+from softarm.experiments.runner import most_infeasible, plot_pair, run_pairs, start
+
+HEADER = [
+    "target",
+    "angle_x_deg",
+    "proposed_deg",
+    "conventional_deg",
+    "proposed_infeasible",
+    "conventional_infeasible",
+    "proposed_first_below_0.57deg_s",
+    "conventional_first_below_0.57deg_s",
+]
 
 
 def rot_x(angle: float, home: np.ndarray) -> np.ndarray:
@@ -34,62 +39,43 @@ def rot_x(angle: float, home: np.ndarray) -> np.ndarray:
     return t
 
 
+def first_below(trace: Trace, angle: float) -> float:
+    """The first time (s) the orientation error is below ``angle`` (rad); inf if never.
+    (The paper's 0.57°: a hundredth of a radian.)"""
+    return next(
+        (t for t, e in zip(trace.time, trace.orientation_error, strict=True) if e < angle),
+        math.inf,
+    )
+
+
 def run(
     out: Path, seed: int = 0, quick: bool = False, gains: Gains | None = None
 ) -> dict[str, Any]:
     """Runs the experiment, writes ``orientation.{csv,json,png}``; returns the summary."""
-    out.mkdir(parents=True, exist_ok=True)
-    plant = SimulatedArm(seed=seed)
-    rng = np.random.default_rng(seed + 2)
+    s = start(out, seed, 2, gains)
     count, duration = (5, 20.0) if quick else (15, 30.0)
-    gains = gains if gains is not None else declared_gains(plant)
-    proposed = Resolver(plant.model, "orientation", gains)
-    conventional = Resolver(plant.model, "orientation", gains.replace(orientation_gamma=0.0))
-    home = plant.true_arm.forward(np.zeros(plant.n))
+    proposed = Resolver(s.plant.model, "orientation", s.gains)
+    conventional = Resolver(s.plant.model, "orientation", s.gains.replace(orientation_gamma=0.0))
+    home = s.plant.true_arm.forward(np.zeros(s.plant.n))
+    angles = np.linspace(0.0, -150.0, count)
+    cases = [
+        (rot_x(math.radians(deg), home), start_configuration(s.rng, s.plant.n)) for deg in angles
+    ]
+    pairs = run_pairs(s.plant, proposed, conventional, cases, duration)
     rows = []
-    finals: dict[str, list[float]] = {"proposed": [], "conventional": []}
-    example = None
-    for i, deg in enumerate(np.linspace(0.0, -150.0, count)):
-        target = rot_x(math.radians(deg), home)
-        q0 = start_configuration(rng, plant.n)
-        a = closed_loop(proposed, plant, target, q0, duration)
-        b = closed_loop(conventional, plant, target, q0, duration, constrained=False)
+    for i, (deg, pair) in enumerate(zip(angles, pairs, strict=True)):
+        a, b = pair.proposed, pair.conventional
+        settle = [first_below(tr, math.radians(0.57)) for tr in (a, b)]
         ea, eb = math.degrees(a.final()[1]), math.degrees(b.final()[1])
-        finals["proposed"].append(ea)
-        finals["conventional"].append(eb)
-        settle = [
-            next(
-                (
-                    t
-                    for t, e in zip(tr.time, tr.orientation_error, strict=True)
-                    if e < math.radians(0.57)
-                ),
-                math.inf,
-            )
-            for tr in (a, b)
-        ]
         rows.append([i, round(float(deg), 2), ea, eb, a.infeasible, b.infeasible, *settle])
-        if example is None or b.infeasible > example[2].infeasible:
-            example = (i, a, b)
-    write_csv(
-        out / "orientation.csv",
-        [
-            "target",
-            "angle_x_deg",
-            "proposed_deg",
-            "conventional_deg",
-            "proposed_infeasible",
-            "conventional_infeasible",
-            "proposed_first_below_0.57deg_s",
-            "conventional_first_below_0.57deg_s",
-        ],
-        rows,
-    )
+    finals = {"proposed": [r[2] for r in rows], "conventional": [r[3] for r in rows]}
+    write_csv(out / "orientation.csv", HEADER, rows)
+    example = most_infeasible(pairs)
     if example is not None:
-        plot_comparison(
+        plot_pair(
             out / "orientation.png",
-            f"IV-C orientation control, target {example[0]} (cf. Fig. 8)",
-            {"proposed (eq. 13)": example[1], "conventional (eq. 7)": example[2]},
+            f"IV-C orientation control, target {example} (cf. Fig. 8)",
+            pairs[example],
             orientation=True,
         )
     plot_final_errors(

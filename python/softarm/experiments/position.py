@@ -10,20 +10,22 @@ from typing import Any
 import numpy as np
 
 from softarm._core import Gains, Resolver
-from softarm.experiments.common import (
-    bush_pressures,
-    closed_loop,
-    declared_gains,
-    start_configuration,
-)
-from softarm.experiments.output import (
-    mean_std,
-    plot_comparison,
-    plot_final_errors,
-    write_csv,
-    write_json,
-)
-from softarm.sim.arm import SimulatedArm
+from softarm.experiments.common import CONTROL_PERIOD
+from softarm.experiments.output import mean_std, plot_final_errors, write_csv, write_json
+from softarm.experiments.runner import bush_cases, most_infeasible, plot_pair, run_pairs, start
+
+HEADER = [
+    "target",
+    "x",
+    "y",
+    "z",
+    "proposed_mm",
+    "conventional_mm",
+    "proposed_infeasible",
+    "conventional_infeasible",
+    "proposed_settle_1mm_s",
+    "conventional_settle_1mm_s",
+]
 
 
 def run(
@@ -31,61 +33,37 @@ def run(
 ) -> dict[str, Any]:
     """Runs the experiment, writes ``position.{csv,json,png}`` into ``out``; returns the
     summary."""
-    out.mkdir(parents=True, exist_ok=True)
-    plant = SimulatedArm(seed=seed)
-    rng = np.random.default_rng(seed + 1)
+    s = start(out, seed, 1, gains)
     count, duration = (8, 20.0) if quick else (35, 30.0)
-    gains = gains if gains is not None else declared_gains(plant)
-    proposed = Resolver(plant.model, "position", gains)
-    conventional = Resolver(plant.model, "conventional", gains)
+    proposed = Resolver(s.plant.model, "position", s.gains)
+    conventional = Resolver(s.plant.model, "conventional", s.gains)
+    cases = [
+        (s.plant.pose_at_pressure(p)[:3, 3], q0) for p, q0 in bush_cases(s.plant, s.rng, count)
+    ]
+    pairs = run_pairs(s.plant, proposed, conventional, cases, duration)
     rows = []
-    finals: dict[str, list[float]] = {"proposed": [], "conventional": []}
-    infeasible = 0
-    example = None
-    for i, p in enumerate(bush_pressures(plant, rng, count)):
-        target = plant.pose_at_pressure(p)[:3, 3]
-        q0 = start_configuration(rng, plant.n)
-        a = closed_loop(proposed, plant, target, q0, duration)
-        b = closed_loop(conventional, plant, target, q0, duration, constrained=False)
-        ea, eb = a.final()[0], b.final()[0]
-        finals["proposed"].append(ea * 1e3)
-        finals["conventional"].append(eb * 1e3)
-        infeasible += b.infeasible
+    for i, ((target, _), pair) in enumerate(zip(cases, pairs, strict=True)):
+        a, b = pair.proposed, pair.conventional
         rows.append(
             [
                 i,
                 *np.round(target, 5),
-                ea * 1e3,
-                eb * 1e3,
+                a.final()[0] * 1e3,
+                b.final()[0] * 1e3,
                 a.infeasible,
                 b.infeasible,
                 a.settle_time(1e-3),
                 b.settle_time(1e-3),
             ]
         )
-        if example is None or b.infeasible > example[2].infeasible:
-            example = (i, a, b)
-    write_csv(
-        out / "position.csv",
-        [
-            "target",
-            "x",
-            "y",
-            "z",
-            "proposed_mm",
-            "conventional_mm",
-            "proposed_infeasible",
-            "conventional_infeasible",
-            "proposed_settle_1mm_s",
-            "conventional_settle_1mm_s",
-        ],
-        rows,
-    )
+    finals = {"proposed": [r[4] for r in rows], "conventional": [r[5] for r in rows]}
+    write_csv(out / "position.csv", HEADER, rows)
+    example = most_infeasible(pairs)
     if example is not None:
-        plot_comparison(
+        plot_pair(
             out / "position.png",
-            f"IV-B position control, set-point {example[0]} (cf. Fig. 7)",
-            {"proposed (eq. 13)": example[1], "conventional (eq. 7)": example[2]},
+            f"IV-B position control, set-point {example} (cf. Fig. 7)",
+            pairs[example],
         )
     plot_final_errors(
         out / "position_final.png",
@@ -100,8 +78,8 @@ def run(
         "duration_s": duration,
         "proposed_mm": mean_std(finals["proposed"]),
         "conventional_mm": mean_std(finals["conventional"]),
-        "conventional_infeasible_commands": infeasible,
-        "conventional_steps": count * round(duration / 0.05),
+        "conventional_infeasible_commands": int(sum(r[7] for r in rows)),
+        "conventional_steps": count * round(duration / CONTROL_PERIOD),
         "proposed_infeasible_commands": int(sum(r[6] for r in rows)),
         "conventional_set_points_with_infeasible": int(sum(1 for r in rows if r[7] > 0)),
         "paper_mm": {"mean": 0.84, "std": 0.38},
