@@ -34,12 +34,12 @@ def main(argv: list[str] | None = None) -> int:
     berry = rig.bush.berries[0]
     result = rig.machine.run_berry(BerryTarget(berry.tag_id), grasp=False)
     print(f"berry tag {berry.tag_id} at {np.round(berry.position, 3)} m: {result.final_state}")
-    steps = [r for r in rig.machine.log.records if r["kind"] == "step" and r["position_error"]]
+    steps = [r for r in rig.machine.log.records if r["kind"] == "step" and r["position_error_m"]]
     for r in steps[:: max(1, len(steps) // 15)] + steps[-1:]:
         print(
             f"  t = {r['t']:5.2f} s  {r['state']:<17} {r['camera']:<12} "
-            f"error {1e3 * r['position_error']:7.2f} mm  pointing "
-            f"{np.degrees(r['orientation_error']):5.2f} deg"
+            f"error {1e3 * r['position_error_m']:7.2f} mm  pointing "
+            f"{np.degrees(r['orientation_error_rad']):5.2f} deg"
         )
     print(
         f"final: measured {result.position_error_mm:.2f} mm, "

@@ -44,6 +44,29 @@ def test_help_has_no_rest_markup_and_says_each_default_once() -> None:
             assert len(re.findall(r"\(default\b", line, re.IGNORECASE)) <= 1, (prog, line)
 
 
+@pytest.mark.parametrize(
+    ("command", "default"), [("identify", "id.json"), ("calibrate", "model.toml")]
+)
+def test_identify_and_calibrate_both_default_out(
+    command: str, default: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    args = cli.build_parser().parse_args([command, "--sim"])
+    assert args.out == Path(default)
+    assert f"(default: {default})" in _parsers()[f"softarm {command}"].format_help()
+
+
+def test_a_default_out_is_checked_before_any_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "id.json").mkdir()  # the default output is a directory here
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        cli.build_parser().parse_args(["identify", "--sim"])
+    assert exc.value.code == 2
+    assert "argument --out: 'id.json' is a directory" in capsys.readouterr().err
+
+
 def test_help_that_names_its_default_gets_no_second_one() -> None:
     from softarm.commands._args import Parser
 

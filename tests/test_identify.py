@@ -131,7 +131,7 @@ def test_not_json(tmp_path: Path) -> None:
     [
         (["--sim", "--budget", "500"], "argument --budget: must be in [30, 120]"),
         (["--sim", "--seed", "-1"], "argument --seed"),
-        (["--sim"], "the following arguments are required: --out"),
+        (["--sim", "--out", "nofolder/i.json"], "argument --out: cannot write"),
         (["--config", "absent.toml"], "no such file"),
     ],
 )

@@ -8,6 +8,8 @@ import pytest
 
 from softarm.errors import InputError
 from softarm.harvest import BerryTarget, HarvestLog, read_log
+from softarm.harvest.header import UNITS
+from softarm.harvest.log import current_record
 
 from .fakes import make_rig
 
@@ -37,9 +39,25 @@ def test_step_records_hold_the_documented_fields(tmp_path) -> None:
     steps = [r for r in read_log(tmp_path / "run.jsonl") if r["kind"] == "step"]
     placing = [r for r in steps if r["state"] == "initial_placement"]
     assert placing
-    for key in ("t", "q", "pose", "target", "goal", "position_error", "camera", "saturated"):
+    keys = ("t", "q", "pose", "target", "goal", "camera", "saturated")
+    for key in (*keys, "target_age_s", "position_error_m", "orientation_error_rad"):
         assert key in placing[0]
+    assert set(UNITS["step"]) <= set(placing[0])  # the header documents every unit
     assert len(placing[0]["q"]) == 3 and len(placing[0]["pose"]) == 4
+
+
+def test_read_log_renames_the_step_fields_of_an_older_log(tmp_path) -> None:
+    old = {"kind": "step", "t": 0.5, "target_age": 0.1, "position_error": 0.002,
+           "orientation_error": 0.05, "goal": None}  # fmt: skip
+    path = tmp_path / "format1.jsonl"
+    path.write_text(json.dumps(old) + "\n" + json.dumps({"kind": "fault", "t": 0.6}) + "\n")
+    step, fault = read_log(path)
+    assert step == {"kind": "step", "t": 0.5, "target_age_s": 0.1, "position_error_m": 0.002,
+                    "orientation_error_rad": 0.05, "goal": None}  # fmt: skip
+    assert fault == {"kind": "fault", "t": 0.6}
+    assert current_record(step) is step  # a current record is left as it is
+    both = {"kind": "step", "position_error": 1.0, "position_error_m": 2.0}
+    assert current_record(both) == both  # the new name wins; nothing is overwritten
 
 
 def test_read_log_skips_only_a_truncated_last_line(tmp_path) -> None:

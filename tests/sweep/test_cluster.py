@@ -139,3 +139,25 @@ def test_tune_writes_gains_that_harvest_and_gains_load(joined: str, tmp_path: Pa
     assert gains.hybrid_alpha == outcome.gains["hybrid_alpha"]
     assert 0.05 <= gains.hybrid_alpha <= 0.6
     assert load_gains(out)["hybrid_alpha"] == gains.hybrid_alpha
+
+
+def test_tune_reports_each_trial_of_a_candidate(
+    joined: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The bar moves per trial (2 plant points here), not per candidate."""
+    pytest.importorskip("optuna")
+    import softarm.sweep.tune as tune_module
+
+    bars: list[Any] = []
+
+    def keep(*args: Any, **kwargs: Any) -> Any:
+        bars.append(real(*args, **kwargs))
+        return bars[-1]
+
+    real = tune_module._bar_callback
+    monkeypatch.setattr(tune_module, "_bar_callback", keep)
+    spec = _spec([0], tune={"samples": 2, "seed": 1})
+    out = tmp_path / "gains.toml"
+    tune_module.run_tune(spec, out, address=joined, trial_fn=fakes.quick, progress=False)
+    (bar,) = bars
+    assert bar.reports == 2 * 2 and bar.count == 2 * 2 and bar.finished == 2

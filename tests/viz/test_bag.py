@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 
 import softarm
 from softarm.cli import main
-from softarm.harvest.log import read_log
+from softarm.harvest.log import STEP_RENAMED, read_log
 from softarm.harvest.states import HarvestState
 from softarm.units import METRES_PER_PSI
 from softarm.viz.bag.convert import TOPICS
@@ -182,7 +182,8 @@ def test_log_and_report_open_with_the_header(run: dict[str, Path]) -> None:
     assert header["seed"] == 3 and header["options"]["berries"] == 2
     assert len(header["world"]["berries"]) == 2 and header["world"]["canes"]
     assert header["plant"]["model"] == "pcc" and len(header["arm"]["sections"]) == 3
-    assert header["units"]["step"]["position_error"] == "m"
+    assert header["units"]["step"]["position_error_m"] == "m"
+    assert header["units"]["step"]["orientation_error_rad"] == "rad"
     report = json.loads(run["report"].read_text())
     assert next(iter(report)) == "header" and report["header"] == header
 
@@ -208,6 +209,42 @@ def test_a_log_without_a_header_gets_the_defaults(run: dict[str, Path], tmp_path
     assert set(topics) == set(TOPICS) and topics["/tf_static"][0][0] == 0
     canes = [m for m in topics["/harvest/markers"][0][1].markers if m.ns == "canes"]
     assert canes == []
+
+
+def test_a_log_from_before_the_unit_names_gives_the_same_bag(
+    run: dict[str, Path], tmp_path: Path
+) -> None:
+    """A format-1 log (a step's ``position_error`` etc. without their units) replays as
+    the current log does: read_log renames the fields."""
+    renamed = {new: old for old, new in STEP_RENAMED.items()}
+    lines = []
+    for line in run["log"].read_text().splitlines():
+        r = json.loads(line)
+        if r["kind"] == "header":
+            r["format"] = 1
+            r["units"]["step"] = {renamed.get(k, k): v for k, v in r["units"]["step"].items()}
+        elif r["kind"] == "step":
+            r = {renamed.get(k, k): v for k, v in r.items()}
+        lines.append(json.dumps(r) + "\n")
+    old = tmp_path / "format1.jsonl"
+    old.write_text("".join(lines))
+    assert '"position_error":' in old.read_text() and '"position_error_m"' not in old.read_text()
+    out = tmp_path / "format1.mcap"
+    assert main(["replay", str(old), "--bag", str(out)]) == 0
+    assert _raw(out) == _raw(run["bag"])
+
+
+def test_a_header_of_an_unknown_format_is_refused(
+    run: dict[str, Path], tmp_path: Path, capsys
+) -> None:
+    lines = run["log"].read_text().splitlines(keepends=True)
+    header = json.loads(lines[0])
+    header["format"] = 3
+    log = tmp_path / "future.jsonl"
+    log.write_text(json.dumps(header) + "\n" + "".join(lines[1:]))
+    assert main(["replay", str(log), "--bag", str(tmp_path / "f.mcap")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "header format must be 1 or 2, got 3" in err and "\n" not in err
 
 
 def test_a_bad_record_names_the_file_and_the_record(tmp_path: Path, capsys) -> None:

@@ -71,9 +71,11 @@ def test_replay_of_the_run_log(harvest_run, tmp_path, capsys) -> None:
     rows = read_rrd(out)
     steps = [r for r in read_log(log) if r["kind"] == "step"]
     assert len(rows["/world/arm/model/backbone"]) == len(steps)
-    measured = [r for r in steps if r["position_error"] is not None]
+    measured = [r for r in steps if r["position_error_m"] is not None]
     errors = column(rows, "/errors/position_mm", SCALARS)
-    assert [e[0] for _, e in errors] == pytest.approx([1e3 * r["position_error"] for r in measured])
+    assert [e[0] for _, e in errors] == pytest.approx(
+        [1e3 * r["position_error_m"] for r in measured]
+    )
     (berries,) = rows["/world/berries"]
     assert berries["Points3D:labels"] == ["tag 10"]
 
@@ -87,8 +89,9 @@ def test_replay_of_a_synthetic_log(tmp_path) -> None:
     _write(log, [
         {"kind": "transition", "t": 0.0, "berry": 12, "old": "idle", "new": "idle", "why": "new"},
         {"kind": "step", "t": 0.05, "state": "initial_placement", "berry": 12, "q": [0.01] * 9,
-         "pose": None, "target": [0.0, 0.3, 0.4], "camera": "eye_to_hand", "target_age": 0.0,
-         "goal": None, "position_error": 0.012, "orientation_error": 0.1, "saturated": False},
+         "pose": None, "target": [0.0, 0.3, 0.4], "camera": "eye_to_hand", "target_age_s": 0.0,
+         "goal": None, "position_error_m": 0.012, "orientation_error_rad": 0.1,
+         "saturated": False},
         {"kind": "fault", "t": 0.1, "berry": 12, "reason": "marker_lost", "detail": "lost"},
         {"kind": "berry_result", "tag_id": 12, "target": [0.0, 0.3, 0.4], "harvested": False,
          "fault": "marker_lost"},

@@ -6,7 +6,6 @@ import argparse
 import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softarm.commands._args import add_quiet, config_file, int_range, non_negative_int, output_file
@@ -17,6 +16,10 @@ if TYPE_CHECKING:
     from softarm.calibration import Calibration
 
 Progress = Callable[[int, Any], None]
+
+#: Where the fitted model is written without --out (as identify's id.json). A string, so
+#: that argparse checks it with output_file as it does a typed --out.
+OUT = "model.toml"
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -42,7 +45,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument(
         "--poses", type=int_range(22, 100), default=80, help="excitation poses (21 parameters)"
     )
-    p.add_argument("--out", type=output_file, default=Path("model.toml"), help="fitted model file")
+    p.add_argument("--out", type=output_file, default=OUT, help="the fitted model (TOML) to write")
     p.add_argument(
         "--bias",
         action="store_true",

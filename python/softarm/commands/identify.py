@@ -22,6 +22,8 @@ if TYPE_CHECKING:
     from softarm.identification import IdentifiedPlant
     from softarm.identification.record import Progress as OnProgress
 
+#: Where the identified plant is written without --out (as calibrate's model.toml).
+OUT = "id.json"
 #: The longest excitation (s of arm time) the command runs.
 MAX_BUDGET_S = 120.0
 
@@ -59,7 +61,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument(
         "--seed", type=non_negative_int, default=0, help="seed of the simulated plant (as harvest)"
     )
-    p.add_argument("--out", type=output_file, required=True, help="write id.json here")
+    # A string default goes through output_file as a typed one does: checked at parse time.
+    p.add_argument(
+        "--out", type=output_file, default=OUT, help="the identified plant (JSON) to write"
+    )
     p.add_argument(
         "--budget", type=_budget, default=MAX_BUDGET_S, help="arm time of the excitation (s)"
     )

@@ -22,18 +22,35 @@ import numpy as np
 import softarm
 from softarm.units import MAX_PSI, METRES_PER_PSI
 
-__all__ = ["FORMAT", "HEADER", "UNITS", "find_header", "git_commit", "header_record"]
+__all__ = [
+    "FORMAT",
+    "HEADER",
+    "READABLE_FORMATS",
+    "UNITS",
+    "find_header",
+    "git_commit",
+    "header_record",
+]
 
 #: The kind of the header record.
 HEADER = "header"
-#: Version of the header's layout; a reader checks it before trusting the fields.
-FORMAT = 1
+#: Version of the log's layout; a reader checks it before trusting the fields. 2: a
+#: ``step``'s scalar fields carry their unit in their name (``target_age_s``,
+#: ``position_error_m``, ``orientation_error_rad``); 1 had them bare
+#: (:data:`softarm.harvest.log.STEP_RENAMED`, which :func:`~softarm.harvest.log.read_log`
+#: applies to an older log).
+FORMAT = 2
+#: The formats a reader accepts (a format-1 log is read through ``read_log``'s renaming).
+READABLE_FORMATS = (1, 2)
 #: How long ``git rev-parse`` may take (s) before the commit is left out.
 GIT_TIMEOUT_S = 2.0
 
 #: The unit of every field, by record kind ("-" for names, flags and counts). Poses are
 #: 4x4 homogeneous matrices in the base frame, positions in metres, times on the run's
-#: clock in seconds (simulated time with --sim).
+#: clock in seconds (simulated time with --sim). The naming scheme: a scalar measurement
+#: carries its unit as a suffix (``position_error_m``, ``duration_s``, ``*_mm``); the run
+#: clock ``t`` (s) and the vectors and poses (``q``, ``pose``, ``target``, ``goal``, in m)
+#: keep bare names, their units listed here.
 UNITS: dict[str, dict[str, str]] = {
     HEADER: {
         "started_unix_ns": "ns since 1970-01-01 UTC",
@@ -52,10 +69,10 @@ UNITS: dict[str, dict[str, str]] = {
         "q": "m (actuator elongations commanded)",
         "pose": "4x4 pose of the end effector measured by the cameras (m)",
         "target": "m (berry position estimate)",
-        "target_age": "s",
+        "target_age_s": "s",
         "goal": "m",
-        "position_error": "m",
-        "orientation_error": "rad",
+        "position_error_m": "m",
+        "orientation_error_rad": "rad",
     },
     "transition": {"t": "s"},
     "fault": {"t": "s"},

@@ -25,13 +25,20 @@ import numpy as np
 from softarm.errors import ConfigError, InputError
 from softarm.files import check_document, check_target, open_regular, output_error
 
-__all__ = ["CUT_MARK", "HarvestLog", "read_log"]
+__all__ = ["CUT_MARK", "STEP_RENAMED", "HarvestLog", "current_record", "read_log"]
 
 #: The kind of the record an appending run writes after a cut-off last line.
 CUT_MARK = "previous_line_cut"
 #: Longest line :func:`read_log` reads (1 MiB; a step record is a few hundred bytes): a
 #: file without newlines must not be read whole into memory.
 MAX_LINE_BYTES = 2**20
+#: A ``step``'s fields renamed when they took their unit in their name (header format 2):
+#: the old name -> the new. :func:`read_log` renames them in an older log.
+STEP_RENAMED = {
+    "target_age": "target_age_s",
+    "position_error": "position_error_m",
+    "orientation_error": "orientation_error_rad",
+}
 
 
 #: Significant digits of the floats in logs and reports: 10 nm on an elongation of a few
@@ -154,8 +161,23 @@ def _lines(path: str | Path) -> Iterator[tuple[int, bytes]]:
             yield number, line
 
 
+def current_record(record: Any) -> Any:
+    """``record`` with the field names of the current layout: a ``step`` of a log
+    written before header format 2 has its fields renamed (:data:`STEP_RENAMED`), where
+    the new name is not there already. Any other record is returned as it is."""
+    if not isinstance(record, dict) or record.get("kind") != "step":
+        return record
+    if not any(old in record and new not in record for old, new in STEP_RENAMED.items()):
+        return record
+    return {
+        STEP_RENAMED[k] if k in STEP_RENAMED and STEP_RENAMED[k] not in record else k: v
+        for k, v in record.items()
+    }
+
+
 def read_log(path: str | Path) -> Iterator[dict[str, Any]]:
-    """Records of a log file, in order.
+    """Records of a log file, in order, with the current field names
+    (:func:`current_record`: an older log's ``step`` fields are renamed).
 
     A cut-off line (a crash mid-write) is skipped where it is the last line, or where the
     run appended after it marked it (:data:`CUT_MARK`). Any other malformed line is an
@@ -170,7 +192,7 @@ def read_log(path: str | Path) -> Iterator[dict[str, Any]]:
             raise pending
         pending = record if isinstance(record, InputError) else None
         if pending is None and line.strip():
-            yield record
+            yield current_record(record)
         ends_with_newline = line.endswith(b"\n")
     if pending is not None and ends_with_newline:  # complete, so not cut: corrupt
         raise pending

@@ -122,9 +122,9 @@ class BerryWatch:
             pose=seen.pose,
             target=None if fix is None else fix.position,
             camera=None if fix is None else fix.camera,
-            target_age=None if fix is None else fix.age,
+            target_age_s=None if fix is None else fix.age,
             goal=None if goal is None else goal[:3, 3],
-            position_error=None if errors is None else errors[0],
-            orientation_error=None if errors is None else errors[1],
+            position_error_m=None if errors is None else errors[0],
+            orientation_error_rad=None if errors is None else errors[1],
             saturated=saturated,
         )

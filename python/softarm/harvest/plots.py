@@ -187,7 +187,7 @@ def plot_errors(
     berry's start, in placement and fine positioning (as the cameras measured them)."""
     berries: dict[int, list[dict[str, Any]]] = {}
     for r in records:
-        if r["kind"] == "step" and r["position_error"] is not None:
+        if r["kind"] == "step" and r["position_error_m"] is not None:
             if r["state"] in ("initial_placement", "fine_positioning"):
                 berries.setdefault(r["berry"], []).append(r)
     colours = colours or berry_colours(list(berries))
@@ -198,9 +198,16 @@ def plot_errors(
             t = [s["t"] - t0 for s in part]
             label = f"tag {tag}" if stage == "fine_positioning" else None
             ax_p.semilogy(
-                t, [1e3 * s["position_error"] for s in part], style, color=colour, lw=1, label=label
+                t,
+                [1e3 * s["position_error_m"] for s in part],
+                style,
+                color=colour,
+                lw=1,
+                label=label,
             )
-            ax_o.plot(t, [np.degrees(s["orientation_error"]) for s in part], style, color=colour)
+            ax_o.plot(
+                t, [np.degrees(s["orientation_error_rad"]) for s in part], style, color=colour
+            )
     ax_p.axhline(1.0, color="k", ls=":", lw=0.8)
     ax_p.set(
         ylabel="position error (mm)",

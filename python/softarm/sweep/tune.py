@@ -22,6 +22,7 @@ import os
 import shutil
 import sys
 import tempfile
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -105,12 +106,11 @@ def run_tune(
     trial_fn: TrialFn | None = None,
 ) -> TuneOutcome:
     """Search the gains of ``spec.tune.space`` (default :data:`DEFAULT_SPACE`) on Ray Tune
-    and write the best as a ``[gains]`` file at ``out``."""
+    and write the best as a ``[gains]`` file at ``out``. The progress bar (``progress``,
+    on a terminal) counts the candidates' trials (each a (plant point, seed) harvest) as
+    they finish, so its ETA shows from the first one."""
     ray = require("ray")
     tune = require("ray.tune")
-    optuna_search = require("ray.tune.search.optuna")
-    from ray.tune.search import ConcurrencyLimiter
-
     space = spec.tune.space or DEFAULT_SPACE
     n_samples = samples if samples is not None else spec.tune.samples
     if n_samples < 1:
@@ -118,59 +118,15 @@ def run_tune(
     base = gains_from(spec.gains).as_dict()
     start_point = {k: base[k] for k in space}
     points = [start_point] if all(_inside(start_point[k], r) for k, r in space.items()) else []
-    trials_of = spec.trials()
-    expected = sum(t.berries for t in trials_of)
-    work = trial_fn or run_trial_rows
-
-    def objective(config: dict[str, Any]) -> None:
-        # One candidate: every plant point and seed, in this worker, one after another.
-        rows: list[dict[str, Any]] = []
-        for t in spec.with_gains(config).trials():
-            rows += work(t)
-        tune.report(score_rows(rows, expected))
-
-    # Tune's own console tables and Optuna's per-trial log lines: the bar says enough.
-    os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
-    # Ctrl-C stops the search: Ray Tune's own SIGINT handler would instead end it quietly
-    # and return the candidates so far (a gains file from a cut search, or exit 2 with
-    # none); KeyboardInterrupt reaches the command line, which exits 130, no gains written.
-    os.environ.setdefault("TUNE_DISABLE_SIGINT_HANDLER", "1")
-    require("optuna").logging.set_verbosity(require("optuna").logging.WARNING)
+    objective = _objective(tune, spec, trial_fn or run_trial_rows)
+    _quiet_tune()
     started = init_ray(address, cpus)
     storage = Path(tempfile.mkdtemp(prefix="softarm-tune-"))
     try:
-        concurrency = max(1, int(ray.cluster_resources().get("CPU", 1)))
-        searcher = optuna_search.OptunaSearch(
-            metric="score", mode="max", seed=spec.tune.seed, points_to_evaluate=points or None
-        )
-        tuner = tune.Tuner(
-            tune.with_resources(objective, {"cpu": 1}),
-            param_space={k: _domain(tune, r) for k, r in space.items()},
-            tune_config=tune.TuneConfig(
-                search_alg=ConcurrencyLimiter(searcher, max_concurrent=concurrency),
-                metric="score",
-                mode="max",
-                num_samples=n_samples,
-            ),
-            run_config=tune.RunConfig(
-                name="softarm-tune",
-                storage_path=str(storage),
-                verbose=0,
-                callbacks=[_bar_callback(tune, n_samples, progress)],
-                failure_config=tune.FailureConfig(max_failures=1),
-            ),
-        )
-        grid = tuner.fit()
-        candidates = []
-        for res in grid:
-            if res.error is None and res.metrics and "score" in res.metrics:
-                candidates.append({**res.config, **{k: res.metrics[k] for k in
-                                   ("score", "success", "cycle_s", "mean_error_mm")}})  # fmt: skip
-        if not candidates:
-            errors = [str(res.error).splitlines()[0] for res in grid if res.error is not None]
-            raise ConfigError(
-                f"tune: no candidate finished ({errors[0] if errors else 'none ran'})"
-            )
+        bar = _bar_callback(tune, n_samples, len(spec.trials()), progress)
+        search = _Search(space, n_samples, spec.tune.seed, points)
+        grid = _tuner(tune, objective, search, storage, bar).fit()
+        candidates = _candidates(grid)
     finally:
         shutil.rmtree(storage, ignore_errors=True)
         if started:
@@ -178,11 +134,95 @@ def run_tune(
     candidates.sort(key=lambda c: c["score"], reverse=True)
     best = candidates[0]
     gains = {**spec.gains, **{k: best[k] for k in space}}
-    metrics = {k: best[k] for k in ("score", "success", "cycle_s", "mean_error_mm")}
+    metrics = {k: best[k] for k in METRICS}
     baseline = next((c for c in candidates if all(c[k] == start_point[k] for k in space)), None)
-    header = _header(spec, n_samples, metrics, baseline)
-    write_gains(out, gains_from(gains), header)
+    write_gains(out, gains_from(gains), _header(spec, n_samples, metrics, baseline))
     return TuneOutcome(gains, metrics, baseline, candidates)
+
+
+#: A candidate's metrics kept in the outcome (score_rows' less the failed trials).
+METRICS = ("score", "success", "cycle_s", "mean_error_mm")
+#: The field of a candidate's report that counts its trials done (the progress bar's).
+TRIALS_DONE = "trials_done"
+
+
+def _objective(tune: Any, spec: SweepSpec, work: TrialFn) -> Callable[[dict[str, Any]], None]:
+    """One candidate: every plant point and seed, in this worker, one after another. It
+    reports after each trial (the score so far, the trials not yet run counting as lost),
+    so the driver's bar moves while it runs; the last report is the candidate's score."""
+    expected = sum(t.berries for t in spec.trials())
+
+    def objective(config: dict[str, Any]) -> None:
+        rows: list[dict[str, Any]] = []
+        for i, t in enumerate(spec.with_gains(config).trials(), start=1):
+            rows += work(t)
+            tune.report({**score_rows(rows, expected), TRIALS_DONE: i})
+
+    return objective
+
+
+def _quiet_tune() -> None:
+    """Ray Tune's and Optuna's console output off, and Ctrl-C left to the command line."""
+    # Tune's own console tables and Optuna's per-trial log lines: the bar says enough.
+    os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
+    # Ctrl-C stops the search: Ray Tune's own SIGINT handler would instead end it quietly
+    # and return the candidates so far (a gains file from a cut search, or exit 2 with
+    # none); KeyboardInterrupt reaches the command line, which exits 130, no gains written.
+    os.environ.setdefault("TUNE_DISABLE_SIGINT_HANDLER", "1")
+    optuna = require("optuna")
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+
+
+@dataclass(frozen=True)
+class _Search:
+    """What the search explores: the space, how many candidates, the sampler's seed and
+    the points tried first."""
+
+    space: dict[str, TuneRange]
+    samples: int
+    seed: int
+    points: list[dict[str, Any]]
+
+
+def _tuner(tune: Any, objective: Any, search: _Search, storage: Path, bar: Any) -> Any:
+    """The Tuner: Optuna's TPE, as many candidates at once as Ray has cores."""
+    ray = require("ray")
+    optuna_search = require("ray.tune.search.optuna")
+    from ray.tune.search import ConcurrencyLimiter
+
+    concurrency = max(1, int(ray.cluster_resources().get("CPU", 1)))
+    searcher = optuna_search.OptunaSearch(
+        metric="score", mode="max", seed=search.seed, points_to_evaluate=search.points or None
+    )
+    return tune.Tuner(
+        tune.with_resources(objective, {"cpu": 1}),
+        param_space={k: _domain(tune, r) for k, r in search.space.items()},
+        tune_config=tune.TuneConfig(
+            search_alg=ConcurrencyLimiter(searcher, max_concurrent=concurrency),
+            metric="score",
+            mode="max",
+            num_samples=search.samples,
+        ),
+        run_config=tune.RunConfig(
+            name="softarm-tune",
+            storage_path=str(storage),
+            verbose=0,
+            callbacks=[bar],
+            failure_config=tune.FailureConfig(max_failures=1),
+        ),
+    )
+
+
+def _candidates(grid: Any) -> list[dict[str, Any]]:
+    """Each finished candidate's gains and metrics (its last report: every trial run)."""
+    candidates = []
+    for res in grid:
+        if res.error is None and res.metrics and "score" in res.metrics:
+            candidates.append({**res.config, **{k: res.metrics[k] for k in METRICS}})
+    if not candidates:
+        errors = [str(res.error).splitlines()[0] for res in grid if res.error is not None]
+        raise ConfigError(f"tune: no candidate finished ({errors[0] if errors else 'none ran'})")
+    return candidates
 
 
 def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict[str, Any] | None) -> str:
@@ -201,26 +241,66 @@ def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict[str, 
     return "\n".join(lines)
 
 
-def _bar_callback(tune: Any, total: int, enabled: bool) -> Any:
+def _bar_callback(
+    tune: Any, candidates: int, per_candidate: int, enabled: bool, file: Any = None
+) -> Any:
+    """A Tune callback drawing the search's progress: one tick per trial of a candidate
+    (``candidates`` x ``per_candidate`` in all), the candidates finished and the best
+    score so far after the bar. Drawn on a terminal only (``file``: default stderr)."""
     tqdm = require("tqdm").tqdm
 
     class Bar(tune.Callback):  # type: ignore[misc]
-        """One tick per finished candidate, best score so far as the postfix."""
-
         def __init__(self) -> None:
             # disable=None: drawn on a terminal only, never into a log file.
-            self.bar = tqdm(total=total, unit="candidate", desc="tune", file=sys.stderr,
-                            disable=None if enabled else True, dynamic_ncols=True)  # fmt: skip
+            self.bar = tqdm(
+                total=candidates * per_candidate, unit=" trial", desc="tune", dynamic_ncols=True,
+                file=sys.stderr if file is None else file, disable=None if enabled else True,
+                bar_format="{desc}: {n_fmt}/{total_fmt}{unit} |{bar}| {elapsed} elapsed, "
+                "ETA {remaining}{postfix}",
+            )  # fmt: skip
             self.best = -math.inf
+            self.done: dict[str, int] = {}  # trials done, by candidate (Tune's trial id)
+            self.reports = 0  # the candidates' reports received
+            self.finished = 0  # candidates
+            self.drawn = time.monotonic()
+
+        @property
+        def count(self) -> int:
+            """Trials done over all candidates (a retried candidate's counted once)."""
+            return sum(self.done.values())
+
+        def _set(self, trial: Any, done: int) -> None:
+            before = self.count
+            self.done[trial.trial_id] = max(
+                self.done.get(trial.trial_id, 0), min(done, per_candidate)
+            )
+            self.bar.update(self.count - before)
+
+        def _finish(self, trial: Any, score: float) -> None:
+            self._set(trial, per_candidate)
+            self.finished += 1
+            self.best = max(self.best, score)
+            self.bar.set_postfix_str(
+                f"{self.finished}/{candidates} candidates, best {self.best:.4f}"
+            )
+
+        def on_trial_result(self, iteration: int, trials: Any, trial: Any, result: Any,
+                            **info: Any) -> None:  # fmt: skip
+            self.reports += 1
+            self._set(trial, int(result.get(TRIALS_DONE, 0)))
 
         def on_trial_complete(self, iteration: int, trials: Any, trial: Any, **info: Any) -> None:
-            score = (trial.last_result or {}).get("score", -math.inf)
-            self.best = max(self.best, score)
-            self.bar.update(1)
-            self.bar.set_postfix(best=f"{self.best:.4f}")
+            self._finish(trial, (trial.last_result or {}).get("score", -math.inf))
 
         def on_trial_error(self, iteration: int, trials: Any, trial: Any, **info: Any) -> None:
-            self.bar.update(1)
+            self._finish(trial, -math.inf)
+
+        def on_step_end(self, iteration: int, trials: Any, **info: Any) -> None:
+            # Tune's loop turns many times a second: redraw once a second so that the
+            # elapsed time moves while the trials run.
+            if time.monotonic() - self.drawn >= 1.0:
+                self.drawn = time.monotonic()
+                self.bar.refresh()
 
         def on_experiment_end(self, trials: Any, **info: Any) -> None:
             self.bar.close()

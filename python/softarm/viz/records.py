@@ -238,9 +238,9 @@ class RecordLogger:
             goal = as_vector(r["goal"], "goal", 3)
             log("world/goal", rr.Points3D([goal], radii=0.004, colors=[(250, 200, 0)]))
         for field, name, scale in (
-            ("position_error", "position_mm", 1e3),
-            ("orientation_error", "pointing_deg", 180.0 / np.pi),
-            ("target_age", "target_age_s", 1.0),
+            ("position_error_m", "position_mm", 1e3),
+            ("orientation_error_rad", "pointing_deg", 180.0 / np.pi),
+            ("target_age_s", "target_age_s", 1.0),
         ):
             value = r.get(field)
             if value is not None:

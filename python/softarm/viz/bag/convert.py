@@ -181,9 +181,9 @@ class Converter:
             for key, name, scale in (
                 ("berry", "berry", None),
                 ("camera", "camera", None),
-                ("position_error_mm", "position_error", 1e3),
-                ("orientation_error_deg", "orientation_error", 180.0 / math.pi),
-                ("target_age_s", "target_age", 1.0),
+                ("position_error_mm", "position_error_m", 1e3),
+                ("orientation_error_deg", "orientation_error_rad", 180.0 / math.pi),
+                ("target_age_s", "target_age_s", 1.0),
                 ("saturated", "saturated", None),
             )
         ]

@@ -14,7 +14,7 @@ import numpy as np
 import softarm
 from softarm.checks import FloatArray
 from softarm.errors import InputError
-from softarm.harvest.header import FORMAT
+from softarm.harvest.header import READABLE_FORMATS
 from softarm.sim.bush import Branch
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.viz.records import as_pose, as_vector
@@ -63,8 +63,10 @@ class RunScene:
         """The scene a header record describes (None: the defaults of an older log)."""
         if header is None:
             return cls._defaults()
-        if header.get("format") != FORMAT:
-            raise InputError(f"header format must be {FORMAT}, got {header.get('format')!r}")
+        fmt = header.get("format")
+        if isinstance(fmt, bool) or fmt not in READABLE_FORMATS:
+            formats = " or ".join(map(str, READABLE_FORMATS))
+            raise InputError(f"header format must be {formats}, got {fmt!r}")
         world = header.get("world") or {}
         if not isinstance(world, Mapping):
             raise InputError(f"header world must be an object, got {world!r:.60}")
