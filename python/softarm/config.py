@@ -171,7 +171,7 @@ class SerialConfig:
 class PlantModelConfig:
     """The plant ``softarm identify`` measured (``[plant_model]``): either ``file``, an
     ``id.json`` path relative to the config file, or the per-channel lists inline (the
-    keys of ``id.json``; see :mod:`softarm.identification.result`)."""
+    keys of ``id.json``; see :mod:`softarm.identified_plant`)."""
 
     file: str | None = None
     tau_s: tuple[float, ...] | None = None
@@ -363,105 +363,131 @@ def _camera(t: _Table, default_source: int) -> CameraConfig:
 
 
 def _build(root: _Table) -> Config:
-    arm_t = root.table("arm", required=True)
-    raw = arm_t.get("sections")
-    if not isinstance(raw, list) or not raw or not all(isinstance(s, dict) for s in raw):
-        raise arm_t.error("sections", "must be a non-empty array of tables")
-    key = arm_t.key("sections")
-    arm = ArmConfig(
-        tuple(_section(_Table(s, f"{key}[{i}]", root.source)) for i, s in enumerate(raw))
-    )
-    arm_t.done()
-
+    """The whole configuration, one table after the other in a fixed order (the first
+    bad key in that order is the one reported); the channels are checked against the
+    arm's elongation ranges, so they come after it."""
+    arm = _arm(root.table("arm", required=True))
     gains = GainsConfig(_gains(root.table("gains")))
-
-    cal_t = root.table("calibration")
-    c1_t, c2_t = cal_t.table("c1"), cal_t.table("c2")
-    d0 = CalibrationConfig()
-    calibration = CalibrationConfig(
-        _camera(c1_t, 0),
-        _camera(c2_t, 1),
-        _pose(cal_t, "T_C1_base"),
-        _pose(cal_t, "T_C2_EE"),
-        _pose(cal_t, "T_EE_cube") or d0.T_EE_cube,
-        cal_t.number("berry_tag", d0.berry_tag, positive=True),
-    )
-    cal_t.done()
-
-    ch = root.table("channels")
-    d = ChannelsConfig()
-    names = ch.get("names", list(d.names))
-    if not isinstance(names, list) or not all(isinstance(n, str) and n for n in names):
-        raise ch.error("names", "must be an array of channel-name strings")
-    if len(names) != 3 * len(arm.sections):
-        raise ch.error("names", f"must name {3 * len(arm.sections)} channels (3 per section)")
-    if len(set(names)) != len(names):
-        raise ch.error("names", "must not repeat a channel")
-    vr = _matrix(ch, "voltage_range", 2) or d.voltage_range
-    if len(vr) != 2 or not vr[0] < vr[1]:
-        raise ch.error("voltage_range", "must be [v_min, v_max] with v_min < v_max")
-    channels = ChannelsConfig(
-        names=tuple(names),
-        voltage_range=(vr[0], vr[1]),
-        full_scale_psi=ch.within(
-            "full_scale_psi",
-            ch.number("full_scale_psi", d.full_scale_psi, positive=True),
-            FULL_SCALE_PSI,
-        ),
-        p_max=ch.number("p_max", d.p_max, positive=True),
-        max_rate_psi_per_s=ch.within(
-            "max_rate_psi_per_s",
-            ch.number("max_rate_psi_per_s", d.max_rate_psi_per_s, positive=True),
-            MAX_RATE_PSI_PER_S,
-        ),
-        watchdog_timeout_s=ch.within(
-            "watchdog_timeout_s",
-            ch.number("watchdog_timeout_s", d.watchdog_timeout_s, positive=True),
-            WATCHDOG_TIMEOUT_S,
-        ),
-        metres_per_psi=ch.number("metres_per_psi", d.metres_per_psi, positive=True),
-    )
-    if channels.p_max > channels.full_scale_psi:
-        raise ch.error("p_max", f"must not exceed full_scale_psi = {channels.full_scale_psi!r}")
-    reach = channels.p_max * channels.metres_per_psi
-    for i, s in enumerate(arm.sections):
-        if s.upper > reach * (1.0 + 1e-9) or s.lower < 0.0:
-            raise ConfigError(
-                f"{root.source}: arm.sections[{i}] elongation range [{s.lower!r}, {s.upper!r}]"
-                f" m is outside what channels.p_max = {channels.p_max!r} psi can produce "
-                f"([0, {reach!r}] m at {channels.metres_per_psi!r} m/psi)"
-            )
-    ch.done()
-
-    se = root.table("serial")
-    d2 = SerialConfig()
-    port = se.get("port", d2.port)
-    if not isinstance(port, str) or not port:
-        raise se.error("port", "must be a non-empty string")
-    baud, retries = se.get("baud", d2.baud), se.get("retries", d2.retries)
-    if isinstance(baud, bool) or not isinstance(baud, int) or baud <= 0:
-        raise se.error("baud", "must be a positive integer")
-    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
-        raise se.error("retries", "must be a non-negative integer")
-    serial = SerialConfig(
-        port,
-        se.within("baud", baud, BAUD),
-        se.within(
-            "timeout_s", se.number("timeout_s", d2.timeout_s, positive=True), SERIAL_TIMEOUT_S
-        ),
-        se.within("retries", retries, RETRIES),
-        se.within(
-            "startup_delay_s",
-            se.number("startup_delay_s", d2.startup_delay_s, lo=0.0),
-            STARTUP_DELAY_S,
-        ),
-    )
-    se.done()
+    calibration = _calibration(root.table("calibration"))
+    channels = _channels(root.table("channels"), arm)
+    serial = _serial(root.table("serial"))
     plant_model = _plant_model(root.table("plant_model"), len(channels.names))
     harvest = _harvest(root.table("harvest"))
     perception = parse_perception(root.table("perception"))
     root.done()
     return Config(arm, gains, calibration, channels, serial, plant_model, harvest, perception)
+
+
+def _arm(t: _Table) -> ArmConfig:
+    """``[arm]``: its ``sections``, a non-empty array of tables, each named by its index
+    in the errors (``arm.sections[1].radius``)."""
+    raw = t.get("sections")
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, dict) for s in raw):
+        raise t.error("sections", "must be a non-empty array of tables")
+    key = t.key("sections")
+    arm = ArmConfig(tuple(_section(_Table(s, f"{key}[{i}]", t.source)) for i, s in enumerate(raw)))
+    t.done()
+    return arm
+
+
+def _calibration(t: _Table) -> CalibrationConfig:
+    """``[calibration]``: the two cameras, the hand-eye poses, the cube mount and the
+    berry tag's size; a key not given keeps the default of :class:`CalibrationConfig`."""
+    c1_t, c2_t = t.table("c1"), t.table("c2")
+    d = CalibrationConfig()
+    calibration = CalibrationConfig(
+        _camera(c1_t, 0),
+        _camera(c2_t, 1),
+        _pose(t, "T_C1_base"),
+        _pose(t, "T_C2_EE"),
+        _pose(t, "T_EE_cube") or d.T_EE_cube,
+        t.number("berry_tag", d.berry_tag, positive=True),
+    )
+    t.done()
+    return calibration
+
+
+def _channel_names(t: _Table, d: ChannelsConfig, arm: ArmConfig) -> tuple[str, ...]:
+    """``channels.names``: distinct strings, three per section of ``arm``."""
+    names = t.get("names", list(d.names))
+    if not isinstance(names, list) or not all(isinstance(n, str) and n for n in names):
+        raise t.error("names", "must be an array of channel-name strings")
+    if len(names) != 3 * len(arm.sections):
+        raise t.error("names", f"must name {3 * len(arm.sections)} channels (3 per section)")
+    if len(set(names)) != len(names):
+        raise t.error("names", "must not repeat a channel")
+    return tuple(names)
+
+
+def _channels(t: _Table, arm: ArmConfig) -> ChannelsConfig:
+    """``[channels]``: the analog outputs and the pressure map, each safety setting inside
+    the range the drivers accept (``softarm.hardware.limits``), and every section's
+    elongation range within what ``p_max`` can produce."""
+    d = ChannelsConfig()
+    names = _channel_names(t, d, arm)
+    vr = _matrix(t, "voltage_range", 2) or d.voltage_range
+    if len(vr) != 2 or not vr[0] < vr[1]:
+        raise t.error("voltage_range", "must be [v_min, v_max] with v_min < v_max")
+    channels = ChannelsConfig(
+        names=names,
+        voltage_range=(vr[0], vr[1]),
+        full_scale_psi=t.within(
+            "full_scale_psi",
+            t.number("full_scale_psi", d.full_scale_psi, positive=True),
+            FULL_SCALE_PSI,
+        ),
+        p_max=t.number("p_max", d.p_max, positive=True),
+        max_rate_psi_per_s=t.within(
+            "max_rate_psi_per_s",
+            t.number("max_rate_psi_per_s", d.max_rate_psi_per_s, positive=True),
+            MAX_RATE_PSI_PER_S,
+        ),
+        watchdog_timeout_s=t.within(
+            "watchdog_timeout_s",
+            t.number("watchdog_timeout_s", d.watchdog_timeout_s, positive=True),
+            WATCHDOG_TIMEOUT_S,
+        ),
+        metres_per_psi=t.number("metres_per_psi", d.metres_per_psi, positive=True),
+    )
+    if channels.p_max > channels.full_scale_psi:
+        raise t.error("p_max", f"must not exceed full_scale_psi = {channels.full_scale_psi!r}")
+    reach = channels.p_max * channels.metres_per_psi
+    for i, s in enumerate(arm.sections):
+        if s.upper > reach * (1.0 + 1e-9) or s.lower < 0.0:
+            raise ConfigError(
+                f"{t.source}: arm.sections[{i}] elongation range [{s.lower!r}, {s.upper!r}]"
+                f" m is outside what channels.p_max = {channels.p_max!r} psi can produce "
+                f"([0, {reach!r}] m at {channels.metres_per_psi!r} m/psi)"
+            )
+    t.done()
+    return channels
+
+
+def _serial(t: _Table) -> SerialConfig:
+    """``[serial]``: the Arduino's port and link settings, each inside the range the
+    driver accepts."""
+    d = SerialConfig()
+    port = t.get("port", d.port)
+    if not isinstance(port, str) or not port:
+        raise t.error("port", "must be a non-empty string")
+    baud, retries = t.get("baud", d.baud), t.get("retries", d.retries)
+    if isinstance(baud, bool) or not isinstance(baud, int) or baud <= 0:
+        raise t.error("baud", "must be a positive integer")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise t.error("retries", "must be a non-negative integer")
+    serial = SerialConfig(
+        port,
+        t.within("baud", baud, BAUD),
+        t.within("timeout_s", t.number("timeout_s", d.timeout_s, positive=True), SERIAL_TIMEOUT_S),
+        t.within("retries", retries, RETRIES),
+        t.within(
+            "startup_delay_s",
+            t.number("startup_delay_s", d.startup_delay_s, lo=0.0),
+            STARTUP_DELAY_S,
+        ),
+    )
+    t.done()
+    return serial
 
 
 def _harvest(t: _Table) -> HarvestConfig:
