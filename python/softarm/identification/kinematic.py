@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -144,6 +145,109 @@ def pose_residual(pred: F64, measured: F64) -> F64:
     return np.concatenate([dp, da], axis=1).ravel()
 
 
+def _fitted_samples(rec: Recording) -> npt.NDArray[np.intp]:
+    """The samples that enter the fit: the last ``WINDOW`` of every hold marked ``fit``
+    (the arm has settled there), less those where the tracker lost the arm."""
+    idx = np.array(
+        [k for h in rec.holds if h.fit for k in range(max(h.start, h.end - WINDOW), h.end)]
+    )
+    valid = np.isfinite(rec.pose[idx]).all(axis=(1, 2))
+    result: npt.NDArray[np.intp] = idx[valid]
+    return result
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """The least-squares problem of one recording. The unknowns ``x`` are, in order, the
+    geometry's log-scales and twists (``n_geom``, 0 when the geometry is not fitted), the
+    log gains (``n``) and the band widths (``n``)."""
+
+    nominal: SoftArm
+    pressure: F64  # (upto + 1, n): the state before the first sample, then every sample
+    idx: npt.NDArray[np.intp]  # the samples fitted
+    measured: F64  # their tracked poses
+    m0: float  # the recording's nominal elongation per psi
+    n: int  # channels
+    n_geom: int
+    keep: float  # the tracker filter's gain per period
+
+    @classmethod
+    def of(cls, rec: Recording, nominal: SoftArm, fit_geometry: bool) -> _Problem:
+        """The problem of ``rec``'s fitted samples. Every sample up to the last one fitted
+        is predicted: the tracker's filter needs the history of the predicted poses, not
+        only the fitted instants."""
+        idx = _fitted_samples(rec)
+        upto = int(idx.max()) + 1
+        return cls(
+            nominal=nominal,
+            pressure=np.vstack([rec.pressure_before[None, :], rec.pressure[:upto]]),
+            idx=idx,
+            measured=rec.pose[idx],
+            m0=rec.metres_per_psi,
+            n=rec.pressure.shape[1],
+            n_geom=4 * nominal.n_sections if fit_geometry else 0,
+            keep=filter_gain(rec),
+        )
+
+    def unpack(self, x: F64) -> tuple[F64, F64, F64]:
+        """(geometry, gains, band widths) of ``x``; the geometry is zero when not fitted.
+        Log-scales keep lengths and gains positive; the play band is |w|."""
+        n, n_geom = self.n, self.n_geom
+        geom = np.zeros(4 * self.nominal.n_sections)
+        geom[:n_geom] = x[:n_geom]
+        return geom, np.exp(x[n_geom : n_geom + n]), np.abs(x[n_geom + n :])
+
+    def residual(self, x: F64, z: F64) -> F64:
+        """The tracker's errors (:func:`pose_residual`) of the poses ``x`` predicts with
+        the play states ``z`` held fixed."""
+        geom, gain, w = self.unpack(x)
+        q = self.m0 * gain * (self.pressure + 0.5 * z * w)
+        predicted: F64 = tracked(_arm(self.nominal, geom), q, self.keep)[self.idx]
+        return pose_residual(predicted, self.measured)
+
+
+def _solve(problem: _Problem, x: F64, scale: F64, max_rounds: int) -> tuple[Any, F64]:
+    """Solves ``problem`` from ``x`` (updated in place); returns the last solution and the
+    play states it was solved with.
+
+    The gains and bands are solved first with the nominal geometry, which keeps the first
+    geometry steps out of far-away minima when the plant is far from nominal; then
+    everything. In each stage the play states are replayed with the current widths and
+    the widths solved with the states fixed, until the states stop changing."""
+    pressure = problem.pressure
+    z_prev = None
+    sol = None
+    for stage in ("gains", "all"):
+        active = np.arange(problem.n_geom, len(x)) if stage == "gains" else np.arange(len(x))
+        z_prev = None
+        for _ in range(max_rounds):
+            z = play_states(pressure, pressure[0], problem.unpack(x)[2])
+            if z_prev is not None and np.max(np.abs(z - z_prev)) < 1e-3:
+                break
+            z_prev = z
+
+            def sub(xa: F64, z: F64 = z, active: npt.NDArray[np.intp] = active) -> F64:
+                full = x.copy()
+                full[active] = xa
+                return problem.residual(full, z)
+
+            sol = least_squares(sub, x[active], method="lm", x_scale=scale[active])
+            x[active] = sol.x
+        if problem.n_geom == 0:
+            break
+    assert sol is not None and z_prev is not None
+    return sol, z_prev
+
+
+def _standard_errors(sol: Any, n_params: int) -> F64:
+    """Standard errors from the Gauss-Newton covariance, scaled by the residual variance."""
+    jac = sol.jac
+    dof = max(1, len(sol.fun) - n_params)
+    cov = np.linalg.pinv(jac.T @ jac) * (2.0 * sol.cost / dof)
+    result: F64 = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return result
+
+
 def fit_kinematics(
     rec: Recording,
     nominal: SoftArm,
@@ -153,71 +257,15 @@ def fit_kinematics(
     max_rounds: int = 4,
 ) -> KinematicFit:
     """Fit gains, band widths and (``fit_geometry``) the geometry to ``rec``'s holds."""
-    n = rec.pressure.shape[1]
-    idx = np.array(
-        [k for h in rec.holds if h.fit for k in range(max(h.start, h.end - WINDOW), h.end)]
-    )
-    valid = np.isfinite(rec.pose[idx]).all(axis=(1, 2))
-    idx = idx[valid]
-    measured = rec.pose[idx]
-    # Predict every sample up to the last one fitted: the tracker's filter needs the
-    # history of the predicted poses, not only the fitted instants.
-    upto = int(idx.max()) + 1
-    pressure = np.vstack([rec.pressure_before[None, :], rec.pressure[:upto]])
-    m0 = rec.metres_per_psi
-    n_geom = 4 * nominal.n_sections if fit_geometry else 0
-    width = np.full(n, width0)
-    keep = filter_gain(rec)
-
-    def unpack(x: F64) -> tuple[F64, F64, F64]:
-        geom = np.zeros(4 * nominal.n_sections)
-        geom[:n_geom] = x[:n_geom]
-        # Log-scales keep lengths and gains positive; the play band is |w|.
-        return geom, np.exp(x[n_geom : n_geom + n]), np.abs(x[n_geom + n :])
-
-    def predict(x: F64, z: F64) -> F64:
-        geom, gain, w = unpack(x)
-        q = m0 * gain * (pressure + 0.5 * z * w)
-        result: F64 = tracked(_arm(nominal, geom), q, keep)[idx]
-        return result
-
-    def residual(x: F64, z: F64) -> F64:
-        return pose_residual(predict(x, z), measured)
-
-    x = np.concatenate([np.zeros(n_geom), np.zeros(n), width])
-    # Typical sizes (a few % of geometry and gain, a psi of band) set the trust region;
-    # the gains and bands are solved first with the nominal geometry, which keeps the
-    # first geometry steps out of far-away minima when the plant is far from nominal.
+    problem = _Problem.of(rec, nominal, fit_geometry)
+    n, n_geom, m0 = problem.n, problem.n_geom, problem.m0
+    x = np.concatenate([np.zeros(n_geom), np.zeros(n), np.full(n, width0)])
+    # Typical sizes (a few % of geometry and gain, a psi of band) set the trust region.
     scale = np.concatenate([np.full(n_geom, 0.03), np.full(n, 0.03), np.full(n, 1.0)])
-    free = np.arange(n_geom, len(x))
-    z_prev = None
-    sol = None
-    for stage in ("gains", "all"):
-        active = free if stage == "gains" else np.arange(len(x))
-        z_prev = None
-        for _ in range(max_rounds):
-            z = play_states(pressure, pressure[0], unpack(x)[2])
-            if z_prev is not None and np.max(np.abs(z - z_prev)) < 1e-3:
-                break
-            z_prev = z
-
-            def sub(xa: F64, z: F64 = z, active: npt.NDArray[np.intp] = active) -> F64:
-                full = x.copy()
-                full[active] = xa
-                return residual(full, z)
-
-            sol = least_squares(sub, x[active], method="lm", x_scale=scale[active])
-            x[active] = sol.x
-        if n_geom == 0:
-            break
-    assert sol is not None and z_prev is not None
-    geom, gain, w = unpack(x)
-    # Standard errors from the Gauss-Newton covariance, scaled by the residual variance.
-    jac = sol.jac
-    dof = max(1, len(sol.fun) - len(x))
-    cov = np.linalg.pinv(jac.T @ jac) * (2.0 * sol.cost / dof)
-    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    r = residual(x, z_prev).reshape(-1, 6)
+    sol, z = _solve(problem, x, scale, max_rounds)
+    geom, gain, w = problem.unpack(x)
+    std = _standard_errors(sol, len(x))
+    r = problem.residual(x, z).reshape(-1, 6)
     rms_p = float(np.sqrt(np.mean(np.sum(r[:, :3] ** 2, axis=1)))) * SIGMA_POSITION
     rms_a = float(np.sqrt(np.mean(np.sum(r[:, 3:] ** 2, axis=1)))) * SIGMA_ANGLE
     return KinematicFit(
@@ -228,6 +276,6 @@ def fit_kinematics(
         arm=_arm(nominal, geom),
         rms_position_m=rms_p,
         rms_angle_rad=rms_a,
-        samples=len(idx),
+        samples=len(problem.idx),
         geometry_fitted=fit_geometry,
     )

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -65,6 +66,89 @@ class Recording:
         return float(self.t[-1]) if len(self.t) else 0.0
 
 
+class _Recorder:
+    """The samples of a run so far: one per control period, taken after the period."""
+
+    def __init__(self, rig: IdentificationRig) -> None:
+        self.rig = rig
+        self.rows: dict[str, list[F64]] = {k: [] for k in ("command", "sent", "pressure", "pose")}
+        self.times: list[float] = []
+        self.modified = 0
+        self.t0 = rig.now()
+
+    def elapsed(self) -> float:
+        """Arm time since the run started (s)."""
+        return self.rig.now() - self.t0
+
+    def step(self, cmd: F64) -> None:
+        """Sends ``cmd`` through the safety layer, holds it one period and samples."""
+        rig = self.rig
+        result = rig.bank.set_pressures(cmd)
+        self.modified += int(result.modified)
+        rig.advance()
+        pose = rig.pose()
+        self.times.append(rig.now() - self.t0)
+        self.rows["command"].append(np.asarray(cmd, dtype=np.float64).copy())
+        self.rows["sent"].append(result.sent)
+        self.rows["pressure"].append(np.asarray(rig.bank.read_pressures(), dtype=np.float64))
+        self.rows["pose"].append(np.full((4, 4), np.nan) if pose is None else pose)
+
+    def ramp(self, start: F64, seg: Segment) -> None:
+        """From ``start`` to the segment's target in straight steps over its duration."""
+        steps = max(1, math.ceil(seg.duration / self.rig.period))
+        for j in range(1, steps + 1):
+            self.step(start + (seg.target - start) * (j / steps))
+
+    def hold(self, seg: Segment, settle_psi: float) -> HoldWindow:
+        """Holds the segment's target for its duration, or from its minimum duration on
+        as soon as every pressure reading is within ``settle_psi`` of what was sent (the
+        regulators have arrived: waiting longer teaches nothing)."""
+        start = len(self.times)
+        k = 0
+        while True:
+            self.step(seg.target)
+            k += 1
+            held = k * self.rig.period
+            settled = np.max(np.abs(self.rows["pressure"][-1] - self.rows["sent"][-1]))
+            if held >= seg.duration - 1e-9 or (
+                held >= seg.min_duration - 1e-9 and settled <= settle_psi
+            ):
+                break
+        return HoldWindow(start, len(self.times), seg.phase, seg.channel, seg.fit)
+
+    def ramp_down(self, budget_s: float) -> None:
+        """Every channel down under the safety layer's rate limit (no whip), within the
+        budget."""
+        n = self.rig.bank.channels
+        while np.max(self.rig.bank.last_sent) > 0.0 and self.elapsed() < budget_s:
+            self.step(np.zeros(n))
+
+    def recording(self, before: tuple[Any, Any], holds: list[HoldWindow]) -> Recording:
+        """The samples as arrays, with the state ``before`` the first (pressures, sent)."""
+        rig, n = self.rig, self.rig.bank.channels
+        sent = np.array(self.rows["sent"]).reshape(-1, n)
+        return Recording(
+            period=rig.period,
+            pose_cutoff=rig.pose_cutoff,
+            metres_per_psi=rig.metres_per_psi,
+            t=np.array(self.times),
+            command=np.array(self.rows["command"]).reshape(-1, n),
+            sent=sent,
+            pressure=np.array(self.rows["pressure"]).reshape(-1, n),
+            pose=np.array(self.rows["pose"]).reshape(-1, 4, 4),
+            pressure_before=np.asarray(before[0], dtype=np.float64),
+            sent_before=np.asarray(before[1], dtype=np.float64),
+            holds=holds,
+            clamped_or_limited=self.modified,
+            max_sent_psi=float(sent.max()) if sent.size else 0.0,
+        )
+
+
+def _describe(seg: Segment) -> str:
+    """What a segment does, for the progress report."""
+    return seg.phase + (f" channel {seg.channel}" if seg.channel >= 0 else "")
+
+
 def run_experiment(
     rig: IdentificationRig,
     segments: Iterable[Segment],
@@ -74,84 +158,33 @@ def run_experiment(
 ) -> Recording:
     """Drive ``rig`` through ``segments`` within ``budget_s`` seconds of arm time.
 
+    A segment starts only if it and the stop after it fit in what is left of the budget.
+
     Raises:
         SafetyError: the safety layer stopped the arm (its vent log says why).
         HardwareError: a device failed; the arm is vented first.
     """
-    dt = rig.period
-    n = rig.bank.channels
-    rows: dict[str, list[F64]] = {k: [] for k in ("command", "sent", "pressure", "pose")}
-    times: list[float] = []
+    before = (rig.bank.read_pressures(), rig.bank.last_sent)
+    rec = _Recorder(rig)
     holds: list[HoldWindow] = []
-    rec_before = (rig.bank.read_pressures(), rig.bank.last_sent)
-    modified = 0
-    t0 = rig.now()
     # What stopping takes: the slowest channel ramped to 0 at the rate limit, plus margin.
-    p_max = rig.bank.max_pressure
-
-    def stop_time() -> float:
-        return p_max / 100.0 + 2 * dt
-
-    def step(cmd: F64) -> None:
-        nonlocal modified
-        result = rig.bank.set_pressures(cmd)
-        modified += int(result.modified)
-        rig.advance()
-        pose = rig.pose()
-        times.append(rig.now() - t0)
-        rows["command"].append(np.asarray(cmd, dtype=np.float64).copy())
-        rows["sent"].append(result.sent)
-        rows["pressure"].append(np.asarray(rig.bank.read_pressures(), dtype=np.float64))
-        rows["pose"].append(np.full((4, 4), np.nan) if pose is None else pose)
-
-    previous = np.zeros(n)
+    stop_time = rig.bank.max_pressure / 100.0 + 2 * rig.period
+    previous = np.zeros(rig.bank.channels)
     try:
         for seg in segments:
-            elapsed = rig.now() - t0
-            need = seg.duration + stop_time()
-            if elapsed + need > budget_s:
+            need = seg.duration + stop_time
+            if rec.elapsed() + need > budget_s:
                 break
             if seg.kind == "ramp":
-                steps = max(1, math.ceil(seg.duration / dt))
-                for j in range(1, steps + 1):
-                    step(previous + (seg.target - previous) * (j / steps))
+                rec.ramp(previous, seg)
             else:
-                start = len(times)
-                k = 0
-                while True:
-                    step(seg.target)
-                    k += 1
-                    held = k * dt
-                    settled = np.max(np.abs(rows["pressure"][-1] - rows["sent"][-1]))
-                    if held >= seg.duration - 1e-9 or (
-                        held >= seg.min_duration - 1e-9 and settled <= settle_psi
-                    ):
-                        break
-                holds.append(HoldWindow(start, len(times), seg.phase, seg.channel, seg.fit))
+                holds.append(rec.hold(seg, settle_psi))
             previous = np.asarray(seg.target, dtype=np.float64)
             if progress is not None:
-                what = seg.phase + (f" channel {seg.channel}" if seg.channel >= 0 else "")
-                progress(rig.now() - t0, budget_s, what)
-        # Down under the rate limit (no whip), then vent.
-        while np.max(rig.bank.last_sent) > 0.0 and rig.now() - t0 < budget_s:
-            step(np.zeros(n))
+                progress(rec.elapsed(), budget_s, _describe(seg))
+        rec.ramp_down(budget_s)
     except BaseException:  # device errors, a refused command, SIGINT/SIGTERM alike
         rig.bank.vent("identification aborted")
         raise
     rig.bank.vent("identification done")
-    sent = np.array(rows["sent"]).reshape(-1, n)
-    return Recording(
-        period=dt,
-        pose_cutoff=rig.pose_cutoff,
-        metres_per_psi=rig.metres_per_psi,
-        t=np.array(times),
-        command=np.array(rows["command"]).reshape(-1, n),
-        sent=sent,
-        pressure=np.array(rows["pressure"]).reshape(-1, n),
-        pose=np.array(rows["pose"]).reshape(-1, 4, 4),
-        pressure_before=np.asarray(rec_before[0], dtype=np.float64),
-        sent_before=np.asarray(rec_before[1], dtype=np.float64),
-        holds=holds,
-        clamped_or_limited=modified,
-        max_sent_psi=float(sent.max()) if sent.size else 0.0,
-    )
+    return rec.recording(before, holds)
