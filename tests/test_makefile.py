@@ -24,3 +24,8 @@ def test_the_demo_build_shows_its_progress() -> None:
     builds = [line for line in _recipe("install") if "maturin develop" in line]
     assert builds and all(" -q" not in line for line in builds)
     assert any("building the Rust extension" in line for line in _recipe("install"))
+
+
+def test_make_demo_builds_through_that_recipe() -> None:
+    demo = next(ln for ln in MAKEFILE.read_text().splitlines() if ln.startswith("demo:"))
+    assert demo.split(":", 1)[1].split() == ["install"]

@@ -10,6 +10,7 @@ import re
 import shlex
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -119,3 +120,58 @@ def test_license_and_citation() -> None:
     assert any("Redundancy Resolution" in t for t in titles)
     assert any("Path Planning of Soft Robotic Arms" in t for t in titles)
     assert all(r["authors"] and r["year"] for r in cff["references"])
+
+
+def test_the_tune_example_is_quick_and_states_its_cost() -> None:
+    """Issue 25 item 6: the README's `softarm tune` line finishes in a few minutes and
+    says what it costs; the stated number of harvests (berries) is the spec's."""
+    from softarm.sweep import load_spec
+
+    (line,) = [ln for ln in README.splitlines() if ln.startswith("softarm tune ")]
+    cost = re.search(r"(\d+) harvests, ~(\d+) min", line)
+    assert cost is not None, line
+    spec = load_spec(ROOT / shlex.split(line, comments=True)[2])
+    berries = spec.tune.samples * sum(t.berries for t in spec.trials())
+    assert int(cost.group(1)) == berries and berries <= 40
+    assert int(cost.group(2)) <= 5
+
+
+def _pyproject_extras() -> set[str]:
+    doc = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    return set(doc["project"]["optional-dependencies"])
+
+
+def test_one_documented_way_to_add_extras_to_the_dev_environment() -> None:
+    """Issue 25 item 6: `pip install ".[extra]"` in the dev .venv replaced the editable
+    install. The README and getting-started give `maturin develop --extras` (editable),
+    naming extras that exist, and the Makefile's dev targets install extras that way."""
+    maturin = re.compile(r"^\.venv/bin/maturin develop --release --extras ([\w,]+)", re.M)
+    for name, text in (("README.md", README), ("getting-started.md", GETTING_STARTED)):
+        lines = [m for body in blocks("sh", text) for m in maturin.findall(body)]
+        assert lines, f"{name} shows no `maturin develop --extras` line"
+        for extras in lines:
+            assert set(extras.split(",")) <= _pyproject_extras(), (name, extras)
+        assert "editable" in text
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    extras = re.search(r"(?m)^TEST_EXTRAS := ([\w,]+)$", makefile)
+    assert extras is not None and set(extras.group(1).split(",")) <= _pyproject_extras()
+    assert re.search(r"(?m)^dev-all:.*\n\t.*maturin develop --release --extras \$\(TEST_EXTRAS\)",
+                     makefile)  # fmt: skip
+    assert "make dev-all" in GETTING_STARTED
+
+
+def test_the_resolver_snippet_solves_for_another_pose(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 25 item 6: the README's Resolver.solve snippet once solved for the pose it
+    started from (0 steps). Its goal lies centimetres away and the solve takes steps."""
+    import numpy as np
+
+    monkeypatch.chdir(tmp_path)
+    (code,) = [b for b in blocks("python") if "res.solve(" in b]
+    scope: dict[str, Any] = {"__name__": "__readme__"}
+    exec(compile(code, "README.md resolver block", "exec"), scope)
+    arm, q, goal, sol = scope["arm"], scope["q"], scope["goal"], scope["sol"]
+    start = arm.forward(q)
+    assert np.linalg.norm(np.asarray(goal)[:3, 3] - start[:3, 3]) > 0.01
+    assert sol.steps > 0 and sol.converged

@@ -4,6 +4,7 @@ resume from a table alone, failed trials known; summaries of the rows."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -11,7 +12,7 @@ pytest.importorskip("pyarrow")
 import pyarrow.parquet as pq
 
 from softarm.sweep import parse_spec
-from softarm.sweep.summary import group_stats, markdown_summary, plot_summary
+from softarm.sweep.summary import axis_label, group_stats, markdown_summary, plot_summary
 from softarm.sweep.table import ResultsTable, results_schema
 from softarm.sweep.trial import error_row
 
@@ -77,3 +78,37 @@ def test_summary_tables_and_plot(tmp_path: Path) -> None:
     assert "## By pressure_tau" in text and "| 0.3 | 2 | 100.0 % |" in text
     plot_summary(all_rows, ["pressure_tau"], tmp_path / "summary.png")
     assert (tmp_path / "summary.png").stat().st_size > 10_000
+
+
+def test_the_summary_plot_axes_carry_units(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import matplotlib.pyplot as plt
+
+    kept: list[Any] = []
+    monkeypatch.setattr(plt, "close", kept.append)
+    trials = SPEC.trials()
+    plot_summary([r for t in trials for r in rows(t)], ["pressure_tau"], tmp_path / "s.png")
+    (fig,) = kept
+    labels = [ax.get_ylabel() for ax in fig.axes if ax.get_ylabel()]
+    assert labels == ["harvested (%)", "mean true error (mm)", "median s / berry (sim.)"]
+    assert fig.axes[-1].get_xlabel() == "pressure_tau (s)"
+    assert axis_label("twist_spread") == "twist_spread (rad)"
+    assert axis_label("gain_spread") == "gain_spread (relative)"
+    assert axis_label("cutoff") == "cutoff (rad/s)"
+    assert axis_label("hysteresis_psi") == "hysteresis_psi"  # the name says it
+    assert axis_label("model") == "model" and axis_label("seed") == "seed"
+
+
+def test_one_of_a_count_is_singular(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 25 item 6 ("1 berries"): the sweep figure's title and the tune file's header."""
+    import matplotlib.pyplot as plt
+
+    from softarm.sweep.tune import _header
+
+    kept: list[Any] = []
+    monkeypatch.setattr(plt, "close", kept.append)
+    one = parse_spec({"sweep": {"seeds": [0], "berries": 1}})
+    plot_summary(rows(one.trials()[0]), [], tmp_path / "s.png")
+    assert kept[0]._suptitle.get_text() == "softarm sweep: 1 berry, other keys pooled"
+    metrics = {"score": 1.0, "success": 1.0, "cycle_s": 2.0, "mean_error_mm": 0.5}
+    text = _header(one, 1, metrics, None)
+    assert ": 1 candidate, Optuna TPE" in text and "1 berry per bush" in text

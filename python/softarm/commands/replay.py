@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 
 from softarm.commands._args import data_file, int_range, non_negative_int, output_file
+from softarm.commands._format import plural
 from softarm.commands._run_info import check_bag, write_log_bag
 from softarm.commands.harvest import MAX_BERRIES
 
@@ -64,5 +65,5 @@ def run(args: argparse.Namespace) -> int:
     scene = None if args.sim_seed is None else (args.sim_seed, args.berries)
     n = replay(args.log, args.record, spawn=args.view or args.record is None, scene=scene)
     where = f"recording: {args.record}" if args.record is not None else "sent to the viewer"
-    print(f"{n} records of {args.log}; {where}")
+    print(f"{plural(n, 'record')} of {args.log}; {where}")
     return 0

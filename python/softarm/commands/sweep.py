@@ -73,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     if outcome.berries:
         rate = f", {outcome.berries_per_hour:.0f} berries/h on {outcome.cpus:g} CPUs"
     print(
-        f"{outcome.ran} trials run ({outcome.failed} failed), {outcome.skipped} already done"
+        f"{plural(outcome.ran, 'trial')} run ({outcome.failed} failed), "
+        f"{outcome.skipped} already done"
         f"{rate}; table {outcome.table}",
         flush=True,
     )

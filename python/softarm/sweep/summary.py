@@ -12,7 +12,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["GroupStats", "group_stats", "markdown_summary", "plot_summary"]
+from softarm.commands._format import plural
+
+__all__ = ["GroupStats", "axis_label", "group_stats", "markdown_summary", "plot_summary"]
 
 
 @dataclass(frozen=True)
@@ -86,6 +88,18 @@ def markdown_summary(rows: list[dict[str, Any]], keys: Sequence[str]) -> str:
     return "\n".join(lines)
 
 
+def axis_label(key: str) -> str:
+    """A swept key as an axis label, with its unit (the plant file's): ``pressure_tau
+    (s)``, ``twist_spread (rad)``, a relative spread ``gain_spread (relative)``; a key
+    that names its unit (``hysteresis_psi``), the model and the seed stay as they are."""
+    from softarm.sim.plant_file import PLANT_KEYS
+
+    spec = PLANT_KEYS.get(key)
+    if spec is None or spec.kind == "model" or key.endswith(f"_{spec.unit}"):
+        return key
+    return f"{key} ({spec.unit or 'relative'})"
+
+
 def plot_summary(rows: list[dict[str, Any]], keys: Sequence[str], path: str | Path) -> None:
     """``path`` (PNG): harvested %, mean error and median cycle time (rows) against each
     swept key (columns; the other keys pooled), or against the seed if none is swept."""
@@ -107,7 +121,7 @@ def plot_summary(rows: list[dict[str, Any]], keys: Sequence[str], path: str | Pa
                       fmt="o-", color="tab:blue", capsize=3)  # fmt: skip
         ax_t.plot(xs, [s.median_duration_s for s in st], "o-", color="tab:orange")
         ax_s.set_ylim(0, 105)
-        ax_t.set_xlabel(key)
+        ax_t.set_xlabel(axis_label(key))
         if not numeric:
             for ax in (ax_s, ax_e, ax_t):
                 ax.set_xticks(xs, [str(k[0]) for k in stats])
@@ -117,7 +131,7 @@ def plot_summary(rows: list[dict[str, Any]], keys: Sequence[str], path: str | Pa
     axes[1, 0].set_ylabel("mean true error (mm)")
     axes[2, 0].set_ylabel("median s / berry (sim.)")
     n = sum(r["error"] is None for r in rows)
-    fig.suptitle(f"softarm sweep: {n} berries, other keys pooled")
+    fig.suptitle(f"softarm sweep: {plural(n, 'berry')}, other keys pooled")
     fig.tight_layout()
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from softarm.commands._format import plural
 from softarm.errors import ConfigError
 from softarm.sweep._deps import require
 from softarm.sweep.gains_file import gains_from, write_gains
@@ -227,9 +228,10 @@ def _candidates(grid: Any) -> list[dict[str, Any]]:
 
 def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict[str, Any] | None) -> str:
     lines = [
-        f"softarm tune {spec.source}: {samples} candidates, Optuna TPE (seed {spec.tune.seed})",
+        f"softarm tune {spec.source}: {plural(samples, 'candidate')}, Optuna TPE "
+        f"(seed {spec.tune.seed})",
         f"plants: {dict(spec.plant) or 'default'}; seeds {list(spec.seeds)}; "
-        f"{spec.berries} berries per bush",
+        f"{plural(spec.berries, 'berry')} per bush",
         f"best: score {m['score']:.4f}, harvested {100 * m['success']:.1f} %, "
         f"mean {m['cycle_s']:.2f} simulated s / berry, mean error {m['mean_error_mm']:.2f} mm",
     ]
