@@ -35,6 +35,7 @@ highest-frequency content, not the equilibrium or the slow bending modes). The d
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -61,6 +62,164 @@ def _rot_z(a: float) -> F64:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+@dataclass(frozen=True)
+class _Elements:
+    """The rod's elements, proximal first, and what each is made of.
+
+    A clamped stub below the base (so that the first section element can tilt by half a
+    segment, as an arc's first chord does), then section i (kind i, ``ne`` elements over
+    its rest length), plate i (kind -1 - i, one element over the plate offset), ...,
+    section n - 1; the distal plate is rigid beyond the tip. Plates and stub are 10 x
+    their section's bending stiffness (rigid SLA resin); in everything else they count
+    with the section before them (the stub with section 0).
+    """
+
+    length: F64
+    kind: npt.NDArray[np.int_]
+    section: npt.NDArray[np.int_]  # the section each element counts with
+    ring_radius: F64
+    line_mass: F64  # kg/m
+    bend: F64  # EI
+    twist: F64  # GJ
+    axial: F64  # EA
+    shear: F64  # GA
+
+    @classmethod
+    def of(cls, arm: SoftArm, p: RodParameters) -> _Elements:
+        """The elements of ``arm`` with ``p``'s discretisation, masses and stiffness."""
+        secs, ne = arm.sections, p.elements_per_section
+        lengths, kinds = [_STUB], [_STUB_KIND]
+        for i, s in enumerate(secs):
+            lengths += [s.rest_length / ne] * ne
+            kinds += [i] * ne
+            if i < len(secs) - 1:
+                lengths.append(s.offset)
+                kinds.append(-1 - i)
+        kind = np.array(kinds)
+        sec_of = np.array([0 if k == _STUB_KIND else (k if k >= 0 else -1 - k) for k in kinds])
+        ei_sec = p.stiffness(arm)
+        r_ring = np.array([s.radius for s in secs])[sec_of]
+        return cls(
+            length=np.array(lengths),
+            kind=kind,
+            section=sec_of,
+            ring_radius=r_ring,
+            line_mass=p.line_masses(arm)[sec_of],
+            bend=np.where(kind >= 0, 1.0, 10.0) * ei_sec[sec_of],
+            twist=(2.0 * ei_sec[sec_of] / r_ring**2) * r_ring**2 / 3.0,
+            axial=p.axial_stiffness(arm)[sec_of],
+            shear=p.shear(arm)[sec_of],
+        )
+
+    def at_nodes(self, k: F64) -> F64:
+        """A stiffness per element as one per Voronoi node (between two elements): the
+        two half elements either side in series, so that a stiff stub or plate next to
+        a section adds only its own (small) compliance."""
+        ln = self.length
+        rvl = 0.5 * (ln[1:] + ln[:-1])
+        result: F64 = rvl / (0.5 * ln[1:] / k[1:] + 0.5 * ln[:-1] / k[:-1])
+        return result
+
+
+def _straight_rod(ea: Any, e: _Elements) -> Any:
+    """The straight, unstrained rod along +z from the stub's foot, with the stiffness of
+    ``e``. Its radius is the body's (ring + one muscle, as the clearance), its density the
+    line mass spread over that disc; the shear and bend matrices carry the stiffness
+    directly (Young's modulus 1)."""
+    n = len(e.length)
+    nodes = np.zeros((3, n + 1))
+    nodes[2] = np.concatenate([[0.0], np.cumsum(e.length)]) - _STUB
+    # The rod is isotropic, so its material frame need not twist at the plates:
+    # Rz(beta) T_i(theta) = T_i(theta + beta) Rz(beta) (eq. 2), so section i bends
+    # towards theta_i + the twists before it, and all twists turn the end effector
+    # at the tip. (A 60 deg rest twist at one node would couple bending across it.)
+    directors = np.repeat(np.eye(3)[:, :, None], n, axis=2)
+    body = e.ring_radius + ACTUATOR_RADIUS
+    density = e.line_mass / (math.pi * body**2)
+    rod = ea.CosseratRod.straight_rod(
+        n, nodes[:, 0].copy(), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]),
+        float(nodes[2, -1] - nodes[2, 0]), body, density, youngs_modulus=1.0,
+        position=nodes, directors=directors,
+    )  # fmt: skip
+    # Axial, shear and torsional stiffness (module docstring of params); the plates
+    # and stub are stiffer in bending only.
+    ga = e.shear
+    rod.shear_matrix[:] = 0.0
+    rod.shear_matrix[0, 0], rod.shear_matrix[1, 1], rod.shear_matrix[2, 2] = ga, ga, e.axial
+    ei_v, gj_v = e.at_nodes(e.bend), e.at_nodes(e.twist)
+    rod.bend_matrix[:] = 0.0
+    rod.bend_matrix[0, 0], rod.bend_matrix[1, 1], rod.bend_matrix[2, 2] = ei_v, ei_v, gj_v
+    return rod
+
+
+def _point_masses(
+    rod_mass: F64, e: _Elements, p: RodParameters, n_sections: int
+) -> tuple[F64, float, float]:
+    """The true node masses with the point masses added, the mass at the tip and its
+    lever. A plate's mass goes to its element's two nodes; the distal plate, gripper
+    and cube sit at the tip (their offset moment is a torque, ``_Weights``)."""
+    true_mass = rod_mass.copy()
+    for i in range(n_sections - 1):
+        k = int(np.flatnonzero(e.kind == -1 - i)[0])
+        true_mass[k : k + 2] += p.plate_masses[i] / 2
+    tip_mass = p.plate_masses[-1] + p.gripper_mass + p.cube_mass
+    true_mass[-1] += tip_mass
+    moment = p.gripper_mass * p.gripper_com + p.cube_mass * p.cube_com
+    lever = moment / tip_mass if tip_mass > 0 else 0.0
+    return true_mass, tip_mass, lever
+
+
+def _scale_inertia(rod: Any, e: _Elements, true_mass: F64) -> float:
+    """Gives the rod fictitious inertia; returns its highest vibration frequency (rad/s).
+
+    The relaxation only seeks the static equilibrium, which inertia does not change
+    (gravity uses the true masses). A node or element whose springs would vibrate faster
+    than a section's axial or shear mode, omega = 2 sqrt(k / (l m_elem)), gets mass or
+    rotational inertia until it does not (Gershgorin: 2 sum(k) / m <= omega^2); short
+    stiff plates and 1-2 cm elements' own rotational inertia would otherwise force a
+    10-100x smaller step.
+    """
+    ln, ga = e.length, e.shear
+    n = len(ln)
+    m_elem = e.line_mass * ln
+    sec_el = e.kind >= 0
+    stiff = np.maximum(e.axial, ga)
+    omega = float(np.max(2.0 * np.sqrt(stiff[sec_el] / ln[sec_el] / m_elem[sec_el])))
+    k_ax = stiff / ln  # per element
+    k_node = np.zeros(n + 1)
+    k_node[:-1] += k_ax
+    k_node[1:] += k_ax
+    rod.mass[:] = np.maximum(true_mass, 2.0 * k_node / omega**2)
+    ei_v, gj_v = e.at_nodes(e.bend), e.at_nodes(e.twist)
+    k_rot_v = np.stack([ei_v, ei_v, gj_v]) / rod.rest_voronoi_lengths  # (3, n - 1)
+    k_el = np.zeros((3, n))
+    k_el[:, :-1] += k_rot_v
+    k_el[:, 1:] += k_rot_v
+    k_el[:2] += ga * ln / 2.0  # shear couples an element's turn to its nodes
+    for k in range(n):
+        jj = np.maximum(
+            np.diag(rod.mass_second_moment_of_inertia[..., k]), 2.0 * k_el[:, k] / omega**2
+        )
+        rod.mass_second_moment_of_inertia[..., k] = np.diag(jj)
+        rod.inv_mass_second_moment_of_inertia[..., k] = np.diag(1.0 / jj)
+    return omega
+
+
+def _bend_shares(kinds: npt.NDArray[np.int_], n_sections: int, ne: int) -> F64:
+    """(n_sections, n_voronoi): the rotation (rad) per unit bending angle of each section
+    at every Voronoi node (v between elements v and v + 1): 1/ne inside a section,
+    1/(2 ne) where it meets the stub or a plate (a discrete arc's chords), 0 elsewhere."""
+    share = np.zeros((n_sections, len(kinds) - 1))
+    for v in range(len(kinds) - 1):
+        a, b = kinds[v], kinds[v + 1]
+        for i in range(n_sections):
+            if a == i and b == i:
+                share[i, v] = 1.0 / ne
+            elif (a == i) != (b == i):
+                share[i, v] = 0.5 / ne
+    return share
+
+
 class RodArm:
     """A Cosserat rod shaped like ``arm`` (the true, unloaded geometry).
 
@@ -80,139 +239,51 @@ class RodArm:
         if self.gravity.shape != (3,) or not np.all(np.isfinite(self.gravity)):
             raise ShapeError(f"gravity: expected 3 finite numbers, got {gravity!r}")
         secs = arm.sections
-        ne = p.elements_per_section
-        # Element lengths and kinds: a clamped stub below the base (so that the first
-        # section element can tilt by half a segment, as an arc's first chord does), then
-        # section i (kind i), plate i (kind -1 - i), ...
-        lengths, kinds = [_STUB], [_STUB_KIND]
-        for i, s in enumerate(secs):
-            lengths += [s.rest_length / ne] * ne
-            kinds += [i] * ne
-            if i < len(secs) - 1:
-                lengths.append(s.offset)
-                kinds.append(-1 - i)
-        self.kinds = np.array(kinds)
-        lengths_a = np.array(lengths)
-        n = len(lengths_a)
-        nodes = np.zeros((3, n + 1))
-        nodes[2] = np.concatenate([[0.0], np.cumsum(lengths_a)]) - _STUB
-        # The rod is isotropic, so its material frame need not twist at the plates:
-        # Rz(beta) T_i(theta) = T_i(theta + beta) Rz(beta) (eq. 2), so section i bends
-        # towards theta_i + the twists before it, and all twists turn the end effector
-        # at the tip. (A 60 deg rest twist at one node would couple bending across it.)
+        elements = _Elements.of(arm, p)
+        self.kinds = elements.kind
+        # Section i bends towards theta_i plus the twists before it (_straight_rod).
         self._twist_before = np.concatenate([[0.0], np.cumsum([s.twist for s in secs])])
-        directors = np.repeat(np.eye(3)[:, :, None], n, axis=2)
-        ei_sec = p.stiffness(arm)
-        r_sec = np.array([s.radius for s in secs])
-        line = p.line_masses(arm)
-        # Section of every element (the stub counts with section 0, a plate with the one
-        # before it). Plates and stub: 10 x the section's stiffness (rigid SLA resin).
-        sec_of = np.array([0 if k == _STUB_KIND else (k if k >= 0 else -1 - k) for k in kinds])
-        ei = np.where(self.kinds >= 0, 1.0, 10.0) * ei_sec[sec_of]
-        r_ring = r_sec[sec_of]
-        m_line = line[sec_of]
-        body = r_ring + ACTUATOR_RADIUS  # body radius: ring + one muscle (as the clearance)
-        density = m_line / (math.pi * body**2)
-        rod = ea.CosseratRod.straight_rod(
-            n, nodes[:, 0].copy(), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]),
-            float(nodes[2, -1] - nodes[2, 0]), body, density, youngs_modulus=1.0,
-            position=nodes, directors=directors,
-        )  # fmt: skip
-        # Axial, shear and torsional stiffness (module docstring of params); the plates
-        # and stub are stiffer in bending only.
-        ea_ax = p.axial_stiffness(arm)[sec_of]
-        ga = p.shear(arm)[sec_of]
-        gj = (2.0 * ei_sec[sec_of] / r_ring**2) * r_ring**2 / 3.0
-        rod.shear_matrix[:] = 0.0
-        rod.shear_matrix[0, 0], rod.shear_matrix[1, 1], rod.shear_matrix[2, 2] = ga, ga, ea_ax
-        # Bending at a Voronoi node: the two half elements either side in series, so that
-        # a stiff stub or plate next to a section adds only its own (small) compliance.
-        rvl = 0.5 * (lengths_a[1:] + lengths_a[:-1])
-
-        def series(k: F64) -> F64:
-            result: F64 = rvl / (0.5 * lengths_a[1:] / k[1:] + 0.5 * lengths_a[:-1] / k[:-1])
-            return result
-
-        ei_v, gj_v = series(ei), series(gj)
-        rod.bend_matrix[:] = 0.0
-        rod.bend_matrix[0, 0], rod.bend_matrix[1, 1], rod.bend_matrix[2, 2] = ei_v, ei_v, gj_v
-        # Point masses (true, for the weights): a plate over its three nodes; the distal
-        # plate, gripper and cube at the tip (their offset moment is a torque, _Weights).
-        true_mass = rod.mass.copy()
-        for i in range(len(secs) - 1):
-            k = int(np.flatnonzero(self.kinds == -1 - i)[0])
-            true_mass[k : k + 2] += p.plate_masses[i] / 2
-        tip_mass = p.plate_masses[-1] + p.gripper_mass + p.cube_mass
-        true_mass[-1] += tip_mass
-        moment = p.gripper_mass * p.gripper_com + p.cube_mass * p.cube_com
-        lever = moment / tip_mass if tip_mass > 0 else 0.0
+        rod = _straight_rod(ea, elements)
+        true_mass, tip_mass, lever = _point_masses(rod.mass, elements, p, len(secs))
         self.true_mass = true_mass
-        # Fictitious inertia (dynamic relaxation): the relaxation only seeks the static
-        # equilibrium, which inertia does not change (gravity uses the true masses). A
-        # node or element whose springs would vibrate faster than a section's axial
-        # or shear mode, omega = 2 sqrt(k / (l m_elem)), gets mass or rotational inertia until it
-        # does not (Gershgorin: 2 sum(k) / m <= omega^2); short stiff plates and 1-2 cm
-        # elements' own rotational inertia would otherwise force a 10-100x smaller step.
-        m_elem = m_line * lengths_a
-        sec_el = self.kinds >= 0
-        stiff = np.maximum(ea_ax, ga)
-        omega = float(np.max(2.0 * np.sqrt(stiff[sec_el] / lengths_a[sec_el] / m_elem[sec_el])))
-        k_ax = stiff / lengths_a  # per element
-        k_node = np.zeros(n + 1)
-        k_node[:-1] += k_ax
-        k_node[1:] += k_ax
-        rod.mass[:] = np.maximum(true_mass, 2.0 * k_node / omega**2)
-        k_rot_v = np.stack([ei_v, ei_v, gj_v]) / rod.rest_voronoi_lengths  # (3, n - 1)
-        k_el = np.zeros((3, n))
-        k_el[:, :-1] += k_rot_v
-        k_el[:, 1:] += k_rot_v
-        k_el[:2] += ga * lengths_a / 2.0  # shear couples an element's turn to its nodes
-        for k in range(n):
-            jj = np.maximum(
-                np.diag(rod.mass_second_moment_of_inertia[..., k]), 2.0 * k_el[:, k] / omega**2
-            )
-            rod.mass_second_moment_of_inertia[..., k] = np.diag(jj)
-            rod.inv_mass_second_moment_of_inertia[..., k] = np.diag(1.0 / jj)
         #: Highest vibration frequency (rad/s) after the scaling.
-        self.omega_max = omega
-        self.dt = p.time_step if p.time_step is not None else 1.0 / omega
-        # Rotation (rad) per unit bending angle at every Voronoi node (v between elements
-        # v and v + 1): 1/ne inside a section, 1/(2 ne) where it meets the stub or a plate
-        # (a discrete arc's chords), 0 elsewhere.
-        self._bend_share = np.zeros((len(secs), n - 1))
-        for v in range(n - 1):
-            a, b = kinds[v], kinds[v + 1]
-            for i in range(len(secs)):
-                if a == i and b == i:
-                    self._bend_share[i, v] = 1.0 / ne
-                elif (a == i) != (b == i):
-                    self._bend_share[i, v] = 0.5 / ne
+        self.omega_max = _scale_inertia(rod, elements, true_mass)
+        self.dt = p.time_step if p.time_step is not None else 1.0 / self.omega_max
+        self._bend_share = _bend_shares(elements.kind, len(secs), p.elements_per_section)
         rod.rest_kappa[:] = 0.0
-        self._ne = ne
+        self._ne = p.elements_per_section
+        self.rod = rod
+        self.sim = self._simulation(ea, tip_mass, lever)
+        self.stepper = ea.PositionVerlet()
+        self.time = 0.0
+        self.steps = 0
+        self.elongation = np.zeros(arm.n_actuators)
+        self._at_rest, self._rest_at = False, self.elongation.copy()
 
-        class Sim(ea.BaseSystemCollection, ea.Constraints, ea.Forcing, ea.Damping):  # type: ignore[misc, name-defined]
+    def _simulation(self, ea: Any, tip_mass: float, lever: float) -> Any:
+        """The rod clamped at the stub's foot, under the true weights (when there is
+        gravity) and the uniform damping, finalised."""
+
+        class Sim(ea.BaseSystemCollection, ea.Constraints, ea.Forcing, ea.Damping):  # type: ignore[misc]
             pass
 
-        sim = Sim()
+        rod, sim = self.rod, Sim()
         sim.append(rod)
         sim.constrain(rod).using(
             ea.FixedConstraint, constrained_position_idx=(0, 1), constrained_director_idx=(0,)
         )
         if np.any(self.gravity != 0.0):
             sim.add_forcing_to(rod).using(
-                _weights_class(ea), mass=true_mass, gravity=self.gravity,
+                _weights_class(ea), mass=self.true_mass, gravity=self.gravity,
                 tip_weight=tip_mass * self.gravity, lever=lever,
             )  # fmt: skip
         sim.dampen(rod).using(
-            ea.AnalyticalLinearDamper, uniform_damping_constant=p.damping, time_step=self.dt
+            ea.AnalyticalLinearDamper,
+            uniform_damping_constant=self.params.damping,
+            time_step=self.dt,
         )
         sim.finalize()
-        self.rod, self.sim = rod, sim
-        self.stepper = ea.PositionVerlet()
-        self.time = 0.0
-        self.steps = 0
-        self.elongation = np.zeros(arm.n_actuators)
-        self._at_rest, self._rest_at = False, self.elongation.copy()
+        return sim
 
     # --- intrinsic strains ----------------------------------------------------------
 
@@ -304,9 +375,9 @@ class RodArm:
 
     def pose(self) -> F64:
         """End-effector pose (4, 4): the tip, then the rigid gripper (eq. 3's b_3), turned
-        by all the twists (see ``__init__``)."""
+        by all the twists (see the module docstring)."""
         off = np.eye(4)
-        off[:3, :3] = _rot_z(float(self._twist_before[-1]))  # every twist, see __init__
+        off[:3, :3] = _rot_z(float(self._twist_before[-1]))  # every twist (module docstring)
         off[2, 3] = self.arm.sections[-1].offset
         return self.tip_frame() @ off
 
