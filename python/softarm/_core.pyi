@@ -71,7 +71,8 @@ class _Kinematics:
     def forward_jacobian(self, q: _ArrayLike) -> tuple[_F64, _F64]:
         """Pose (4, 4) and Jacobian (6, n) from one pass."""
     def point(self, q: _ArrayLike, section: int, s: float) -> tuple[_F64, _F64]:
-        """Backbone point (3,) at fraction s of a section, and its Jacobian (3, n)."""
+        """Backbone point (3,) at fraction s of ``section`` (counted from 0: 0 = proximal),
+        and its Jacobian (3, n)."""
     def frames(self, q: _ArrayLike) -> _F64:
         """Base frame of every section, then the end effector: (n_sections + 1, 4, 4)."""
     def backbone(self, q: _ArrayLike, samples: int = 20) -> _F64:
