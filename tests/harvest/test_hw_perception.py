@@ -16,7 +16,7 @@ import pytest
 
 from softarm.errors import ConfigError
 from softarm.hardware.simulated import SimulatedCamera
-from softarm.harvest import hw_rig, rig
+from softarm.harvest import hw_devices, hw_rig, rig
 from softarm.perception.bush_vision import BushVision
 from softarm.perception_config import PerceptionConfig
 from softarm.vision import CameraModel
@@ -52,7 +52,7 @@ def opened(monkeypatch: pytest.MonkeyPatch) -> dict[Any, Any]:
         frames.setdefault("opened", []).append(source)
         return SimulatedCamera(lambda: frames.get(source))
 
-    monkeypatch.setattr(hw_rig, "OpenCVCamera", camera)
+    monkeypatch.setattr(hw_devices, "OpenCVCamera", camera)
     return frames
 
 

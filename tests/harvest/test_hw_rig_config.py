@@ -16,7 +16,7 @@ from softarm.hardware.simulated import (
     SimulatedPressureBank,
     SimulatedRipenessSensor,
 )
-from softarm.harvest import HarvestConfig, hw_rig
+from softarm.harvest import HarvestConfig, hw_devices, hw_rig
 
 
 class _Link:
@@ -30,10 +30,10 @@ class _Link:
 @pytest.fixture
 def no_devices(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(
-        hw_rig, "NidaqPressureBank", lambda names, vmap: SimulatedPressureBank(IdealPlant())
+        hw_devices, "NidaqPressureBank", lambda names, vmap: SimulatedPressureBank(IdealPlant())
     )
-    monkeypatch.setattr(hw_rig, "ArduinoLink", _Link)
-    monkeypatch.setattr(hw_rig, "OpenCVCamera", lambda source: SimulatedCamera(lambda: None))
+    monkeypatch.setattr(hw_devices, "ArduinoLink", _Link)
+    monkeypatch.setattr(hw_devices, "OpenCVCamera", lambda source: SimulatedCamera(lambda: None))
     monkeypatch.setattr(hw_rig, "ArduinoGripper", lambda link: SimulatedGripper())
     monkeypatch.setattr(hw_rig, "ArduinoRipenessSensor", lambda link: SimulatedRipenessSensor())
 

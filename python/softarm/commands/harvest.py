@@ -24,6 +24,14 @@ from softarm.commands._args import (
     non_negative_int,
     output_file,
 )
+from softarm.commands._dry_run import (
+    add_dry_run_options,
+    check_dry_run,
+    dry_run_verdict,
+    log_commands,
+    replay_devices,
+    replay_rounds,
+)
 from softarm.commands._format import plural
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
@@ -42,6 +50,7 @@ if TYPE_CHECKING:
     from softarm.config import Config
     from softarm.harvest.hw_rig import HardwareRig
     from softarm.harvest.log import HarvestLog
+    from softarm.harvest.replay_devices import ReplayDevices
     from softarm.harvest.report import HarvestReport
     from softarm.harvest.sim_rig import SimRig
 
@@ -67,7 +76,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--berries", type=int_range(1, MAX_BERRIES), default=5, help="berries to harvest"
     )
     p.add_argument(
-        "--seed", type=non_negative_int, default=0, help="seed of the simulated bush and arm"
+        "--seed",
+        type=non_negative_int,
+        default=None,
+        help="seed of the simulated bush and arm, and of the planner's restarts (both "
+        "worlds; default 0, or the recording's with --dry-run)",
     )
     p.add_argument("--report", type=output_file, help="write the JSON report here")
     p.add_argument("--log", type=output_file, help="write the JSON-lines step log here")
@@ -92,6 +105,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--berries counts ripe and unripe together, 30%% unripe",
     )  # fmt: skip
     add_plant_options(p)
+    add_dry_run_options(p)
     p.add_argument(
         "--gains",
         type=config_file,
@@ -116,14 +130,17 @@ def run(args: argparse.Namespace) -> int:
     if (args.view or args.record is not None) and not args.sim:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
+    check_dry_run(args)
     check_bag(args.bag)
     check_view(args.view, args.record)
     configure_logging(args.quiet)
     options = plant_options(args)
     gains = _gains(args)
     if args.sim:
+        args.seed = 0 if args.seed is None else args.seed
         if args.world == "bush":
             options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
+            options.update(record_frames=args.record_frames)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
             gains=gains, view=args.view, record=args.record, bag=args.bag, args=args, **options,
@@ -280,9 +297,14 @@ def _run_hardware(args: argparse.Namespace) -> int:
 
     log = HarvestLog(args.log)  # first of all: a stop during set-up is recorded in it
     try:
+        devices = replay_devices(args)  # --dry-run: the recording's, else the drivers
+        if args.seed is None:
+            args.seed = 0 if devices is None else devices.recorded_seed()
+        if devices is not None:
+            log_commands(devices, log)
         # Nothing is pressurised yet; a device opened so far is vented by its own close.
         with vents_on_stop(lambda reason: None, log):
-            rig = _hardware_rig(args, log)
+            rig = _hardware_rig(args, log, devices)
     except HardwareUnavailableError as exc:
         log.close()
         print(
@@ -295,21 +317,26 @@ def _run_hardware(args: argparse.Namespace) -> int:
     except Exception:
         log.close()
         raise
+    berries = args.berries if devices is None else replay_rounds(devices)
     try:
         # The tags 10, 11, ... stuck to the berries (section IV-E), or the map's ripe
         # berries with markerless [perception].
         with vents_on_stop(rig.machine.actuator.vent, log):
-            report = rig.run(args.berries)
+            report = rig.run(berries)
+        sent = None if devices is None else list(devices.commands)  # before the close
     finally:
         rig.close()  # vents and releases every device, whatever happened
         log.close()
     report.header = log.records[0]
     print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
+    status = 0 if report.stopped is None else 1
+    if devices is not None and sent is not None:
+        status = max(status, dry_run_verdict(devices, sent, report))
     if args.report:
         report.save(args.report)
         print(f"report: {args.report}")
     write_run_bag(log.records, args.bag)
-    return 0 if report.stopped is None else 1
+    return status
 
 
 def _hardware_config(args: argparse.Namespace) -> Config:
@@ -333,8 +360,11 @@ def _hardware_config(args: argparse.Namespace) -> Config:
     return config
 
 
-def _hardware_rig(args: argparse.Namespace, log: HarvestLog) -> HardwareRig:
-    """The hardware rig of ``args``, its header written to ``log`` first."""
+def _hardware_rig(
+    args: argparse.Namespace, log: HarvestLog, devices: ReplayDevices | None = None
+) -> HardwareRig:
+    """The hardware rig of ``args``, its header written to ``log`` first; ``devices``:
+    the dry run's (default: the real drivers)."""
     from softarm.harvest.hw_rig import build_hardware_rig
     from softarm.identified_plant import identified_from_config, load_identified
 
@@ -346,7 +376,10 @@ def _hardware_rig(args: argparse.Namespace, log: HarvestLog) -> HardwareRig:
     )
     calibration = plant_options(args).get("calibration")  # --model: the arm and its gains
     start_log(log, hardware_header(config, args))
-    return build_hardware_rig(config, log=log, identified=identified, calibration=calibration)
+    return build_hardware_rig(
+        config, log=log, identified=identified, calibration=calibration, devices=devices,
+        seed=args.seed,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

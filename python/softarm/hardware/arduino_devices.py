@@ -10,15 +10,15 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Protocol
 
 import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.errors import HardwareError, OutOfRangeError, ParameterError
-from softarm.hardware.arduino import ArduinoLink
 from softarm.hardware.serial_protocol import FrameError
 
-__all__ = ["ArduinoGripper", "ArduinoPressureMonitor", "ArduinoRipenessSensor", "ReadingError"]
+__all__ = ["ArduinoGripper", "ArduinoPressureMonitor", "ArduinoRipenessSensor", "Link", "ReadingError"]
 
 
 #: Plain decimal numbers only: ``float()`` also takes ``" 1"``, ``"1_0"`` or ``"infinity"``.
@@ -30,6 +30,15 @@ _ANGLE_RESOLUTION_DEG = 0.1
 #: not below -1 psi; the regulators' supply is at most 1.0 MPa (145 psi), so no actuator
 #: pressure can exceed that.
 PRESSURE_READING_RANGE_PSI = (-1.0, 145.0)
+
+
+class Link(Protocol):
+    """What the devices need of the Arduino: :class:`~softarm.hardware.arduino.
+    ArduinoLink`'s request/reply (the dry run replays one)."""
+
+    def request(self, command: str, *args: object) -> list[str]: ...
+
+    def close(self) -> None: ...
 
 
 class ReadingError(HardwareError):
@@ -60,7 +69,7 @@ class ArduinoGripper:
     """The tendon gripper's SG90 servo. ``position`` is the closure fraction, mapped
     linearly from ``open_deg`` (0.0) to ``closed_deg`` (1.0)."""
 
-    def __init__(self, link: ArduinoLink, open_deg: float = 10.0, closed_deg: float = 170.0):
+    def __init__(self, link: Link, open_deg: float = 10.0, closed_deg: float = 170.0):
         for name, deg in (("open_deg", open_deg), ("closed_deg", closed_deg)):
             if not 0.0 <= deg <= 180.0:
                 raise ParameterError(f"{name} must lie in [0, 180] degrees, got {deg!r}")
@@ -108,7 +117,7 @@ class ArduinoGripper:
 class ArduinoRipenessSensor:
     """The palm NIR sensor; the firmware returns the ripeness index in [0, 1]."""
 
-    def __init__(self, link: ArduinoLink) -> None:
+    def __init__(self, link: Link) -> None:
         self._link = link
 
     def read(self) -> float:
@@ -130,7 +139,7 @@ class ArduinoPressureMonitor:
 
     def __init__(
         self,
-        link: ArduinoLink,
+        link: Link,
         channels: int = 9,
         valid_psi: tuple[float, float] = PRESSURE_READING_RANGE_PSI,
     ) -> None:

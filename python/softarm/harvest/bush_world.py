@@ -15,16 +15,15 @@ import numpy as np
 from softarm._core import PolynomialCurve
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
+from softarm.harvest.hw_perception import Pair, StereoC1
 from softarm.harvest.interfaces import BerryTarget
 from softarm.harvest.map_harvest import harvest_map
 from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.rig_parts import a_cane
 from softarm.harvest.sim_devices import SimGripper
+from softarm.harvest.states import FAULTS_THAT_STOP
 from softarm.perception.bush_map import BushMap, MappedBerry
 from softarm.perception.cane_metrics import cane_map_error
-from softarm.perception.canes import fit_canes
 from softarm.perception.overlay import draw_bush_map
-from softarm.perception.stereo import locate_berries
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.plant import ArmPlant
@@ -62,6 +61,10 @@ class BushScene:
     #: base-tag registration (eq. 22), as the cube tracking places it. The world's own
     #: C1 pose is the truth, which only the renderer uses.
     stereo: StereoCamera | None = None
+    #: The registration's base pose in C1 (set by :meth:`registered`).
+    T_C1_base: FloatArray | None = None
+    #: C1's stereo source: :meth:`pair` unless a recorder wraps it.
+    read_pair: Callable[[], Pair] | None = None
     _drawn: bytes = b""
 
     def _draw(self) -> None:
@@ -72,9 +75,12 @@ class BushScene:
             draw_arm(self.world, self.plant)
             self._drawn = key
 
-    def registered(self, T_base_c1: FloatArray) -> None:
-        """Place C1 where the registration found it."""
-        self.stereo = replace(self.world.stereo, T_base_left=T_base_c1)
+    def registered(self, T_C1_base: FloatArray) -> None:
+        """Place C1 where the registration found it: ``T_C1_base`` (the base in C1), as
+        the hardware configuration keeps it, inverted as the hardware rig inverts it,
+        so that a recorded run replays on the hardware path bit for bit."""
+        self.T_C1_base = np.array(T_C1_base, dtype=float)
+        self.stereo = replace(self.world.stereo, T_base_left=invert(self.T_C1_base))
 
     def c1(self) -> StereoCamera:
         """C1 as the rig knows it (after :meth:`registered`)."""
@@ -82,24 +88,27 @@ class BushScene:
             raise ParameterError("the bush scene's C1 is not registered yet")
         return self.stereo
 
-    def look(self) -> int:
-        """One C1 stereo view with the arm where it truly is, merged into the map; the
-        number of berries new to it."""
+    def pair(self) -> Pair:
+        """C1's stereo pair now, with the arm drawn where it truly is."""
         self._draw()
         left, right = self.world.c1()
-        return self.bush_map.update(locate_berries(left.colour, right.colour, self.c1()))
+        return left.colour, right.colour
+
+    def stereo_c1(self) -> StereoC1:
+        """C1 as the hardware rig has it: the registered pair, its source, the map."""
+        return StereoC1(self.c1(), self.read_pair or self.pair, self.bush_map)
+
+    def look(self) -> int:
+        """One C1 stereo view merged into the map (:meth:`StereoC1.look`, as on the
+        arm); the number of berries new to it."""
+        return self.stereo_c1().look()
 
     def fit_canes(self, rig_parts: FloatArray, reach: float) -> list[PolynomialCurve]:
-        """The canes fitted from one C1 stereo view, without what is the rig's own: a fit
-        that comes within SELF_MARGIN of ``rig_parts`` ((N, 3) points of the arm's
-        model at the poses it looks from, its cube and the base tag) is the robot seen
-        by its own camera, the robot self-filter of any point-cloud pipeline; a fit
-        wholly beyond ``reach`` (m) of the base cannot be touched. The map keeps them."""
-        self._draw()
-        left, right = self.world.c1()
-        fits = fit_canes(left.colour, right.colour, self.c1())
-        self.bush_map.canes = [f for f in fits if a_cane(f.points[:, :3], rig_parts, reach)]
-        return [c.curve for c in self.bush_map.canes]
+        """The canes fitted from one C1 stereo view, without what is the rig's own
+        (:meth:`StereoC1.fit_canes`, as on the arm: a fit that comes within SELF_MARGIN
+        of ``rig_parts``, the robot seen by its own camera, or lies wholly beyond
+        ``reach`` of the base is left out); the map keeps them."""
+        return self.stereo_c1().fit_canes(rig_parts, reach)
 
     def frames(self) -> tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray]]:
         """C1's left eye and C2 as ``(time) -> image`` with the arm drawn as it is."""
@@ -178,7 +187,8 @@ def harvest_bush(
         if on_berry is not None:
             on_berry(len(report.berries) - 1, result)
 
-    harvest_map(scene.look, scene.bush_map, run_berry, len(scene.bush.berries) + 8, judged)
+    rounds = len(scene.bush.berries) + 8
+    harvest_map(scene.look, scene.bush_map, run_berry, rounds, judged, stop_on=FAULTS_THAT_STOP)
     report.extra.update(_bush_extra(scene, delivered))
     return report
 

@@ -1,7 +1,9 @@
 """Recorded camera frames for the dry run of the hardware path (issue 24, item 3):
 :class:`FrameRecorder` saves each frame the vision reads, with its time, as a lossless
 PNG and an entry of ``frames.json``; :class:`FrameFolder` gives them back, in the order
-they were read, checking that none is missing or out of order."""
+they were read, checking that none is missing or out of order. Beside the frames the
+index keeps named streams of other readings (the ripeness sensor's, the pressures
+sent), in the order they were taken."""
 
 from __future__ import annotations
 
@@ -17,10 +19,14 @@ from softarm.files import write_text
 from softarm.files.read import load_json
 from softarm.vision.crop import ImageCrop
 
-__all__ = ["INDEX", "FrameFolder", "FrameRecorder"]
+__all__ = ["INDEX", "TIME_TOLERANCE_S", "FrameFolder", "FrameRecorder"]
 
 #: The index of a frames folder: one entry per frame read, in the order read.
 INDEX = "frames.json"
+
+#: How far (s) a replayed frame's time may lie from its recorded time: both clocks step
+#: by the same control periods, so only rounding separates them.
+TIME_TOLERANCE_S = 1e-9
 
 Frame = Callable[[float], Any]
 
@@ -38,6 +44,11 @@ class FrameRecorder:
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         self.entries: list[dict[str, Any]] = []
+        self.streams: dict[str, list[Any]] = {}
+
+    def record(self, stream: str, value: Any) -> None:
+        """Append ``value`` (JSON: numbers, lists, strings) to the named stream."""
+        self.streams.setdefault(stream, []).append(value)
 
     def wrap(self, camera: str, frame: Frame) -> Frame:
         """``frame`` that records each image it gives as ``camera``'s."""
@@ -46,6 +57,21 @@ class FrameRecorder:
             image = frame(t)
             self._save(camera, t, image)
             return image
+
+        return recorded
+
+    def wrap_pair(
+        self, read: Callable[[], tuple[Any, Any]], now: Callable[[], float]
+    ) -> Callable[[], tuple[Any, Any]]:
+        """The stereo source ``read`` that records each pair it gives, its eyes as
+        ``c1_left`` and ``c1_right`` at the time ``now`` tells."""
+
+        def recorded() -> tuple[Any, Any]:
+            left, right = read()
+            t = now()
+            self._save("c1_left", t, left)
+            self._save("c1_right", t, right)
+            return left, right
 
         return recorded
 
@@ -66,7 +92,8 @@ class FrameRecorder:
     def save(self) -> Path:
         """Write the index; its path."""
         path = self.folder / INDEX
-        write_text(path, json.dumps({"frames": self.entries}, indent=1) + "\n", "frames index")
+        index = {"frames": self.entries, "streams": self.streams}
+        write_text(path, json.dumps(index, indent=1) + "\n", "frames index")
         return path
 
 
@@ -84,6 +111,10 @@ class FrameFolder:
         frames = data.get("frames") if isinstance(data, dict) else None
         if not isinstance(frames, list):
             raise ConfigError(f"{self.folder / INDEX}: frames must be a list of entries")
+        streams = data.get("streams", {})
+        if not isinstance(streams, dict):
+            raise ConfigError(f"{self.folder / INDEX}: streams must be a table of lists")
+        self.streams: dict[str, list[Any]] = streams
         self.entries: dict[str, list[dict[str, Any]]] = {}
         for i, entry in enumerate(frames):
             self._check(i, entry)
@@ -104,12 +135,24 @@ class FrameFolder:
                 f"{where}: frame file {str(self.folder / entry['file'])!r} is missing"
             )
 
-    def frame(self, camera: str) -> Frame:
-        """``camera``'s frames, one per call in the order recorded (the time asked for
-        is not used: the replay reads them as the recording did).
+    def stream(self, name: str) -> list[Any]:
+        """The readings of stream ``name``, in the order taken.
 
         Raises:
-            ConfigError: more frames are read than were recorded.
+            ConfigError: the recording has no such stream.
+        """
+        if name not in self.streams or not isinstance(self.streams[name], list):
+            raise ConfigError(f"{self.folder / INDEX}: no {name!r} readings recorded")
+        return self.streams[name]
+
+    def frame(self, camera: str) -> Frame:
+        """``camera``'s frames, one per call in the order recorded; each must be asked
+        for at the time it was recorded (within :data:`TIME_TOLERANCE_S`), or the
+        replay has left the recording.
+
+        Raises:
+            ConfigError: more frames are read than were recorded, or one is read at
+                another time than it was recorded.
         """
         entries = iter(self.entries.get(camera, []))
 
@@ -117,9 +160,20 @@ class FrameFolder:
             entry = next(entries, None)
             if entry is None:
                 raise ConfigError(f"{self.folder}: no {camera} frame left to replay at t = {t}")
+            if abs(t - entry["t"]) > TIME_TOLERANCE_S:
+                raise ConfigError(
+                    f"{self.folder}: the replay left the recording: {camera} frame "
+                    f"{entry['n']} asked for at t = {t!r} s, recorded at {entry['t']!r} s"
+                )
             return None if entry["file"] is None else self._image(entry)
 
         return replayed
+
+    def pair(self, now: Callable[[], float]) -> Callable[[], tuple[Any, Any]]:
+        """The recorded stereo source: one pair per call, asked for at the time ``now``
+        tells (checked as :meth:`frame` checks it)."""
+        left, right = self.frame("c1_left"), self.frame("c1_right")
+        return lambda: (left(now()), right(now()))
 
     def _image(self, entry: dict[str, Any]) -> Any:
         image = _cv2().imread(str(self.folder / entry["file"]), -1)  # IMREAD_UNCHANGED

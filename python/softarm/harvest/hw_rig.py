@@ -18,17 +18,15 @@ from softarm._core import PolynomialCurve, Section, SoftArm
 from softarm.calibration.result import Calibration
 from softarm.config import Config
 from softarm.errors import ConfigError
-from softarm.hardware.arduino import ArduinoLink
 from softarm.hardware.arduino_devices import ArduinoGripper, ArduinoRipenessSensor
-from softarm.hardware.camera import OpenCVCamera
 from softarm.hardware.clock import MonotonicClock
-from softarm.hardware.daq import NidaqPressureBank
-from softarm.hardware.pressure_map import ElongationMap, VoltageMap
+from softarm.hardware.pressure_map import ElongationMap
+from softarm.hardware.protocols import PressureBank
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.actuator import PressureMap
-from softarm.harvest.config import HarvestConfig
-from softarm.harvest.hw_perception import StereoC1, open_stereo, stereo_camera
-from softarm.harvest.interfaces import BerryTarget
+from softarm.harvest.hw_devices import DeviceDrivers, Devices
+from softarm.harvest.hw_perception import StereoC1, stereo_camera
+from softarm.harvest.interfaces import BerryTarget, Clock
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.map_harvest import harvest_map
@@ -36,13 +34,13 @@ from softarm.harvest.report import HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
 from softarm.harvest.rig_parts import CANE_REACH, rig_parts
 from softarm.harvest.states import FAULTS_THAT_STOP
-from softarm.harvest.vision_loop import CameraVision
+from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_vision import BushVision
-from softarm.vision import CameraModel, MarkerCube
+from softarm.vision import MarkerCube
 from softarm.vision.camera_model import camera_from_config
 from softarm.vision.poses import invert
-from softarm.vision.two_cameras import Frame
+from softarm.vision.two_cameras import CameraVision
 
 __all__ = ["HardwareRig", "MonotonicClock", "build_hardware_rig", "hardware_inputs"]
 
@@ -86,6 +84,8 @@ def build_hardware_rig(
     identified: IdentifiedPlant | None = None,
     calibration: Calibration | None = None,
     canes: Sequence[PolynomialCurve] = (),
+    devices: Devices | None = None,
+    seed: int = 0,
 ) -> HardwareRig:
     """Open every device of ``config`` and wire the machine, tuned by ``harvest`` (default:
     the config's ``[harvest]``), on the control stack the simulator uses
@@ -96,6 +96,8 @@ def build_hardware_rig(
     ``calibration`` (``--model``) replaces the configured arm and pressure map; the
     ``canes`` are avoided by planner, resolver and way check: with ``[perception]``
     (and none given) the ones fitted from C1's stereo at start, else none unless given.
+    ``devices`` opens the devices (default: the real drivers; the dry run's replay
+    them); ``seed`` is the planner's.
 
     Raises:
         HardwareUnavailableError: a device (or its driver) is absent.
@@ -105,23 +107,19 @@ def build_hardware_rig(
     cal = config.calibration
     if cal.T_C1_base is None or cal.T_C2_EE is None:
         raise ConfigError("calibration.T_C1_base and calibration.T_C2_EE must be set to harvest")
-    inputs = hardware_inputs(config, identified, calibration)
+    inputs = hardware_inputs(config, identified, calibration, seed)
+    dev = devices or DeviceDrivers()
     with ExitStack() as stack:
-        bank = _pressure_bank(config, stack)
-        s = config.serial
-        link = ArduinoLink(
-            s.port, s.baud, s.timeout_s, s.retries, startup_delay_s=s.startup_delay_s
-        )
-        stack.callback(link.close)
-        c1 = _stereo_c1(config, stack)
+        clock = dev.clock()
+        bank = _pressure_bank(config, dev.pressure_outputs(config, stack), clock, stack)
+        link = dev.arduino(config, stack)
+        c1 = _stereo_c1(config, dev, stack)
         if c1 is not None and not canes:
             canes = _perceived_canes(c1, config, cfg, inputs.model)
-        vision = _vision(config, cfg, stack, c1)
-        gripper = ArduinoGripper(link)
-        clock = MonotonicClock()
+        vision = _vision(config, cfg, dev, stack, c1)
         control = build_control_stack(cfg, inputs, canes, bank, clock.now)
         machine = HarvestMachine(
-            clock, vision, control.controller, control.actuator, gripper,
+            clock, vision, control.controller, control.actuator, ArduinoGripper(link),
             ArduinoRipenessSensor(link), inputs.model.n_actuators, cfg, log,
             planner=control.planner,
         )  # fmt: skip
@@ -134,36 +132,36 @@ def hardware_inputs(
     config: Config,
     identified: IdentifiedPlant | None = None,
     calibration: Calibration | None = None,
+    seed: int = 0,
 ) -> ControlInputs:
     """The control stack's inputs of a hardware ``config``: its arm and channels unless
     a fitted ``calibration`` replaces them, the ``identified`` lag and play, its
-    ``[gains]`` (``--gains`` merged in already)."""
+    ``[gains]`` (``--gains`` merged in already), the planner's ``seed``."""
     ch = config.channels
     if calibration is None:
         model = SoftArm([Section(**vars(sec)) for sec in config.arm.sections])
         pressure_map: PressureMap = ElongationMap(ch.p_max, ch.metres_per_psi)
     else:
         model, pressure_map = calibration.arm, calibration.pressure_map(ch.p_max)
-    return ControlInputs(
-        model,
-        pressure_map,
-        lag_s=None if identified is None else identified.lag_s,
-        play_m=0.0 if identified is None else np.asarray(identified.play_m),
-        gains=dict(config.gains.values),
+    return ControlInputs.of_plant(
+        model, pressure_map, identified, gains=dict(config.gains.values), seed=seed
     )
 
 
-def _pressure_bank(config: Config, stack: ExitStack) -> SafePressureBank:
-    """The DAQ's outputs behind the safety layer, both closed (vented) by ``stack``."""
+def _pressure_bank(
+    config: Config, outputs: PressureBank, clock: Clock, stack: ExitStack
+) -> SafePressureBank:
+    """The pressure ``outputs`` behind the safety layer, timed by ``clock``; ``stack``
+    closes (vents) it."""
     ch = config.channels
-    daq = NidaqPressureBank(ch.names, VoltageMap(ch.full_scale_psi, *ch.voltage_range))
-    stack.callback(daq.close)
-    bank = SafePressureBank(daq, ch.p_max, ch.max_rate_psi_per_s, ch.watchdog_timeout_s)
+    bank = SafePressureBank(
+        outputs, ch.p_max, ch.max_rate_psi_per_s, ch.watchdog_timeout_s, clock.now
+    )
     stack.callback(bank.close)
     return bank
 
 
-def _stereo_c1(config: Config, stack: ExitStack) -> StereoC1 | None:
+def _stereo_c1(config: Config, devices: Devices, stack: ExitStack) -> StereoC1 | None:
     """C1 as the ``[perception]`` stereo source (its devices closed by ``stack``), its
     first view in the map; None without the table."""
     perception = config.perception
@@ -171,7 +169,7 @@ def _stereo_c1(config: Config, stack: ExitStack) -> StereoC1 | None:
         return None
     T_base_c1 = invert(np.array(config.calibration.T_C1_base))
     stereo = stereo_camera(perception, T_base_c1)
-    c1 = StereoC1(stereo, open_stereo(perception, OpenCVCamera, stack))
+    c1 = StereoC1(stereo, devices.stereo(perception, stack))
     c1.look()
     return c1
 
@@ -186,17 +184,16 @@ def _perceived_canes(
 
 
 def _vision(
-    config: Config, cfg: HarvestConfig, stack: ExitStack, c1: StereoC1 | None
+    config: Config, cfg: HarvestConfig, devices: Devices, stack: ExitStack, c1: StereoC1 | None
 ) -> CameraVision:
     """Both cameras, opened and closed by ``stack``, and the vision loop on them: with
     ``c1`` the stereo source's left eye is C1, and the berries come from its map unless
     ``[perception]`` asks for tags."""
     cal = config.calibration
-    frame1, model1 = _c1(config, stack, c1)
-    cam2 = OpenCVCamera(cal.c2.device)
-    stack.callback(cam2.close)
+    frame1 = devices.c1_frames(config, stack, None if c1 is None else c1.left)
+    model1 = camera_from_config(cal.c1, "c1") if c1 is None else c1.stereo.left
     args = (
-        frame1, lambda t: cam2.read(), model1, camera_from_config(cal.c2, "c2"),
+        frame1, devices.c2_frames(config, stack), model1, camera_from_config(cal.c2, "c2"),
         invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)),
         np.array(cal.T_EE_cube), MarkerCube.standard(), cal.berry_tag, cfg.grasp_offset,
     )  # fmt: skip
@@ -204,13 +201,3 @@ def _vision(
     if c1 is not None and perception is not None and perception.berries == "markerless":
         return BushVision(*args, bush_map=c1.bush_map)
     return CameraVision(*args)
-
-
-def _c1(config: Config, stack: ExitStack, c1: StereoC1 | None) -> tuple[Frame, CameraModel]:
-    """C1's frames and intrinsics: the stereo source's left eye, or the C1 camera."""
-    if c1 is not None:
-        return c1.left, c1.stereo.left
-    cal = config.calibration
-    cam1 = OpenCVCamera(cal.c1.device)
-    stack.callback(cam1.close)
-    return (lambda t: cam1.read()), camera_from_config(cal.c1, "c1")

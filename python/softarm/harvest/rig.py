@@ -14,6 +14,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from softarm._core import Gains, PolynomialCurve, Resolver, SoftArm
 from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError, ParameterError
@@ -24,6 +26,7 @@ from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_alpha
+from softarm.identified_plant import IdentifiedPlant
 
 __all__ = ["ControlInputs", "ControlStack", "build_control_stack", "gains_over"]
 
@@ -55,6 +58,22 @@ class ControlInputs:
     joint_limit_gain: float | None = None
     avoid_canes: bool = True
     seed: int = 0
+
+    @classmethod
+    def of_plant(
+        cls,
+        model: SoftArm,
+        pressure_map: PressureMap | None,
+        plant: IdentifiedPlant | None,
+        **options: Any,
+    ) -> ControlInputs:
+        """The inputs of an arm ``model`` on a ``plant`` as `softarm identify` measures
+        it (its slowest channel's lag, its play bands; None: unknown), ``options`` the
+        other fields. Both rigs build theirs here."""
+        if plant is None:
+            return cls(model, pressure_map, **options)
+        play = np.asarray(plant.play_m)
+        return cls(model, pressure_map, lag_s=plant.lag_s, play_m=play, **options)
 
     @property
     def predicts(self) -> bool:

@@ -16,11 +16,23 @@ import numpy as np
 
 import softarm
 from softarm.calibration.result import Calibration
+from softarm.config import ChannelsConfig
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
+from softarm.hardware.pressure_map import ElongationMap
+from softarm.harvest.actuator import PressureMap
 from softarm.harvest.bush_world import BushGripper, BushScene, harvest_bush
 from softarm.harvest.clearance import Clearance
-from softarm.harvest.config import HarvestConfig
+from softarm.harvest.dry_run import (
+    BERRY_STATES,
+    COMMANDS,
+    CommandTap,
+    RecordedSensor,
+    RigDescription,
+    berry_outcome,
+    write_rig_files,
+)
+from softarm.harvest.frame_files import FrameRecorder
 from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
@@ -28,18 +40,20 @@ from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
 from softarm.harvest.rig_parts import CANE_REACH, rig_parts
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
-from softarm.harvest.sim_plant import ArmPlant
 from softarm.harvest.sim_vision import BASE_TAG_ID, SimCameras, look_at, sim_vision
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
-from softarm.harvest.vision_loop import CameraVision, register_c1
-from softarm.identification.result import IdentifiedPlant
+from softarm.harvest_config import HarvestConfig
+from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_map import BushMap
 from softarm.perception.bush_vision import BushVision
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
+from softarm.sim.plant import ArmPlant
 from softarm.sim.render.world import world_for
-from softarm.units import MAX_PSI
+from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.vision import MarkerCube
+from softarm.vision.poses import invert
+from softarm.vision.two_cameras import CameraVision, register_c1
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "control_inputs", "default_cameras"]
 
@@ -83,6 +97,10 @@ class SimRigOptions:
     world: str = "tags"
     #: Resolver gain keywords (``--gains``) over every controller resolver's own.
     gains: Mapping[str, Any] = field(default_factory=dict)
+    #: A folder to record the rendered bush's frames, the ripeness readings and the
+    #: pressure commands in, with the rig's hw.toml: the dry run's input
+    #: (:mod:`softarm.harvest.dry_run`).
+    record_frames: str | Path | None = None
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -126,6 +144,8 @@ class SimRig:
     machine: HarvestMachine
     #: The rendered bush and its map (``world = "bush"``), None in the tag world.
     scene: BushScene | None = None
+    #: What ``record_frames`` records into, None without it.
+    recorder: FrameRecorder | None = None
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
         """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
@@ -165,6 +185,10 @@ class SimRig:
             sim_time_s=self.clock.now(),
         )
         self.machine.log.close()
+        if self.recorder is not None:
+            for berry in report.berries:
+                self.recorder.record(BERRY_STATES, berry_outcome(berry))
+            self.recorder.save()
         return report
 
 
@@ -180,64 +204,107 @@ def build_sim_rig(
     model = nominal if o.calibration is None else o.calibration.arm
     plant = _plant(o, nominal)
     cams = default_cameras(o.scale, o.noise_std)
-    # The true actuators' range: 0-70 psi (or less if the regulators saturate lower)
-    # through each one's true elongation per psi.
-    true_upper = min(MAX_PSI, o.plant.max_psi) * plant.sim.metres_per_psi
-    bush = Bush.generate(
-        plant.arm, o.n_berries, o.seed, grasp_offset=cfg.grasp_offset,
-        unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],
-        limits=(np.zeros_like(true_upper), true_upper),
-    )  # fmt: skip
+    bush = _bush(o, plant, cams)
     on_bush = list(bush.berries)
     canes = [b.curve() for b in bush.branches]  # the truth: contacts are scored on it
-    scene = None
-    if o.world == "bush":
-        scene = _bush_scene(bush, plant, cams)
-    elif o.world != "tags":
-        raise ParameterError(f"world = {o.world!r}: must be 'tags' or 'bush'")
     watch = _watch(o, plant, canes)
     clock = SimClock([plant.advance, watch.sample])
-    bank = SafePressureBank(
-        SimulatedPressureBank(plant, plant.arm.n_actuators), MAX_PSI, 100.0, 0.5, clock.now,
-        watchdog_thread=False,
-    )  # fmt: skip
-    if scene is None:
-        vision = sim_vision(
-            cams, plant.pose, lambda: on_bush, cfg.grasp_offset,
-            seed=o.seed, hidden=o.hidden,
-        )  # fmt: skip
-        gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    recorder = _recorder(o)
+    bank = _bank(plant, clock, recorder)
+    vision: CameraVision
+    gripper: SimGripper
+    if o.world == "bush":
+        scene, vision, gripper, canes = _bush_world(o, bush, plant, model, cams, clock, recorder)
     else:
-        vision = _bush_vision(scene, cams, cfg.grasp_offset)
-        gripper = BushGripper(scene, plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
-        # The planner, resolver and clearance avoid these.
-        parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
-        canes = scene.fit_canes(parts, CANE_REACH)
+        scene = None
+        vision = sim_vision(
+            cams, plant.pose, lambda: on_bush, cfg.grasp_offset, seed=o.seed, hidden=o.hidden
+        )
+        gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
     stack = build_control_stack(cfg, control_inputs(o, model), canes, bank, clock.now)
+    sensor = gripper if recorder is None else RecordedSensor(gripper, recorder)
     machine = HarvestMachine(
-        clock, vision, controller or stack.controller, stack.actuator, gripper, gripper,
+        clock, vision, controller or stack.controller, stack.actuator, gripper, sensor,
         n_actuators=model.n_actuators, config=cfg, log=HarvestLog(o.log_path),
         ground_truth=gripper, planner=stack.planner,
     )  # fmt: skip
-    return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine, scene)
+    return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine, scene, recorder)
 
 
 def control_inputs(o: SimRigOptions, model: softarm.SoftArm) -> ControlInputs:
     """The control stack's inputs of ``o``: the plant's lag and play measured by
     `softarm identify` when given, else declared by the plant description (its
-    regulators' time constant, as a datasheet states it)."""
-    declared = o.identified is None
-    return ControlInputs(
+    regulators' time constant, as a datasheet states it), as the hardware's
+    ``[plant_model]`` gives them."""
+    return ControlInputs.of_plant(
         model,
-        None if o.calibration is None else o.calibration.pressure_map(),
-        lag_s=o.plant.pressure_tau if declared else o.identified.lag_s,  # type: ignore[union-attr]
-        play_m=o.plant.play_m if declared else np.asarray(o.identified.play_m),  # type: ignore[union-attr]
+        _pressure_map(o),
+        o.identified or declared_plant(o.plant, model.n_actuators, o.config.period),
         gains=dict(o.gains),
         lag_control=o.lag_control,
         joint_limit_gain=o.joint_limit_gain,
         avoid_canes=o.avoid_canes,
         seed=o.seed,
     )
+
+
+def declared_plant(plant: PlantConfig, n: int, period: float) -> IdentifiedPlant:
+    """The simulated plant as its description declares it, in the form `softarm
+    identify` measures: every regulator's time constant, no dead time, the nominal
+    elongation per psi and the declared play band."""
+    return IdentifiedPlant(
+        tau_s=(plant.pressure_tau,) * n,
+        metres_per_psi=(METRES_PER_PSI,) * n,
+        hysteresis_psi=(plant.hysteresis_psi,) * n,
+        dead_time_s=(0.0,) * n,
+        control_period_s=period,
+    )
+
+
+def _pressure_map(o: SimRigOptions) -> PressureMap:
+    """Elongation to psi: the fitted model's (``--model``), else the channels' nominal
+    map, as the hardware's ``[channels]`` give it."""
+    if o.calibration is not None:
+        return o.calibration.pressure_map()
+    ch = ChannelsConfig()
+    return ElongationMap(ch.p_max, ch.metres_per_psi)
+
+
+def _bush(o: SimRigOptions, plant: ArmPlant, cams: SimCameras) -> Bush:
+    """The bush of ``o``'s seed, in the true actuators' reach: 0-70 psi (or less if the
+    regulators saturate lower) through each one's true elongation per psi."""
+    if o.world not in ("tags", "bush"):
+        raise ParameterError(f"world = {o.world!r}: must be 'tags' or 'bush'")
+    true_upper = min(MAX_PSI, o.plant.max_psi) * plant.sim.metres_per_psi
+    return Bush.generate(
+        plant.arm, o.n_berries, o.seed, grasp_offset=o.config.grasp_offset,
+        unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],
+        limits=(np.zeros_like(true_upper), true_upper),
+    )  # fmt: skip
+
+
+def _recorder(o: SimRigOptions) -> FrameRecorder | None:
+    """The recorder of ``--record-frames`` (the rendered bush only)."""
+    if o.record_frames is None:
+        return None
+    if o.world != "bush":
+        raise ParameterError("record_frames: records the rendered bush (world = 'bush') only")
+    recorder = FrameRecorder(o.record_frames)
+    recorder.record("seed", o.seed)
+    return recorder
+
+
+def _bank(plant: ArmPlant, clock: SimClock, recorder: FrameRecorder | None) -> SafePressureBank:
+    """The simulated regulators behind the safety layer with the channels' limits (the
+    hardware's ``[channels]`` defaults); each command recorded for the dry run."""
+    outputs: Any = SimulatedPressureBank(plant, plant.arm.n_actuators)
+    if recorder is not None:
+        outputs = CommandTap(outputs, clock.now, lambda c: recorder.record(COMMANDS, c))
+    ch = ChannelsConfig()
+    return SafePressureBank(
+        outputs, ch.p_max, ch.max_rate_psi_per_s, ch.watchdog_timeout_s, clock.now,
+        watchdog_thread=False,
+    )  # fmt: skip
 
 
 def _plant(o: SimRigOptions, nominal: softarm.SoftArm) -> ArmPlant:
@@ -267,22 +334,61 @@ def _watch(o: SimRigOptions, plant: ArmPlant, canes: list[softarm.PolynomialCurv
 C2_SCALE = 0.5
 
 
-def _bush_scene(bush: Bush, plant: ArmPlant, cams: SimCameras) -> BushScene:
+def _bush_world(
+    o: SimRigOptions,
+    bush: Bush,
+    plant: ArmPlant,
+    model: softarm.SoftArm,
+    cams: SimCameras,
+    clock: SimClock,
+    recorder: FrameRecorder | None,
+) -> tuple[BushScene, BushVision, BushGripper, list[softarm.PolynomialCurve]]:
+    """The rendered bush and its map, the markerless vision, the gripper that closes on
+    the true berry a map entry stands for, and the canes the planner, the resolver and
+    the clearance avoid: fitted from C1 without the rig's own parts. With ``recorder``
+    every frame is recorded, and the rig's hardware configuration written beside."""
+    cfg = o.config
+    scene = _bush_scene(bush, plant, cams, clock, recorder)
+    canes = scene.fit_canes(rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag), CANE_REACH)
+    vision = _bush_vision(scene, cams, cfg.grasp_offset, recorder)
+    gripper = BushGripper(
+        scene, plant, vision, list(bush.berries), cfg.grasp_offset, cfg.grasp_workspace
+    )
+    if recorder is not None:
+        identified = o.identified or declared_plant(o.plant, model.n_actuators, cfg.period)
+        rig = RigDescription(
+            model, cfg, dict(o.gains), identified, scene, scene.world.c2,
+            cams.T_ee_c2, cams.T_ee_cube, cams.berry_tag,
+        )  # fmt: skip
+        write_rig_files(recorder.folder, rig)
+    return scene, vision, gripper, canes
+
+
+def _bush_scene(
+    bush: Bush, plant: ArmPlant, cams: SimCameras, clock: SimClock, recorder: FrameRecorder | None
+) -> BushScene:
     """The rendered bush, C1 registered on its base tag, the first C1 look merged
     into its map."""
     world = world_for(bush, cams, BASE_TAG_ID, c2_scale=C2_SCALE)
     scene = BushScene(world, BushMap(), bush, plant)
-    scene.registered(
-        register_c1(scene.c1_whole, cams.model(1), BASE_TAG_ID, cams.base_tag, cams.T_base_tag)
+    if recorder is not None:
+        scene.read_pair = recorder.wrap_pair(scene.pair, clock.now)
+    T_base_c1 = register_c1(
+        scene.c1_whole, cams.model(1), BASE_TAG_ID, cams.base_tag, cams.T_base_tag
     )
+    scene.registered(invert(T_base_c1))
     scene.look()
     return scene
 
 
-def _bush_vision(scene: BushScene, cams: SimCameras, grasp_offset: float) -> BushVision:
+def _bush_vision(
+    scene: BushScene, cams: SimCameras, grasp_offset: float, recorder: FrameRecorder | None
+) -> BushVision:
     """The markerless vision: the cube and base tag in the rendered C1, the berries
     from the map and C2 (softarm.perception.bush_vision)."""
     c1, c2 = scene.frames()
+    if recorder is not None:
+        c1, c2 = recorder.wrap("c1", c1), recorder.wrap("c2", c2)
     m1, m2 = cams.model(1), scene.world.c2
     T_base_c1 = scene.c1().T_base_left
     cube = MarkerCube.standard(cams.cube_marker)

@@ -1,0 +1,97 @@
+"""The dry run of the hardware path: a simulated harvest of the rendered bush records
+its frames, readings and commands with the rig's hw.toml; the hardware rig, fed that
+recording through its device boundary, must send the same pressure commands and end
+every berry the same way. A recording that does not match is reported as such."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from softarm.cli import main
+from softarm.harvest.frame_files import INDEX
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+#: A bush whose one ripe berry in reach is quick to pick (not a reported seed).
+SEED = 902
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    pytest.importorskip("mujoco")
+    folder = tmp_path_factory.mktemp("dry") / "rec"
+    args = ["harvest", "--sim", "--world", "bush", "--berries", "3", "--seed", str(SEED)]
+    status = main([*args, "--record-frames", str(folder), "-q"])
+    if not (folder / INDEX).is_file():
+        pytest.skip("the rendered bush is unavailable here (EGL)")
+    assert status == 0
+    return folder
+
+
+def _replay(folder: Path, tmp_path: Path) -> tuple[int, dict]:
+    report = tmp_path / "replay.json"
+    status = main(
+        ["harvest", "--config", str(folder / "hw.toml"), "--frames", str(folder),
+         "--dry-run", "--report", str(report), "--log", str(tmp_path / "replay.jsonl"), "-q"]
+    )  # fmt: skip
+    return status, json.loads(report.read_text())
+
+
+def test_the_hardware_path_sends_the_recorded_commands(recording: Path, tmp_path: Path) -> None:
+    status, report = _replay(recording, tmp_path)
+    dry = report["dry_run"]
+    assert status == 0 and dry["same"]
+    assert dry["count"][0] == dry["count"][1] > 10
+    assert dry["max_psi"] <= 1e-9 and dry["berries_as_recorded"]
+    assert report["berries"] and report["berries"][0]["final_state"] == "done"
+    logged = [
+        json.loads(line)
+        for line in (tmp_path / "replay.jsonl").read_text().splitlines()
+        if '"pressure_command"' in line
+    ]
+    assert len(logged) >= dry["count"][0]  # and the close's vent
+
+
+def test_a_different_ripeness_reading_is_not_the_recording(recording: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "tampered"
+    shutil.copytree(recording, folder)
+    index = json.loads((folder / INDEX).read_text())
+    index["streams"]["ripeness"] = [0.0 for _ in index["streams"]["ripeness"]]
+    (folder / INDEX).write_text(json.dumps(index))
+    status, report = _replay(folder, tmp_path)
+    assert status == 1 and not report["dry_run"]["same"]
+
+
+def test_a_missing_frame_is_a_one_line_error(
+    recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "holed"
+    shutil.copytree(recording, folder)
+    (folder / "c2_000003.png").unlink()
+    status = main(
+        ["harvest", "--config", str(folder / "hw.toml"), "--frames", str(folder), "--dry-run"]
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "c2_000003.png" in err[0] and "missing" in err[0]
+
+
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (["--config", "hw.toml", "--dry-run"], "--frames"),
+        (["--config", "hw.toml", "--frames", "x"], "--dry-run"),
+        (["--sim", "--record-frames", "x"], "--world bush"),
+    ],
+)
+def test_the_dry_run_options_outside_their_mode_are_refused(
+    args: list[str], named: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "hw.toml").write_text("")
+    os.chdir(tmp_path)
+    assert main(["harvest", *args]) == 2
+    assert named in capsys.readouterr().err
