@@ -181,7 +181,7 @@ REEXPORTS = (
 )
 #: Modules that still import a re-export, to be moved to the real module (issue 27 item 5).
 #: This set may only shrink.
-STILL_REEXPORTED = {"harvest/machine.py", "harvest/rig.py", "harvest/servo.py"}
+STILL_REEXPORTED: set[str] = set()
 
 
 def test_the_package_imports_no_reexport_module() -> None:

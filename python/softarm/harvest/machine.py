@@ -31,7 +31,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from softarm.errors import HardwareError, NonFiniteError, SafetyError, VisionError
-from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryTarget,
     Clock,
@@ -50,6 +49,7 @@ from softarm.harvest.outcome import Fault
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.servo import Servo
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+from softarm.harvest_config import HarvestConfig
 
 __all__ = ["HarvestMachine"]
 

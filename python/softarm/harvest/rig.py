@@ -22,10 +22,10 @@ from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.actuator import PressureMap, SafeActuator, lead_gain
 from softarm.harvest.clearance import Clearance
-from softarm.harvest.config import HarvestConfig
 from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK, planning_resolver
 from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_alpha
+from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 
 __all__ = ["ControlInputs", "ControlStack", "build_control_stack", "gains_over"]

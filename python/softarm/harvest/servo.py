@@ -11,7 +11,6 @@ from dataclasses import replace
 import numpy as np
 
 from softarm.errors import NonFiniteError, ParameterError
-from softarm.harvest.config import HarvestConfig
 from softarm.harvest.interfaces import (
     BerryFix,
     Clock,
@@ -27,6 +26,7 @@ from softarm.harvest.observe import BerryWatch
 from softarm.harvest.outcome import Ending, Fault, StageOutcome
 from softarm.harvest.states import FaultReason, HarvestState
 from softarm.harvest.targets import grasp_point, pointing_error, tool_pose
+from softarm.harvest_config import HarvestConfig
 
 __all__ = ["Fault", "Servo"]
 

@@ -279,7 +279,7 @@ def _bush(o: SimRigOptions, plant: ArmPlant, cams: SimCameras) -> Bush:
     return Bush.generate(
         plant.arm, o.n_berries, o.seed, grasp_offset=o.config.grasp_offset,
         unripe_fraction=o.unripe_fraction, view_point=cams.T_base_c1[:3, 3],
-        limits=(np.zeros_like(true_upper), true_upper),
+        limits=(np.zeros_like(true_upper), true_upper), cone_deg=o.config.approach_cone_deg,
     )  # fmt: skip
 
 
