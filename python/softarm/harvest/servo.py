@@ -24,6 +24,7 @@ from softarm.harvest.interfaces import (
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.observe import BerryWatch
 from softarm.harvest.outcome import Ending, Fault, StageOutcome
+from softarm.harvest.servo_goal import Aim, Progress, ServoGoal
 from softarm.harvest.states import FaultReason, HarvestState
 from softarm.harvest.targets import grasp_point, pointing_error, tool_pose
 from softarm.harvest_config import HarvestConfig
@@ -125,10 +126,11 @@ class Servo:
         start = self.clock.now()
         for q_way in waypoints:
             q = self.follow(watch, stage, q, q_way, start + c.placement_timeout)
-        out = self._servo(
-            watch, stage, q, axis, c.grasp_offset + c.standoff, c.placement_tolerance,
-            c.placement_timeout, None, record_errors=True, placed_on_limit=True,
+        placement = ServoGoal(
+            c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout,
+            placed_on_limit=True,
         )  # fmt: skip
+        out = self._servo(watch, stage, q, axis, placement)
         return replace(out, waypoints=waypoints)
 
     def fine(
@@ -146,11 +148,9 @@ class Servo:
         machine has a better use for the arm (another axis to try, an earlier attempt
         that ended nearer): farther out it is UNREACHABLE here, with the error."""
         c = self.cfg
-        return self._servo(
-            watch, stage, q, axis, c.grasp_offset, c.fine_tolerance, c.fine_timeout,
-            c.fine_budget, record_errors=True, placed_on_limit=False,
-            grasp_within=c.grasp_workspace if grasp_within is None else grasp_within,
-        )  # fmt: skip
+        within = c.grasp_workspace if grasp_within is None else grasp_within
+        fine = ServoGoal(c.grasp_offset, c.fine_tolerance, c.fine_timeout, c.fine_budget, within)
+        return self._servo(watch, stage, q, axis, fine)
 
     def go_home(
         self,
@@ -168,19 +168,11 @@ class Servo:
         c = self.cfg
         start = self.clock.now()
         try:
-            q = self._servo(
-                watch,
-                stage,
-                q,
-                axis,
-                c.grasp_offset + c.standoff,
-                c.placement_tolerance,
-                c.home_timeout / 2,
-                None,
-                record_errors=False,
-                placed_on_limit=False,
-                frozen=berry,
-            ).q
+            back_out = ServoGoal(
+                c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2,
+                record_errors=False, frozen=berry,
+            )  # fmt: skip
+            q = self._servo(watch, stage, q, axis, back_out).q
         except Fault as fault:
             # Backing out is best effort: the berry is already in the fingers (or the
             # machine is backing out of a fault), and the ramp home is open loop anyway.
@@ -333,8 +325,9 @@ class Servo:
         while np.any(q != goal):
             if self.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: ramp not done in time")
-            q = q + straight_step(q, goal, step)
-            self.actuator.send(q)
+            wanted = q + straight_step(q, goal, step)
+            # Go on from what was sent: a rate limit or a clamp holds the ramp back.
+            q = self._send(wanted)
             seen = self._look(watch, q, need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
@@ -344,7 +337,7 @@ class Servo:
         while settle and not self._arrived():
             if self.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: arm not settled in time")
-            self.actuator.send(q)
+            q = self._send(q)
             seen = self._look(watch, q, need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)
             self.clock.sleep(self.cfg.period)
@@ -369,111 +362,122 @@ class Servo:
     # -- the loop -------------------------------------------------------------------
 
     def _servo(
-        self,
-        watch: BerryWatch,
-        stage: HarvestState,
-        q: FloatArray,
-        axis: FloatArray,
-        distance: float,
-        tol: float,
-        timeout: float,
-        budget: float | None,
-        record_errors: bool,
-        placed_on_limit: bool,
-        frozen: FloatArray | None = None,
-        grasp_within: float = 0.0,
-    ) -> StageOutcome:
-        """Drive the end effector to ``distance`` short of the berry along the approach
-        ``axis`` until the error stays below ``tol``; see :class:`HarvestConfig`. With
-        ``frozen`` the berry position is that fixed point, not the cameras' (the berry is
-        in the fingers on the way back). With ``record_errors`` every step keeps its errors
-        at the grasp in ``watch``; with ``placed_on_limit`` a saturated arm within ``tol``
-        hands over (:attr:`Ending.PLACEMENT_LIMIT`) instead of faulting. With a ``budget``
-        the gripper grasps within ``grasp_within`` when the arm stalls on a limit
-        (:attr:`Ending.LIMIT_GRASP`) or the budget runs out (:attr:`Ending.BUDGET`); past
-        the budget, farther out but inside ``grasp_workspace``, it is UNREACHABLE (the
-        machine re-approaches)."""
-        c = self.cfg
+        self, watch: BerryWatch, stage: HarvestState, q: FloatArray, axis: FloatArray,
+        goal: ServoGoal,
+    ) -> StageOutcome:  # fmt: skip
+        """Drive the end effector to ``goal.distance`` short of the berry along the
+        approach ``axis`` until the error stays below ``goal.tol``; see
+        :class:`HarvestConfig` and :class:`ServoGoal` for how else it may end."""
         start = self.clock.now()
         watch.excuse_berry(start)  # the open-loop ramp needed no berry
-        inside = 0
-        best, best_t, saturated_since = np.inf, start, None
-        angle_tol = np.radians(c.angle_tolerance_deg)
+        progress = Progress(start)
         while True:
-            seen = self._look(watch, q, need_fix=frozen is None)
-            if frozen is not None:
-                seen = replace(seen, fix=BerryFix(frozen, "held", seen.t - start))
-            elapsed = seen.t - start
+            seen = self._look(watch, q, need_fix=goal.frozen is None)
+            if goal.frozen is not None:
+                seen = replace(seen, fix=BerryFix(goal.frozen, "held", seen.t - start))
             if seen.pose is None or seen.fix is None:
                 watch.log_step(stage, seen, q, None, None, False)
                 q = self._hold(q)
                 continue
-            # The grasp point, not the end-effector origin, is servoed onto its goal
-            # ``distance - grasp_offset`` short of the berry: a residual pointing error then
-            # does not move the berry off the fingers.
-            point = seen.fix.position - (distance - c.grasp_offset) * axis
-            goal = tool_pose(seen.pose, point, axis, c.grasp_offset)
-            err = float(np.linalg.norm(grasp_point(seen.pose, c.grasp_offset) - point))
-            ang = pointing_error(seen.pose, axis)
-            if record_errors:  # the errors at the grasp
-                watch.record_grasp_errors(
-                    float(
-                        np.linalg.norm(grasp_point(seen.pose, c.grasp_offset) - seen.fix.position)
-                    ),
-                    ang,
-                )
-            inside = inside + 1 if err <= tol and ang <= angle_tol else 0
-            if inside >= c.settle_steps:
-                watch.log_step(stage, seen, q, goal, (err, ang), False)
-                return StageOutcome(q, Ending.SETTLED, axis)
-            if budget is not None and elapsed > budget and err <= c.grasp_workspace:
-                if err > grasp_within:  # another axis is left to try
-                    raise Fault(
-                        FaultReason.UNREACHABLE,
-                        f"{stage.value}: error {err:.4f} m after the {budget:.0f} s budget",
-                        retreat_from=q,
-                        grasp_error=err,
-                    )
-                self.log.event("fine_budget", t=seen.t, error=err)
-                watch.log_step(stage, seen, q, goal, (err, ang), False)
-                return StageOutcome(q, Ending.BUDGET, axis)
-            if elapsed > timeout:
-                raise Fault(
-                    FaultReason.TIMEOUT,
-                    f"{stage.value}: error {err:.4f} m after {elapsed:.1f} s",
-                    retreat_from=q,
-                )
-            q_next, saturated = self.controller.step(q, goal, seen.pose)
-            q_next = np.asarray(q_next, dtype=np.float64)
-            if not np.all(np.isfinite(q_next)):
-                raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
-            if err < best - c.stall_progress:
-                best, best_t = err, seen.t
-            saturated_since = (saturated_since or seen.t) if saturated else None
-            if (
-                saturated_since is not None
-                and min(seen.t - saturated_since, seen.t - best_t) > c.stall_time
-            ):
-                if budget is not None and err <= grasp_within:
-                    # On a joint limit but inside the gripper's ±1 cm: grasp (III-D).
-                    self.log.event("limit_grasp", t=seen.t, error=err)
-                    return StageOutcome(q, Ending.LIMIT_GRASP, axis)
-                if placed_on_limit and err <= tol:
-                    # Placed, but a joint limit holds the pointing: fine positioning, on
-                    # the eye-in-hand camera, decides whether the berry can be reached.
-                    self.log.event("placement_limit", t=seen.t, error=err, pointing=ang)
-                    return StageOutcome(q, Ending.PLACEMENT_LIMIT, axis)
-                raise Fault(
-                    FaultReason.UNREACHABLE,
-                    f"{stage.value}: saturated at error {err:.4f} m, "
-                    f"pointing {np.degrees(ang):.1f} deg",
-                    retreat_from=q,
-                    grasp_error=err if budget is not None else None,
-                )
-            watch.log_step(stage, seen, q_next, goal, (err, ang), saturated)
+            aim = self._aim(seen, axis, goal.distance)
+            if goal.record_errors:  # the errors at the grasp
+                watch.record_grasp_errors(self._grasp_error(seen), aim.pointing)
+            ended = self._settled_or_out_of_time(watch, stage, seen, q, axis, aim, goal, progress)
+            if ended is not None:
+                return ended
+            q_next, saturated = self._loop_step(q, aim.goal, seen.pose)
+            progress.update(seen.t, aim.error, saturated, self.cfg.stall_progress)
+            if progress.stalled(seen.t, self.cfg.stall_time):
+                return self._stalled(stage, seen, q, axis, aim, goal)
+            watch.log_step(stage, seen, q_next, aim.goal, (aim.error, aim.pointing), saturated)
             # Go on from what was sent: the safety layer may have clamped or rate-limited it.
             q = self.actuator.send(q_next)
-            self.clock.sleep(c.period)
+            self.clock.sleep(self.cfg.period)
+
+    def _aim(self, seen: Observation, axis: FloatArray, distance: float) -> Aim:
+        """The grasp point, not the end-effector origin, is servoed onto its goal
+        ``distance - grasp_offset`` short of the berry: a residual pointing error then
+        does not move the berry off the fingers."""
+        assert seen.pose is not None and seen.fix is not None
+        offset = self.cfg.grasp_offset
+        point = seen.fix.position - (distance - offset) * axis
+        goal = tool_pose(seen.pose, point, axis, offset)
+        error = float(np.linalg.norm(grasp_point(seen.pose, offset) - point))
+        return Aim(goal, error, pointing_error(seen.pose, axis))
+
+    def _grasp_error(self, seen: Observation) -> float:
+        """The grasp point's distance (m) from the berry."""
+        assert seen.pose is not None and seen.fix is not None
+        return float(
+            np.linalg.norm(grasp_point(seen.pose, self.cfg.grasp_offset) - seen.fix.position)
+        )
+
+    def _loop_step(
+        self, q: FloatArray, goal: FloatArray, pose: FloatArray
+    ) -> tuple[FloatArray, bool]:
+        """The resolver's next command towards ``goal`` from the measured ``pose``."""
+        q_next, saturated = self.controller.step(q, goal, pose)
+        q_next = np.asarray(q_next, dtype=np.float64)
+        if not np.all(np.isfinite(q_next)):
+            raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
+        return q_next, saturated
+
+    def _settled_or_out_of_time(
+        self, watch: BerryWatch, stage: HarvestState, seen: Observation, q: FloatArray,
+        axis: FloatArray, aim: Aim, goal: ServoGoal, progress: Progress,
+    ) -> StageOutcome | None:  # fmt: skip
+        """SETTLED after ``settle_steps`` steps within the tolerances; past the budget,
+        BUDGET inside ``grasp_within`` (else UNREACHABLE); past the timeout, TIMEOUT;
+        else None (the loop goes on)."""
+        c = self.cfg
+        err, elapsed = aim.error, seen.t - progress.start
+        within = err <= goal.tol and aim.pointing <= np.radians(c.angle_tolerance_deg)
+        progress.inside = progress.inside + 1 if within else 0
+        if progress.inside >= c.settle_steps:
+            watch.log_step(stage, seen, q, aim.goal, (err, aim.pointing), False)
+            return StageOutcome(q, Ending.SETTLED, axis)
+        if goal.budget is not None and elapsed > goal.budget and err <= c.grasp_workspace:
+            if err > goal.grasp_within:  # another axis is left to try
+                raise Fault(
+                    FaultReason.UNREACHABLE,
+                    f"{stage.value}: error {err:.4f} m after the {goal.budget:.0f} s budget",
+                    retreat_from=q,
+                    grasp_error=err,
+                )
+            self.log.event("fine_budget", t=seen.t, error=err)
+            watch.log_step(stage, seen, q, aim.goal, (err, aim.pointing), False)
+            return StageOutcome(q, Ending.BUDGET, axis)
+        if elapsed > goal.timeout:
+            raise Fault(
+                FaultReason.TIMEOUT,
+                f"{stage.value}: error {err:.4f} m after {elapsed:.1f} s",
+                retreat_from=q,
+            )
+        return None
+
+    def _stalled(
+        self, stage: HarvestState, seen: Observation, q: FloatArray, axis: FloatArray,
+        aim: Aim, goal: ServoGoal,
+    ) -> StageOutcome:  # fmt: skip
+        """Saturated on a joint limit without progress: grasp inside ``grasp_within``
+        (III-D), hand a placement within ``tol`` over to fine positioning, or
+        UNREACHABLE."""
+        err, ang = aim.error, aim.pointing
+        if goal.budget is not None and err <= goal.grasp_within:
+            # On a joint limit but inside the gripper's ±1 cm: grasp (III-D).
+            self.log.event("limit_grasp", t=seen.t, error=err)
+            return StageOutcome(q, Ending.LIMIT_GRASP, axis)
+        if goal.placed_on_limit and err <= goal.tol:
+            # Placed, but a joint limit holds the pointing: fine positioning, on the
+            # eye-in-hand camera, decides whether the berry can be reached.
+            self.log.event("placement_limit", t=seen.t, error=err, pointing=ang)
+            return StageOutcome(q, Ending.PLACEMENT_LIMIT, axis)
+        raise Fault(
+            FaultReason.UNREACHABLE,
+            f"{stage.value}: saturated at error {err:.4f} m, pointing {np.degrees(ang):.1f} deg",
+            retreat_from=q,
+            grasp_error=err if goal.budget is not None else None,
+        )
 
     def _hold(self, q: FloatArray) -> FloatArray:
         """Keep commanding ``q`` (it also feeds the safety layer's watchdog) and wait;
