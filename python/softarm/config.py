@@ -131,8 +131,10 @@ class CalibrationConfig:
     """Cameras, extrinsics and marker geometry: ``T_C1_base`` (base in the eye-to-hand
     camera C1) and ``T_C2_EE`` (end effector in the eye-in-hand camera C2), 4×4, or
     ``None`` if unknown; ``T_EE_cube``, the marker cube in the end-effector frame (eq. 22;
-    as built: 5 cm behind the gripper frame), and ``berry_tag``, the side (m) of the
-    berry ArUco tags (the paper's 12 mm, section III-D)."""
+    as built: 5 cm behind the gripper frame), ``berry_tag``, the side (m) of the
+    berry ArUco tags (the paper's 12 mm, section III-D), and ``T_base_tag``, the base
+    tag on its bracket in the base frame (None: not known), which the cane fit leaves
+    out as the rig's own (:mod:`softarm.harvest.rig_parts`)."""
 
     c1: CameraConfig = field(default_factory=CameraConfig)
     c2: CameraConfig = field(default_factory=lambda: CameraConfig(source=1))
@@ -141,6 +143,7 @@ class CalibrationConfig:
     T_EE_cube: Matrix = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, -0.05),
                          (0.0, 0.0, 0.0, 1.0))  # fmt: skip
     berry_tag: float = 0.012
+    T_base_tag: Matrix | None = None
 
 
 @dataclass(frozen=True)
@@ -402,6 +405,7 @@ def _calibration(t: _Table) -> CalibrationConfig:
         _pose(t, "T_C2_EE"),
         _pose(t, "T_EE_cube") or d.T_EE_cube,
         t.number("berry_tag", d.berry_tag, positive=True),
+        _pose(t, "T_base_tag"),
     )
     t.done()
     return calibration
@@ -607,7 +611,8 @@ def dump_config(config: Config) -> str:
     out += ["[gains]", *_lines(config.gains.values), ""]
     cal = config.calibration
     poses = {"T_C1_base": cal.T_C1_base, "T_C2_EE": cal.T_C2_EE, "T_EE_cube": cal.T_EE_cube}
-    out += ["[calibration]", *_lines({**poses, "berry_tag": cal.berry_tag}), ""]
+    tags = {"berry_tag": cal.berry_tag, "T_base_tag": cal.T_base_tag}
+    out += ["[calibration]", *_lines({**poses, **tags}), ""]
     for name, cam in (("c1", cal.c1), ("c2", cal.c2)):
         written = {k: v for k, v in asdict(cam).items() if k != "folder"}
         out += [f"[calibration.{name}]", *_lines(written), ""]

@@ -121,11 +121,12 @@ class RigDescription:
         T_ee_c2: FloatArray,
         T_ee_cube: FloatArray,
         berry_tag: float,
+        T_base_tag: FloatArray,
     ) -> None:
         self.model, self.harvest, self.gains, self.plant = model, harvest, gains, plant
         self.stereo, self.T_C1_base = scene.c1(), scene.T_C1_base
         self.c2, self.T_ee_c2, self.T_ee_cube = c2, T_ee_c2, T_ee_cube
-        self.berry_tag = berry_tag
+        self.berry_tag, self.T_base_tag = berry_tag, T_base_tag
 
     def config(self) -> Config:
         """The hardware configuration: the rig's arm, the default channels (the
@@ -142,6 +143,7 @@ class RigDescription:
             T_C2_EE=_matrix(invert(self.T_ee_c2)),
             T_EE_cube=_matrix(self.T_ee_cube),
             berry_tag=self.berry_tag,
+            T_base_tag=_matrix(self.T_base_tag),
         )
         return Config(
             ArmConfig(sections),

@@ -177,9 +177,11 @@ def _stereo_c1(config: Config, devices: Devices, stack: ExitStack) -> StereoC1 |
 def _perceived_canes(
     c1: StereoC1, config: Config, cfg: HarvestConfig, model: SoftArm
 ) -> list[PolynomialCurve]:
-    """The canes fitted from C1's stereo, the arm and its cube left out (the base tag's
-    pose is not configured: its fit, if any, lies beyond the arm's gap)."""
-    parts = rig_parts(model, cfg, np.array(config.calibration.T_EE_cube), None)
+    """The canes fitted from C1's stereo, the arm, its cube and (where the config
+    places it) the base tag left out as the rig's own."""
+    cal = config.calibration
+    tag = None if cal.T_base_tag is None else np.array(cal.T_base_tag)
+    parts = rig_parts(model, cfg, np.array(cal.T_EE_cube), tag)
     return c1.fit_canes(parts, CANE_REACH)
 
 

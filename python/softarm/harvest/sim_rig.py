@@ -358,7 +358,7 @@ def _bush_world(
         identified = o.identified or declared_plant(o.plant, model.n_actuators, cfg.period)
         rig = RigDescription(
             model, cfg, dict(o.gains), identified, scene, scene.world.c2,
-            cams.T_ee_c2, cams.T_ee_cube, cams.berry_tag,
+            cams.T_ee_c2, cams.T_ee_cube, cams.berry_tag, cams.T_base_tag,
         )  # fmt: skip
         write_rig_files(recorder.folder, rig)
     return scene, vision, gripper, canes
