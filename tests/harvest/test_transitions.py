@@ -5,9 +5,11 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest import BerryTarget, FaultReason, HarvestConfig, HarvestState
+from softarm.harvest.outcome import Fault
 from softarm.harvest.targets import grasp_point
 
 from .fakes import BERRIES, commanded_before_the_vent, make_rig
@@ -31,6 +33,13 @@ def test_happy_path_visits_every_state_in_order_and_ends_at_rest() -> None:
     home_psi = rig.machine.config.home_elongation / METRES_PER_PSI
     assert np.allclose(rig.plant.psi, home_psi)  # back at the ready pose
     assert not rig.gripper.closed  # berry dropped at home
+    # The way home is closed on the tracked cube (goals in the step log), not ramped.
+    kinds = [r["kind"] for r in rig.machine.log.records]
+    assert "return_open_loop" not in kinds
+    home_steps = [
+        r for r in rig.machine.log.records if r["kind"] == "step" and r["state"] == "return_home"
+    ]
+    assert any(r["goal"] is not None for r in home_steps)
     assert rig.bank.vent_log[-1].reason == "startup"  # never vented: no fault
 
 
@@ -77,11 +86,22 @@ def test_timeout_in_fine_positioning_faults_and_vents() -> None:
     assert rig.vented()
 
 
-def test_a_retreat_that_fails_vents_where_it_is_with_the_first_fault() -> None:
+def test_a_retreat_that_fails_vents_where_it_is_with_the_first_fault(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     config = HarvestConfig(
         fine_timeout=0.3, fine_budget=0.2, grasp_workspace=1e-4, home_timeout=0.01
     )
     rig = make_rig(config=config)
+    servo, ramp = rig.machine.servo, rig.machine.servo.ramp
+
+    def stuck(watch: object, stage: S, *args: object, **kwargs: object) -> object:
+        # The ramp home (after the closed loop ran out of its 10 ms) cannot finish.
+        if stage is S.RETURN_HOME:
+            raise Fault(FaultReason.TIMEOUT, "return_home: ramp not done in time")
+        return ramp(watch, stage, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(servo, "ramp", stuck)
     result = rig.machine.run_berry(BerryTarget(1))
     assert result.fault is FaultReason.TIMEOUT
     fault = next(r for r in rig.machine.log.records if r["kind"] == "fault")

@@ -187,12 +187,40 @@ class Servo:
             self.log.event("retreat_incomplete", t=self.clock.now(), detail=str(fault))
             if fault.retreat_from is not None:  # where the loop left the arm
                 q = fault.retreat_from
-        # Leave by the planned way in (checked against the known canes), reversed. The
-        # first is the plan's pre-grasp q, a few mm of elongation from where the back-out
-        # left the arm: the ramp on from it need not wait for the arm to settle there.
-        for k, q_way in enumerate(reversed(waypoints)):
-            q = self.ramp(watch, stage, q, q_way, start + c.home_timeout, settle=k > 0)
-        return self.ramp(watch, stage, q, home, start + c.home_timeout)
+        return self._way_back(watch, stage, q, (*reversed(waypoints), home), start)
+
+    def _way_back(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        way: Sequence[FloatArray],
+        start: float,
+    ) -> FloatArray:
+        """Leave by the planned way in, reversed, then home (the last of ``way``),
+        closed on the tracked cube as the way in was (:meth:`follow`: the canes repel
+        inside the resolver's step, the way to each command is checked): the model may be
+        centimetres off the true arm (a rod sagging under gravity), and a ramp open loop
+        through the model's waypoints would carry the true arm wherever that error puts
+        it. The loop ends on the exact home q, open loop from where it left the arm. If
+        the cube is lost or the loop runs out of ``home_timeout``, the rest of the way is
+        ramped open loop (the only way out: vented in the bush, the arm would relax
+        through the canes)."""
+        c = self.cfg
+        legs = list(way)
+        try:
+            while legs:
+                q = self.follow(watch, stage, q, legs[0], start + c.home_timeout)
+                legs.pop(0)
+        except Fault as fault:
+            if fault.reason not in (FaultReason.TIMEOUT, FaultReason.MARKER_LOST):
+                raise
+            self.log.event("return_open_loop", t=self.clock.now(), detail=str(fault))
+            q = fault.retreat_from if fault.retreat_from is not None else q
+            for q_way in legs[:-1]:
+                q = self.ramp(watch, stage, q, q_way, self.clock.now() + c.home_timeout)
+        home = way[-1]
+        return self.ramp(watch, stage, q, home, self.clock.now() + c.home_timeout)
 
     def follow(
         self,
