@@ -47,6 +47,8 @@ def written_by_readme() -> set[str]:
         for i, word in enumerate(words[:-1]):
             if word in ("--out", "--log", "--record", "--report", "init"):
                 out.add(words[i + 1])
+            if word == "--record-frames":  # the recording's folder and its hw.toml
+                out.add(words[i + 1].rstrip("/") + "/hw.toml")
     return out
 
 
