@@ -175,6 +175,7 @@ def harvest_bush(
     """Pick the map's ripe berries one by one (:func:`~softarm.harvest.map_harvest.
     harvest_map`, the loop the arm runs), each result judged against the true bush."""
     report = HarvestReport()
+    index: dict[int, int] = {}  # map berry -> its place in the report (a retry replaces)
 
     def judged(entry: MappedBerry, result: BerryResult) -> None:
         truth = scene.truth_of(entry.id)
@@ -183,9 +184,13 @@ def harvest_bush(
             result.localisation_error_mm = 1000.0 * float(
                 np.linalg.norm(entry.position - truth.position)
             )
-        report.berries.append(result)
+        if entry.id in index:  # the berry's last attempt stands, as in the tag world
+            report.berries[index[entry.id]] = result
+        else:
+            index[entry.id] = len(report.berries)
+            report.berries.append(result)
         if on_berry is not None:
-            on_berry(len(report.berries) - 1, result)
+            on_berry(index[entry.id], result)
 
     rounds = len(scene.bush.berries) + 8
     harvest_map(scene.look, scene.bush_map, run_berry, rounds, judged, stop_on=FAULTS_THAT_STOP)

@@ -1,7 +1,9 @@
 """The markerless harvest's loop, the same in the rendered bush and on the arm: pick
 the bush map's ripe berries one by one, left to right, looking again with C1 each time
 the arm is home (a berry the arm or a picked one hid may come into view), until no ripe
-berry is left untried."""
+berry is left untried. A berry lost from view (MARKER_LOST: the cube or the berry out of
+sight too long) is tried once more after the others, as the tag world does: from
+another start the cameras may keep it."""
 
 from __future__ import annotations
 
@@ -28,14 +30,19 @@ def harvest_map(
     tried yet; ``on_result(entry, result)`` after each; a fault in ``stop_on`` ends it."""
     results: list[BerryResult] = []
     tried: set[int] = set()
+    lost: set[int] = set()  # lost from view once: one more try
     for _ in range(rounds):
         look()
-        todo = [b for b in bush_map.ripe() if b.id not in tried]
+        ripe = bush_map.ripe()
+        todo = [b for b in ripe if b.id not in tried] or [b for b in ripe if b.id in lost]
         if not todo:
             break
         entry = min(todo, key=lambda b: b.position[0])  # left to right
-        tried.add(entry.id)
+        lost.discard(entry.id)
         result = run_berry(BerryTarget(entry.id, f"map berry {entry.id}"))
+        if result.fault is FaultReason.MARKER_LOST and entry.id not in tried:
+            lost.add(entry.id)
+        tried.add(entry.id)
         results.append(result)
         if on_result is not None:
             on_result(entry, result)
