@@ -45,6 +45,12 @@ def write_json(path: Path, data: dict[str, Any]) -> None:
     path.write_text(json.dumps(clean(data), indent=2) + "\n")
 
 
+def channel_labels(n: int) -> list[str]:
+    """The actuators' names in the papers' numbering, ``l11`` ... ``l33``: section then
+    actuator, from 1 (docs/architecture.md; the API's q[3i + j] is l(i+1)(j+1))."""
+    return [f"l{i // 3 + 1}{i % 3 + 1}" for i in range(n)]
+
+
 def plot_comparison(
     path: Path,
     title: str,
@@ -78,7 +84,10 @@ def plot_comparison(
         k = 2
     for name, tr in traces.items():
         ax = axes[k]
-        ax.plot(tr.time, np.asarray(tr.command_psi))
+        psi = np.asarray(tr.command_psi)
+        for j, label in enumerate(channel_labels(psi.shape[1])):
+            ax.plot(tr.time, psi[:, j], label=label, lw=1.0)
+        ax.legend(ncol=3, fontsize=6, title="channel", title_fontsize=6, loc="upper right")
         ax.axhline(0.0, color="k", lw=0.8)
         ax.axhline(max_psi, color="k", lw=0.8, ls="--")
         ax.set_ylabel("command (psi)")
