@@ -401,6 +401,28 @@ class LagModel:
     def __reduce__(self) -> tuple[type[LagModel], tuple[float, float, _F64]]:
         """Pickles as ``LagModel(tau_s, period_s, q)``: the predicted state travels."""
 
+LEAD_GAIN_CAP: float
+PREDICTED_ALPHA_MAX: float
+PREDICTED_ALPHA_LAG_S: float
+PREDICTED_ALPHA_MIN: float
+
+def play(output: _ArrayLike, input: _ArrayLike, width: _ArrayLike) -> _F64:
+    """The play (backlash) operator per channel, ``clip(output, input - width/2, input +
+    width/2)`` (a new array): the one law of play, which the simulated hysteresis and the
+    controller's measurement model both apply. Raises ShapeError for lengths that differ,
+    NonFiniteError for a non-finite output or input, ParameterError for a width < 0."""
+
+def lead_gain(tau_s: float, period_s: float, cap: float = ...) -> float:
+    """The regulators' pre-compensation gain ``k``: half the overshoot-free bound
+    ``a/(1 - a)``, ``a = exp(-period_s/tau_s)``, at most ``cap`` (``LEAD_GAIN_CAP``,
+    1.5); 0 for ``tau_s = 0`` (docs/control.md, section 6)."""
+
+def predicted_loop_alpha(lag_s: float) -> float:
+    """The resolver's gain for the loop closed through the lag model, for a measurement
+    chain lagging ``lag_s`` (s) in all: ``PREDICTED_ALPHA_LAG_S / lag_s`` within
+    [``PREDICTED_ALPHA_MIN`` (the default ``hybrid_alpha``), ``PREDICTED_ALPHA_MAX``];
+    the largest for no lag (docs/control.md, section 6)."""
+
 # --- distance queries and planning (planning paper eq. 9-18) -------------------------
 
 @final
@@ -561,3 +583,57 @@ def path_clearance(
 
 def paper_scenario(name: str) -> tuple[_F64, list[PolynomialCurve]]:
     """The planning paper's simulation "line", "curve" or "tree": (goal, curves)."""
+
+# --- the arm's body -------------------------------------------------------------------
+
+ACTUATOR_RADIUS: float
+GRIPPER_RADIUS: float
+CANE_RADIUS: float
+
+@final
+class Body:
+    """The arm's body, the one description every clearance measures: each section's tube
+    (``section_radii``: ring radius + ``ACTUATOR_RADIUS``), each inner section's end plate
+    (its section's radius), and the gripper, a capsule of ``gripper_radius`` along the
+    end-effector's z axis from ``gripper_back`` behind its frame to ``grasp_offset``
+    ahead of it (m)."""
+
+    def __new__(
+        cls,
+        section_radii: _ArrayLike,
+        gripper_radius: float,
+        gripper_back: float,
+        grasp_offset: float,
+    ) -> Body: ...
+    @staticmethod
+    def for_arm(arm: SoftArm, grasp_offset: float) -> Body:
+        """The body of ``arm``: its ring radii + ``ACTUATOR_RADIUS``, a gripper of
+        ``GRIPPER_RADIUS`` from the distal arc's tip to ``grasp_offset`` (m) ahead of the
+        end-effector frame."""
+    @property
+    def section_radii(self) -> _F64:
+        """Each section's surface radius about its backbone (m), proximal first."""
+    @property
+    def gripper_radius(self) -> float: ...
+    @property
+    def gripper_back(self) -> float: ...
+    @property
+    def grasp_offset(self) -> float: ...
+    @property
+    def widest(self) -> float:
+        """The widest surface radius of the body (m)."""
+    def gap(
+        self,
+        arm: SoftArm | ArcChain,
+        q: _ArrayLike,
+        obstacles: Sequence[_Obstacle],
+        obstacle_radius: float = ...,
+    ) -> float:
+        """Smallest surface gap (m) between the body on ``arm`` at ``q`` and
+        ``obstacles``, each of radius ``obstacle_radius`` (``CANE_RADIUS`` by default):
+        the exact backbone distance of each piece less its radius and the obstacle's; inf
+        without obstacles, below zero when the surfaces overlap."""
+    def __reduce__(self) -> tuple[type[Body], tuple[_F64, float, float, float]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
+    __hash__: None  # type: ignore[assignment]

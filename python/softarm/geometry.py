@@ -2,7 +2,9 @@
 surfaces and the cane, and the fan of approach axes around a direction and how wide it
 opens by default.
 
-This module imports only numpy, so :mod:`softarm.sim` (the bush generator, the Cosserat
+The radii are declared once, in the Rust core (``crates/softarm-core/src/body.rs``, with
+the arm's whole :class:`softarm._core.Body`), and re-exported here. This module imports
+only numpy and ``softarm._core``, so :mod:`softarm.sim` (the bush generator, the Cosserat
 clearance) and :mod:`softarm.harvest` (clearance, placement) both take these from below
 (see ``docs/architecture.md``, "Layers").
 """
@@ -12,16 +14,14 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+# Radius (m) of one pneumatic artificial muscle (5/8" braided sleeve, section II-A), of
+# the gripper with its fingers around its axis, and of a blackberry cane.
+from softarm._core import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
+
 __all__ = ["ACTUATOR_RADIUS", "APPROACH_CONE_DEG", "CANE_RADIUS", "GRIPPER_RADIUS", "cone_axes"]
 
 FloatArray = npt.NDArray[np.float64]
 
-#: Radius (m) of one pneumatic artificial muscle (5/8" braided sleeve, section II-A).
-ACTUATOR_RADIUS = 0.008
-#: Radius (m) of the gripper with its fingers, around its axis.
-GRIPPER_RADIUS = 0.025
-#: Radius (m) of a blackberry cane.
-CANE_RADIUS = 0.005
 #: How far (deg) a placement plan may tilt the approach from its axis: the default of
 #: ``HarvestConfig.approach_cone_deg``, and the cone the simulated bush keeps its canes
 #: out of (``softarm.sim.bush.Bush.generate``), so that every axis the planner may choose

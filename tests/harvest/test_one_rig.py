@@ -59,7 +59,7 @@ def _settings(stack: rig.ControlStack) -> dict[str, Any]:
         "limits": [x.tolist() for x in c.limits()],
         "lead": a._lead,
         "lag_period": None if lag is None else lag.period,
-        "play": None if lag is None else lag._half_play.tolist(),
+        "play": None if lag is None else lag._play.tolist(),
         "regulators": None if lag is None else _lag(lag._regulators),
         "sensor": None if lag is None else _lag(lag._filter),
         "planner_gains": p.resolver.gains.as_dict(),

@@ -26,6 +26,7 @@
 
 pub mod arc;
 pub mod arc_chain;
+pub mod body;
 pub mod chain;
 pub mod distance;
 pub mod error;
@@ -37,6 +38,7 @@ pub mod soft_arm;
 
 pub use arc::ArcParams;
 pub use arc_chain::ArcChain;
+pub use body::{Body, BodyGap, Part, ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS};
 pub use distance::{
     closest, Closest, Obstacle, PointCloud, PolynomialCurve, Segment, TriangleMesh,
 };

@@ -389,7 +389,10 @@ pub fn obstacle_from(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Obstacle> {
 }
 
 /// Applies `f` to the obstacle held by `obj` without copying it (a point is built).
-fn with_obstacle<R>(obj: &Bound<'_, PyAny>, f: impl FnOnce(&Obstacle) -> R) -> PyResult<R> {
+pub(crate) fn with_obstacle<R>(
+    obj: &Bound<'_, PyAny>,
+    f: impl FnOnce(&Obstacle) -> R,
+) -> PyResult<R> {
     if let Ok(c) = obj.cast::<PolynomialCurve>() {
         return Ok(f(&c.get().obstacle));
     }

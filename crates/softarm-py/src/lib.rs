@@ -2,6 +2,7 @@
 //! (numpy ↔ nalgebra, core errors → `softarm.errors` exceptions) and releases the GIL
 //! around batch work; all math lives in softarm-core.
 
+mod body;
 mod convert;
 mod distance;
 mod errors;
@@ -19,5 +20,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     resolver::register(m)?;
     distance::register(m)?;
     planner::register(m)?;
+    body::register(m)?;
     Ok(())
 }

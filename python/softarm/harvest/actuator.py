@@ -17,6 +17,7 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
+from softarm._core import lead_gain
 from softarm.checks import FloatArray
 from softarm.errors import NonFiniteError, ParameterError
 from softarm.hardware.pressure_map import ElongationMap
@@ -33,21 +34,6 @@ class PressureMap(Protocol):
     def to_psi(self, elongation: npt.ArrayLike, *, clamp: bool = True) -> FloatArray: ...
 
     def to_elongation(self, psi: npt.ArrayLike, *, clamp: bool = True) -> FloatArray: ...
-
-
-def lead_gain(tau_s: float, period_s: float, cap: float = 1.5) -> float:
-    """The pre-compensation gain ``k`` for regulators of time constant ``tau_s`` driven
-    every ``period_s``: half the overshoot-free bound ``a/(1 − a)``, ``a = e^{−T/τ}``
-    (docs/control.md, section 6), at most ``cap``. The cap (tuned on seeds 0–3) keeps the
-    boosted commands near the planned path: a larger boost saturates some channels at 0
-    or 70 psi and not others, and the arm leaves the straight line in q between two plan
-    waypoints that the canes were checked against."""
-    if not (np.isfinite(tau_s) and tau_s >= 0 and np.isfinite(period_s) and period_s > 0):
-        raise ParameterError(f"tau_s = {tau_s!r}, period_s = {period_s!r}: need tau >= 0, T > 0")
-    if tau_s == 0:
-        return 0.0
-    a = float(np.exp(-period_s / tau_s))
-    return min(cap, 0.5 * a / (1.0 - a))
 
 
 class SafeActuator:

@@ -1,10 +1,12 @@
 """Clearance between the arm's body and the canes.
 
-The arm is its three arcs, each with the section's body radius (actuator ring radius +
-actuator radius), plus the gripper, a cylinder from the distal plate to the grasp point.
-The arc-to-cane distance is exact (``softarm.closest``, planning paper eq. 12–18); the
-gripper's straight part is sampled (6 points against canes sampled every ~2 mm). The gap is
-distance minus the body radius and the cane radius: below zero the surfaces touch.
+The body is the core's one description of it, :class:`softarm._core.Body`
+(``crates/softarm-core/src/body.rs``): each section's arc with the section's body radius
+(actuator ring radius + actuator radius), the inner sections' end plates, and the gripper,
+a capsule from the distal arc's tip to the grasp point. The gap is exact for every piece
+(the backbone-to-cane distance of ``softarm.closest``, planning paper eq. 12–18) less the
+piece's radius and the cane's: below zero the surfaces touch. The Cosserat rod's ground
+truth (``softarm.sim.cosserat.clearance``) measures the same radii and gripper.
 """
 
 from __future__ import annotations
@@ -13,10 +15,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from softarm._core import PolynomialCurve, SoftArm, closest
+from softarm._core import Body, PolynomialCurve, SoftArm
 from softarm.checks import FloatArray
 
-# The radii are defined once in softarm.geometry (the Cosserat plant uses them too).
+# The radii are declared once, in the core (softarm.geometry re-exports them).
 from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
 
 __all__ = ["ACTUATOR_RADIUS", "CANE_RADIUS", "GRIPPER_RADIUS", "Clearance"]
@@ -33,25 +35,11 @@ class Clearance:
 
     def __init__(self, arm: SoftArm, canes: Sequence[PolynomialCurve], grasp_offset: float) -> None:
         self.arm, self.canes, self.offset = arm, list(canes), grasp_offset
-        sections = arm.sections
-        self.radii = [s.radius + ACTUATOR_RADIUS + CANE_RADIUS for s in sections]
-        self.plate = sections[-1].offset
-        self.samples = [c(np.linspace(*c.u_range, 150)) for c in self.canes]  # (150, 3) each
+        self.body = Body.for_arm(arm, grasp_offset)
 
     def gap(self, q: FloatArray) -> float:
         """Smallest surface gap (m) at ``q``; inf without canes; < 0 means contact."""
-        if not self.canes:
-            return float("inf")
-        gaps = []
-        for cane in self.canes:
-            c = closest(self.arm, q, cane)
-            gaps.append(c.distance - self.radii[c.section])
-        ee = self.arm.forward(q)
-        tip = ee[:3, 3] + np.outer(np.linspace(-self.plate, self.offset, 6), ee[:3, 2])
-        pts = np.concatenate(self.samples)
-        d = np.linalg.norm(tip[:, None, :] - pts[None], axis=2).min()
-        gaps.append(float(d) - GRIPPER_RADIUS - CANE_RADIUS)
-        return float(min(gaps))
+        return self.body.gap(self.arm, q, self.canes, CANE_RADIUS)
 
     def path_gap(self, q0: FloatArray, q1: FloatArray, steps: int = 12) -> float:
         """Smallest gap along the straight line from ``q0`` to ``q1`` in actuator space."""

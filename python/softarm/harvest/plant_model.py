@@ -23,11 +23,25 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from softarm._core import Gains, LagModel
+from softarm._core import (
+    PREDICTED_ALPHA_LAG_S,
+    PREDICTED_ALPHA_MAX,
+    PREDICTED_ALPHA_MIN,
+    LagModel,
+    play,
+    predicted_loop_alpha,
+)
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 
-__all__ = ["MEASUREMENT_LAG_PERIODS", "MeasurementModel", "predicted_loop_alpha"]
+__all__ = [
+    "MEASUREMENT_LAG_PERIODS",
+    "PREDICTED_ALPHA_LAG_S",
+    "PREDICTED_ALPHA_MAX",
+    "PREDICTED_ALPHA_MIN",
+    "MeasurementModel",
+    "predicted_loop_alpha",
+]
 
 
 #: The measurement's own lag (control periods) the predictor puts behind the regulators:
@@ -39,37 +53,10 @@ __all__ = ["MEASUREMENT_LAG_PERIODS", "MeasurementModel", "predicted_loop_alpha"
 #: tracker filter the rig used to assume; docs/control.md, section 6).
 MEASUREMENT_LAG_PERIODS = 1.0
 
-#: The predicted loop's gain on a quick plant, and the lag-time product it keeps below
-#: on a slower one (:func:`predicted_loop_alpha`; tuned on seeds 0–3, docs/control.md).
-#: 0.9 keeps ``α (1 + δ) < 1`` for a plant's gain up to 11 % above the model's, the
-#: range where the lag-free iteration converges without overshoot; 0.21 s keeps τ = 0.3 s
-#: at the 0.6 it was tuned at.
-PREDICTED_ALPHA_MAX = 0.9
-PREDICTED_ALPHA_LAG_S = 0.21
-#: The mode's own gain, the floor on any plant: read from the core's default gains, so
-#: that it follows ``hybrid_alpha`` rather than copying it.
-PREDICTED_ALPHA_MIN = Gains().hybrid_alpha
-
-
-def predicted_loop_alpha(lag_s: float) -> float:
-    """The resolver's gain for the loop closed through the lag model, for a measurement
-    chain lagging ``lag_s`` in all (regulators + measurement lag, s).
-
-    With an exact model the predicted loop is the lag-free iteration ``u ← u + α J⁺ e(u)``
-    and any ``0 < α < 1`` converges without overshoot whatever the lag (docs/control.md,
-    section 2). What the model leaves out (the play, the measurement's true lag, an error in
-    τ) acts for a time that grows with the lag, so the gain is cut as the lag grows:
-    ``α = PREDICTED_ALPHA_LAG_S / lag_s`` between the mode's own gain
-    (``PREDICTED_ALPHA_MIN``, 0.3) and 0.9. Measured on
-    seeds 0–3 at 5 psi of play: 0.6 shortens fine positioning by a third at τ = 0.08 and
-    0.3 s against 0.3; at τ = 0.08 s 0.9 is quicker again (3.2 → 2.8 s per berry), at
-    τ = 0.3 s 0.69 was less accurate than 0.6; at τ = 1 s both 0.45 and 0.6 were slower
-    and less accurate than 0.3."""
-    if not (np.isfinite(lag_s) and lag_s >= 0):
-        raise ParameterError(f"lag_s = {lag_s!r}: must be finite and >= 0")
-    if lag_s == 0:
-        return PREDICTED_ALPHA_MAX
-    return float(np.clip(PREDICTED_ALPHA_LAG_S / lag_s, PREDICTED_ALPHA_MIN, PREDICTED_ALPHA_MAX))
+# The predicted loop's gain law and its constants are the core's (control math, beside
+# LagModel: crates/softarm-core/src/resolver/lag.rs), re-exported here:
+# ``predicted_loop_alpha(lag_s) = PREDICTED_ALPHA_LAG_S / lag_s`` within
+# [PREDICTED_ALPHA_MIN (the default hybrid_alpha), PREDICTED_ALPHA_MAX].
 
 
 def _widths(play_m: float | npt.ArrayLike, n: int) -> FloatArray:
@@ -112,9 +99,9 @@ class MeasurementModel:
         for name, value in (("tau_s", tau_s), ("filter_s", filter_s)):
             if not (np.isfinite(value) and value >= 0):
                 raise ParameterError(f"{name} = {value!r}: must be finite and >= 0")
-        play = _widths(play_m, n)
+        widths = _widths(play_m, n)
         self.period = float(period_s)
-        self._half_play = 0.5 * play.copy()
+        self._play = widths.copy()  # the band widths of softarm._core.play
         zeros = np.zeros(n)
         self._arm = zeros.copy()  # the play's output: where the actuators are
         self._regulators = LagModel(tau_s, period_s, zeros) if tau_s > 0 else None
@@ -138,8 +125,7 @@ class MeasurementModel:
             self._pressure = np.asarray(self._regulators.advance(drive))
         else:
             self._pressure = np.asarray(drive, dtype=np.float64).copy()
-        h = self._half_play
-        self._arm = np.clip(self._arm, self._pressure - h, self._pressure + h)
+        self._arm = play(self._arm, self._pressure, self._play)
         if self._filter is not None:
             self._filter.advance(self._arm)
 
@@ -152,9 +138,7 @@ class MeasurementModel:
         last target: ``q − ŷ`` without play; with it, the play's output at the end of
         that monotone approach, ``clip(arm, q − w/2, q + w/2)``, less ŷ (a command
         inside the band moves nothing)."""
-        h = self._half_play
-        final = np.clip(self._arm, self._target - h, self._target + h)
-        return final - self.measured
+        return play(self._arm, self._target, self._play) - self.measured
 
     def arm_in_flight(self) -> FloatArray:
         """The motion (m) the actuators themselves will still make towards the last

@@ -16,15 +16,22 @@ from typing import Any
 
 import numpy as np
 
-from softarm._core import Gains, PolynomialCurve, Resolver, SoftArm
+from softarm._core import (
+    Gains,
+    PolynomialCurve,
+    Resolver,
+    SoftArm,
+    lead_gain,
+    predicted_loop_alpha,
+)
 from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.safety import SafePressureBank
-from softarm.harvest.actuator import PressureMap, SafeActuator, lead_gain
+from softarm.harvest.actuator import PressureMap, SafeActuator
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.controller import ResolverController
 from softarm.harvest.ik import ModelIK, planning_resolver
-from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS, predicted_loop_alpha
+from softarm.harvest.plant_model import MEASUREMENT_LAG_PERIODS
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 

@@ -3,13 +3,15 @@
 The output follows the input only once the input has moved more than half the band
 width ``w`` away from it, ``y = clip(y_prev, x - w/2, x + w/2)``; it depends on the
 path of the input, not on its speed. A pneumatic muscle's braid friction gives this
-kind of loop between pressure and length."""
+kind of loop between pressure and length. The law is the core's (``softarm._core.play``),
+which the controller's model of the plant (``softarm.harvest.plant_model``) applies too."""
 
 from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
 
+from softarm._core import play
 from softarm.errors import ParameterError
 
 
@@ -28,7 +30,5 @@ class PlayHysteresis:
 
     def __call__(self, x: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Feeds input ``x``; returns the operator outputs."""
-        x = np.asarray(x, dtype=np.float64)
-        half = 0.5 * self.width
-        self.output = np.clip(self.output, x - half, x + half)
+        self.output = play(self.output, np.asarray(x, dtype=np.float64), self.width)
         return self.output.copy()

@@ -254,12 +254,8 @@ declare_gains! {
     }
 }
 
-/// Radius (m) of an actuator: the body reaches this far beyond the actuators' axes.
-pub const ACTUATOR_RADIUS: f64 = 0.008;
-
-/// Radius (m) of a cane, the obstacle the repulsion is tuned for: a cane's backbone
-/// curve must stay this much farther away.
-pub const CANE_RADIUS: f64 = 0.005;
+// The body's radii are declared once, in [`crate::body`].
+pub use crate::body::{ACTUATOR_RADIUS, CANE_RADIUS};
 
 /// Lag the default gains tolerate in closed loop (control periods): 20, i.e. 1 s at the
 /// 50 ms period of the harvest, the slow end of pneumatic regulators behind long hoses.
@@ -355,14 +351,18 @@ impl Gains {
         }
     }
 
-    /// [`Gains::blackberry`] with the body radius of `arm`: its largest actuator radius
-    /// plus [`ACTUATOR_RADIUS`] and [`CANE_RADIUS`] (capped at the field's bound, 1 m).
+    /// [`Gains::blackberry`] with the body radius of `arm`: the widest surface radius of
+    /// its [`crate::body::Body`] (its largest actuator radius plus [`ACTUATOR_RADIUS`], or
+    /// the gripper's where that is wider) plus [`CANE_RADIUS`] (capped at the field's
+    /// bound, 1 m). The repulsion measures every piece with this one radius, the body's
+    /// envelope.
     /// The other gains are dimensionless or tuned per step and carry over to arms of
     /// similar size. `for_arm(&SoftArm::blackberry())` equals [`Gains::blackberry`].
     pub fn for_arm(arm: &crate::SoftArm) -> Self {
-        let widest = arm.sections().iter().map(|s| s.radius).fold(0.0, f64::max);
+        // Every valid arm has a body (its radii are far below the body's bounds).
+        let widest = crate::body::Body::for_arm(arm, 0.0).map_or(0.0, |b| b.widest());
         Gains {
-            body_radius: (widest + ACTUATOR_RADIUS + CANE_RADIUS).min(1.0),
+            body_radius: (widest + CANE_RADIUS).min(1.0),
             ..Gains::blackberry()
         }
     }

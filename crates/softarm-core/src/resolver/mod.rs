@@ -37,7 +37,10 @@ mod step;
 mod tasks;
 
 pub use gains::{lag_alpha, Gains, Schedule};
-pub use lag::LagModel;
+pub use lag::{
+    lead_gain, play, play_into, predicted_alpha_min, predicted_loop_alpha, LagModel, LEAD_GAIN_CAP,
+    PREDICTED_ALPHA_LAG_S, PREDICTED_ALPHA_MAX,
+};
 pub use solve::{Solution, SolveOptions, SolveTermination};
 pub use step::{StepInfo, StepInput, Workspace};
 

@@ -1,10 +1,11 @@
 """Clearance between the Cosserat rod's body and the canes (ground truth of contact).
 
-The same surfaces as :class:`softarm.harvest.clearance.Clearance` (each section's ring
-radius + one muscle, the gripper as a 25 mm cylinder from the distal plate to the grasp
-point, 5 mm canes), measured on the rod's *current* centre line: exact point-to-segment
-distances from every centre-line segment to the canes sampled at 150 points each. The
-rod's shape depends on gravity and its history, not on q alone, so ``gap`` ignores q.
+The same body as :class:`softarm.harvest.clearance.Clearance`, the core's one description
+of it (:class:`softarm._core.Body`: each section's radius, the gripper as a capsule from
+the distal arc's tip to the grasp point; 5 mm canes), measured on the rod's *current*
+centre line, a polyline: exact point-to-segment distances from every centre-line segment
+and from the gripper's axis to the canes sampled at 150 points each. The rod's shape
+depends on gravity and its history, not on q alone, so ``gap`` ignores q.
 """
 
 from __future__ import annotations
@@ -14,9 +15,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softarm._core import PolynomialCurve
+from softarm._core import Body, PolynomialCurve
 from softarm.checks import FloatArray as F64
-from softarm.geometry import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
+from softarm.geometry import CANE_RADIUS
 
 if TYPE_CHECKING:
     from softarm.sim.cosserat.plant import CosseratPlant
@@ -44,9 +45,8 @@ class RodClearance:
         self, plant: CosseratPlant, canes: Sequence[PolynomialCurve], grasp_offset: float
     ) -> None:
         self.plant, self.canes, self.offset = plant, list(canes), grasp_offset
-        sections = plant.arm.sections
-        self.radii = np.array([s.radius + ACTUATOR_RADIUS + CANE_RADIUS for s in sections])
-        self.plate = sections[-1].offset
+        self.body = Body.for_arm(plant.arm, grasp_offset)
+        self.radii = self.body.section_radii + CANE_RADIUS
         self.points = (
             np.concatenate([c(np.linspace(*c.u_range, 150)) for c in self.canes])
             if self.canes
@@ -61,10 +61,14 @@ class RodClearance:
         sec = self.plant.centreline_sections()[1:]
         d = _point_segment_distances(self.points, line[:-1], line[1:]).min(axis=1)
         body = float((d - self.radii[sec]).min())
+        # The gripper's capsule: its axis along the end-effector's z, from the distal arc's
+        # tip (gripper_back behind the end-effector frame) to the grasp point.
         ee = self.plant.pose()
-        tip = ee[:3, 3] + np.outer(np.linspace(-self.plate, self.offset, 6), ee[:3, 2])
-        dg = np.linalg.norm(tip[:, None, :] - self.points[None], axis=2).min()
-        return min(body, float(dg) - GRIPPER_RADIUS - CANE_RADIUS)
+        z = ee[:3, 2]
+        a = ee[:3, 3] - self.body.gripper_back * z
+        b = ee[:3, 3] + self.body.grasp_offset * z
+        dg = _point_segment_distances(self.points, a[None], b[None]).min()
+        return min(body, float(dg) - self.body.gripper_radius - CANE_RADIUS)
 
     def path_gap(self, q0: F64, q1: F64, steps: int = 12) -> float:
         """The rod cannot be evaluated at other commands: the gap now."""
