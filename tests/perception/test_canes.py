@@ -3,6 +3,7 @@ on a small rendered bush, and bad inputs."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
@@ -14,6 +15,7 @@ from softarm.perception.cane_curves import (
     split_into_curves,
 )
 from softarm.perception.cane_metrics import cane_map_error
+from softarm.perception.cane_pixels import stereo_disparity
 from softarm.perception.canes import CaneFit, fit_canes
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
@@ -58,6 +60,61 @@ def test_points_of_two_canes_and_clutter_split_into_two_canes() -> None:
     assert len(groups) == 2
     assert scores["coverage"] > 0.95 and scores["median_mm"] < 1.0
     assert scores["precision"] > 0.95
+
+
+def _hidden_middle(
+    coeffs: np.ndarray, hole: tuple[float, float], rng: np.random.Generator
+) -> np.ndarray:
+    """Points of a cane with the stretch ``hole`` (u range) hidden, as a leaf does."""
+    u = rng.uniform(0, 1, 800)
+    u = u[(u < hole[0]) | (u > hole[1])]
+    return curve_points(coeffs, u=u) + rng.normal(0, 0.0015, (len(u), 3))
+
+
+def test_the_two_visible_pieces_of_a_cane_behind_a_leaf_are_one_cane() -> None:
+    rng = np.random.default_rng(3)
+    coeffs = np.array([[0.0, 0.4, 0.0, 0.0], [0.5, 0.05, -0.03, 0.0], [0.1, 0.1, -0.02, 0.0]])
+    length = float(np.sum(np.linalg.norm(np.diff(curve_points(coeffs), axis=0), axis=1)))
+    hole = (0.45, 0.45 + 0.12 / length)  # 12 cm hidden: beyond the growth's max_gap
+    points = _hidden_middle(coeffs, hole, rng)
+    search = CurveSearch()
+    assert search.max_gap < 0.12 <= search.join_gap
+    groups = split_into_curves(points, search)
+    assert len(groups) == 1
+    scores = cane_map_error([_Cane(arc_length_cubic(points[groups[0]]))], [_Cane(coeffs)], 5.0)
+    assert scores["coverage"] > 0.95 and scores["median_mm"] < 1.5
+
+
+def test_pieces_of_two_canes_one_above_the_other_stay_two() -> None:
+    rng = np.random.default_rng(4)
+    a = np.array([[0.0, 0.15, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]])
+    b = a + np.array([[0.1], [0.0], [0.06]])  # 6 cm above, overlapping along x: no ends face
+    points = np.vstack([_noisy(c, 300, 0.001, rng) for c in (a, b)])
+    groups = split_into_curves(points, CurveSearch())
+    assert sorted(len(g) for g in groups) == [300, 300]
+
+
+def test_the_disparity_of_a_thin_cane_is_its_own_not_the_backdrops(stereo: StereoCamera) -> None:
+    # A shaded 5-pixel tube 1 m away, before a textured backdrop at 1.4 m: strong SGBM
+    # smoothing would give the tube the backdrop's disparity.
+    rect = stereo.rectification
+    fb = rect.focal * rect.baseline
+    d_bar, d_backdrop = round(fb / 1.0), round(fb / 1.4)
+    rng = np.random.default_rng(5)
+    texture = rng.integers(0, 255, (480, 900)).astype(np.uint8)
+    blurred = cv2.GaussianBlur(texture, (0, 0), 1.0)
+    backdrop = np.repeat(blurred[:, :, None], 3, axis=2).astype(np.uint8)
+    left = backdrop[:, 100:740].copy()
+    right = backdrop[:, 100 + d_backdrop : 740 + d_backdrop].copy()
+    tube = (np.array([0.6, 0.9, 1.0, 0.8, 0.5])[:, None] * [40, 120, 110]).astype(np.uint8)
+    mask = np.zeros((480, 640), bool)
+    for y in range(100, 400):
+        x = 300 + (3 * (y - 100)) // 10
+        left[y, x : x + 5] = tube
+        right[y, x - d_bar : x - d_bar + 5] = tube
+        mask[y, x : x + 5] = True
+    disparity = stereo_disparity(left, right, rect, mask, (0.6, 1.5))
+    assert np.mean(np.abs(disparity[mask] - d_bar) <= 1.0) > 0.85
 
 
 def test_the_map_error_of_no_fit_is_no_coverage() -> None:

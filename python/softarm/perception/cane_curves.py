@@ -1,7 +1,9 @@
 """Canes as cubic curves from 3D points: the planning paper's curve obstacle (eq. 10),
 p(u) = Σ_k c_k u^k for u in [0, 1], fitted by least squares with u the normalised arc
 length, and the points split into canes by sequential RANSAC (a line proposes a cane,
-the cubic through its inliers grows it along the cane, past gaps where leaves hide it).
+the cubic through its inliers grows it along the cane, past gaps where leaves hide it);
+then the pieces of one cane that a leaf cuts apart further than the growth reaches are
+joined when their ends face each other and one cubic passes through both.
 """
 
 from __future__ import annotations
@@ -38,6 +40,10 @@ class CurveSearch:
         min_length: its shortest extent.
     max_gap: the longest hole (a leaf in front) a cane is followed across.
     proposals: random lines tried for each cane; seed: their generator's seed.
+    join_gap, join_angle: two canes whose ends face each other across at most
+        ``join_gap`` (m), each end's outward direction within ``join_angle`` (degrees)
+        of the line to the other end, are one cane hidden in between when a single
+        cubic passes 90 % of their points within ``curve_tolerance``.
     """
 
     line_tolerance: float = 0.008
@@ -47,6 +53,8 @@ class CurveSearch:
     max_gap: float = 0.10
     proposals: int = 150
     seed: int = 0
+    join_gap: float = 0.15
+    join_angle: float = 35.0
 
 
 def curve_points(coeffs: FloatArray, n: int = DENSE, u: FloatArray | None = None) -> FloatArray:
@@ -106,7 +114,63 @@ def split_into_curves(points: FloatArray, search: CurveSearch) -> list[IndexArra
         if members is not None:
             canes.append(remaining[members])
         remaining = np.delete(remaining, line if members is None else members)
-    return canes
+    return _joined(points, canes, search)
+
+
+def _joined(points: FloatArray, canes: list[IndexArray], search: CurveSearch) -> list[IndexArray]:
+    """``canes`` with the pieces of one cane joined (see ``CurveSearch.join_gap``),
+    the closest facing pair first, until no pair joins."""
+    canes = list(canes)
+    ends = [_ends(arc_length_cubic(points[c])) for c in canes]
+    while True:
+        best: tuple[float, int, int, IndexArray] | None = None
+        for i in range(len(canes)):
+            for j in range(i + 1, len(canes)):
+                gap = _facing_gap(ends[i], ends[j], search)
+                if gap is None or (best is not None and gap >= best[0]):
+                    continue
+                members = np.concatenate([canes[i], canes[j]])
+                dense = curve_points(arc_length_cubic(points[members]), DENSE)
+                residual = cKDTree(dense).query(points[members])[0]
+                if np.percentile(residual, 90) <= search.curve_tolerance:
+                    best = (gap, i, j, members)
+        if best is None:
+            return canes
+        _, i, j, merged = best
+        keep = [k for k in range(len(canes)) if k not in (i, j)]
+        canes = [canes[k] for k in keep] + [merged]
+        ends = [ends[k] for k in keep] + [_ends(arc_length_cubic(points[merged]))]
+
+
+def _ends(coeffs: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
+    """The curve's two ends, each with the unit direction out of the curve there."""
+    p = curve_points(coeffs, u=np.array([0.0, 0.05, 0.95, 1.0]))
+    ends = []
+    for end, inner in ((p[0], p[1]), (p[3], p[2])):
+        out = end - inner
+        ends.append((end, out / max(float(np.linalg.norm(out)), 1e-12)))
+    return ends
+
+
+def _facing_gap(
+    a: list[tuple[FloatArray, FloatArray]],
+    b: list[tuple[FloatArray, FloatArray]],
+    search: CurveSearch,
+) -> float | None:
+    """The shortest gap (m), at most ``join_gap``, between an end of ``a`` and an end
+    of ``b`` that face each other; None when no two do."""
+    cos = float(np.cos(np.radians(search.join_angle)))
+    best = None
+    for pa, out_a in a:
+        for pb, out_b in b:
+            step = pb - pa
+            gap = float(np.linalg.norm(step))
+            if gap > search.join_gap or (best is not None and gap >= best):
+                continue
+            towards = step / max(gap, 1e-12)
+            if gap < 1e-6 or (float(out_a @ towards) >= cos and float(-out_b @ towards) >= cos):
+                best = gap
+    return best
 
 
 def _grow(points: FloatArray, line: IndexArray, search: CurveSearch) -> IndexArray | None:

@@ -79,10 +79,18 @@ def stereo_disparity(
     rect: Rectification,
     mask: BoolImage,
     depth_range: tuple[float, float],
+    smoothness: tuple[int, int] = (4, 16),
 ) -> npt.NDArray[np.float32]:
     """Disparity (pixels, NaN where unknown) of the rectified ``left`` from
-    ``right`` (OpenCV's StereoSGBM), computed only over the rows and columns that
-    ``mask`` occupies, for depths within ``depth_range`` (m)."""
+    ``right`` (OpenCV's StereoSGBM, 3×3 blocks), computed only over the rows and
+    columns that ``mask`` occupies, for depths within ``depth_range`` (m).
+
+    ``smoothness``: SGBM's penalties P1, P2 for a disparity step of one pixel and of
+    more. They are low: a cane is 3–8 pixels wide, and strong penalties (72, 288, the
+    usual 8 and 32 per block pixel) carry the disparity of the leaf or backdrop around
+    it into the cane along the aggregation paths (on tuning bushes 0–4 and 900–919,
+    (72, 288) → (4, 16) took the cane map's coverage from 0.83 to 0.86, its
+    precision from 0.87 to 0.91 and its median from 1.5 to 0.95 mm)."""
     fb = rect.focal * rect.baseline
     d_min = int(np.floor(fb / depth_range[1]))
     n_disp = 16 * int(np.ceil((fb / depth_range[0] - d_min) / 16))
@@ -94,8 +102,9 @@ def stereo_disparity(
     y0, y1 = max(rows.min() - pad, 0), min(rows.max() + pad + 1, mask.shape[0])
     x1 = min(cols.max() + pad + 1, mask.shape[1])
     x0 = max(cols.min() - pad - d_min - n_disp, 0)
+    p1, p2 = smoothness
     sgbm = cv2.StereoSGBM.create(
-        minDisparity=d_min, numDisparities=n_disp, blockSize=3, P1=72, P2=288,
+        minDisparity=d_min, numDisparities=n_disp, blockSize=3, P1=p1, P2=p2,
         uniquenessRatio=10, speckleWindowSize=100, speckleRange=2,
     )  # fmt: skip
     grey = [cv2.cvtColor(img[y0:y1, x0:x1], cv2.COLOR_BGR2GRAY) for img in (left, right)]

@@ -51,12 +51,15 @@ class CaneFit:
 class CaneSettings:
     """``look``: which pixels are canes; ``search``: how points become canes;
     ``depth_range``: nearest and farthest depth (m) a cane is looked for at;
-    ``max_points``: points kept for the fit (an even subsample beyond that)."""
+    ``max_points``: points kept for the fit (an even subsample beyond that);
+    ``smoothness``: StereoSGBM's penalties P1, P2 (see
+    :func:`softarm.perception.cane_pixels.stereo_disparity`)."""
 
     look: CaneLook = field(default_factory=CaneLook)
     search: CurveSearch = field(default_factory=CurveSearch)
     depth_range: tuple[float, float] = (0.6, 1.5)
     max_points: int = 4000
+    smoothness: tuple[int, int] = (4, 16)
 
 
 def fit_canes(
@@ -75,7 +78,8 @@ def fit_canes(
         depth: optional (H, W) depth in metres along the left eye's optical axis,
             aligned with ``left`` (0 or NaN where unknown), e.g. from an RGB-D
             camera; when given, stereo matching is skipped.
-        settings: thresholds; the defaults were tuned on rendered bushes 0–4.
+        settings: thresholds; the defaults were tuned on rendered bushes 0–4 and
+            900–919.
 
     Raises:
         VisionError: an empty image, a wrong dtype or shape, or sizes that disagree.
@@ -133,7 +137,9 @@ def _stereo_points(
     rect = stereo.rectification
     rect_left, rect_right = rect.rectify(left, right)
     mask = cane_mask(rect_left, settings.look)
-    disparity = stereo_disparity(rect_left, rect_right, rect, mask, settings.depth_range)
+    disparity = stereo_disparity(
+        rect_left, rect_right, rect, mask, settings.depth_range, settings.smoothness
+    )
     mask &= np.isfinite(disparity)
     rows, cols = _subsample(np.nonzero(mask), settings.max_points)
     pixels = np.column_stack([cols, rows]).astype(np.float64)
