@@ -18,7 +18,13 @@ from softarm.checks import FloatArray
 from softarm.errors import HardwareError, OutOfRangeError, ParameterError
 from softarm.hardware.serial_protocol import FrameError
 
-__all__ = ["ArduinoGripper", "ArduinoPressureMonitor", "ArduinoRipenessSensor", "Link", "ReadingError"]
+__all__ = [
+    "ArduinoGripper",
+    "ArduinoPressureMonitor",
+    "ArduinoRipenessSensor",
+    "Link",
+    "ReadingError",
+]
 
 
 #: Plain decimal numbers only: ``float()`` also takes ``" 1"``, ``"1_0"`` or ``"infinity"``.
