@@ -168,7 +168,7 @@ def run_experiment(
     rec = _Recorder(rig)
     holds: list[HoldWindow] = []
     # What stopping takes: the slowest channel ramped to 0 at the rate limit, plus margin.
-    stop_time = rig.bank.max_pressure / 100.0 + 2 * rig.period
+    stop_time = rig.bank.max_pressure / rig.bank.max_rate + 2 * rig.period
     previous = np.zeros(rig.bank.channels)
     try:
         for seg in segments:

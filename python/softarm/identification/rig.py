@@ -15,18 +15,23 @@ import numpy as np
 
 from softarm._core import SoftArm
 from softarm.checks import FloatArray as F64
+from softarm.config import ChannelsConfig
 from softarm.errors import ParameterError
 from softarm.hardware.safety import SafePressureBank
 from softarm.hardware.simulated import SimulatedPressureBank
 from softarm.sim.arm import PlantConfig, SimulatedArm
-from softarm.units import MAX_PSI, METRES_PER_PSI
+from softarm.units import METRES_PER_PSI
 
 __all__ = ["IdentificationRig", "SimIdentificationRig", "sim_plant_seed"]
 
 
-#: Safety limits of the simulated rig, the same as ``build_sim_rig``'s: 70 psi (the
-#: arm's 0.0333 m upper limit), 100 psi/s, 0.5 s watchdog.
-SIM_P_MAX, SIM_RATE, SIM_WATCHDOG = MAX_PSI, 100.0, 0.5
+#: Safety limits of the simulated rig: the channels' defaults, as ``build_sim_rig``'s
+#: (70 psi, the arm's 0.0333 m upper limit; 100 psi/s; a 0.5 s watchdog).
+SIM_P_MAX, SIM_RATE, SIM_WATCHDOG = (
+    ChannelsConfig().p_max,
+    ChannelsConfig().max_rate_psi_per_s,
+    ChannelsConfig().watchdog_timeout_s,
+)
 
 
 def sim_plant_seed(seed: int) -> int:
