@@ -233,3 +233,21 @@ def test_plant_step_advances_like_apply_without_measuring() -> None:
     np.testing.assert_array_equal(a.true_pose(), b.true_pose())
     assert measured.shape == (4, 4)
     assert a.time == b.time
+
+
+#: The longest a function of the package may be (issue 27: functions short enough to
+#: read whole; split where the parts have names).
+MAX_FUNCTION_LINES = 80
+
+
+def test_no_function_of_the_package_is_over_80_lines() -> None:
+    long = [
+        f"{path.relative_to(PACKAGE).as_posix()}:{node.lineno} {node.name} "
+        f"({node.end_lineno - node.lineno + 1} lines)"
+        for path in _modules(PACKAGE)
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+        and node.end_lineno is not None
+        and node.end_lineno - node.lineno + 1 > MAX_FUNCTION_LINES
+    ]
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
