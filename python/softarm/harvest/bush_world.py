@@ -171,9 +171,11 @@ def harvest_bush(
     run_berry: Callable[[BerryTarget], BerryResult],
     delivered: list[int],
     on_berry: Callable[[int, BerryResult], None] | None = None,
+    on_look: Callable[[], None] | None = None,
 ) -> HarvestReport:
     """Pick the map's ripe berries one by one (:func:`~softarm.harvest.map_harvest.
-    harvest_map`, the loop the arm runs), each result judged against the true bush."""
+    harvest_map`, the loop the arm runs), each result judged against the true bush;
+    ``on_look()`` after each C1 look (the rig logs the map)."""
     report = HarvestReport()
     index: dict[int, int] = {}  # map berry -> its place in the report (a retry replaces)
 
@@ -193,7 +195,10 @@ def harvest_bush(
             on_berry(index[entry.id], result)
 
     rounds = len(scene.bush.berries) + 8
-    harvest_map(scene.look, scene.bush_map, run_berry, rounds, judged, stop_on=FAULTS_THAT_STOP)
+    harvest_map(
+        scene.look, scene.bush_map, run_berry, rounds, judged, stop_on=FAULTS_THAT_STOP,
+        on_look=on_look,
+    )  # fmt: skip
     report.extra.update(_bush_extra(scene, delivered))
     return report
 

@@ -88,6 +88,11 @@ UNITS: dict[str, dict[str, str]] = {
     "ripeness": {"value": "0..1", "threshold": "0..1"},
     "berry_result": {"target": "m", "duration_s": "s", "*_mm": "mm", "*_deg": "deg"},
     "run_done": {"success_rate": "0..1"},
+    "bush_map": {"t": "s", "berries.position": "m (base frame)", "berries.radius_m": "m",
+                 "berries.ripe": "true: most sightings ripe", "canes.coeffs":
+                 "cubic coefficients (3x4, ascending powers) in u in [0, 1], base frame (m)",
+                 "canes.radius_m": "m"},
+    "pressure_command": {"t": "s", "psi": "psi, one per channel (a vent: none)"},
 }  # fmt: skip
 
 

@@ -69,8 +69,9 @@ class HardwareRig:
         report = HarvestReport()
         c1, machine = self.c1, self.machine
         report.berries = harvest_map(
-            c1.look, c1.bush_map, machine.run_berry, berries, stop_on=FAULTS_THAT_STOP
-        )
+            c1.look, c1.bush_map, machine.run_berry, berries, stop_on=FAULTS_THAT_STOP,
+            on_look=lambda: machine.log_map(c1.bush_map),
+        )  # fmt: skip
         last = report.berries[-1].fault if report.berries else None
         report.stopped = last if last in FAULTS_THAT_STOP else None
         machine.log.event("run_done", success_rate=report.success_rate)

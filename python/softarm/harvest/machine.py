@@ -44,12 +44,14 @@ from softarm.harvest.interfaces import (
     Vision,
 )
 from softarm.harvest.log import HarvestLog
+from softarm.harvest.map_harvest import map_record
 from softarm.harvest.observe import BerryWatch
 from softarm.harvest.outcome import Fault
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.servo import Servo
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
 from softarm.harvest_config import HarvestConfig
+from softarm.perception.bush_map import BushMap
 
 __all__ = ["HarvestMachine"]
 
@@ -301,6 +303,11 @@ class HarvestMachine:
             "fault", t=self.clock.now(), berry=berry.tag_id, reason=reason, detail=detail
         )
         self._transition(S.FAULT, berry, f"{reason.value}: {detail}")
+
+    def log_map(self, bush_map: BushMap) -> None:
+        """Log the bush map as it is now (a ``bush_map`` record: the berries perception
+        found and the canes it fitted), after each C1 look of the markerless loop."""
+        self.log.event("bush_map", t=self.clock.now(), **map_record(bush_map))
 
     def _vent(self, reason: str) -> None:
         """The safe state: every channel exhausted; the arm relaxes to its rest shape."""

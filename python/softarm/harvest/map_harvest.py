@@ -8,13 +8,16 @@ another start the cameras may keep it."""
 from __future__ import annotations
 
 from collections.abc import Callable, Collection
+from typing import Any
+
+import numpy as np
 
 from softarm.harvest.interfaces import BerryTarget
 from softarm.harvest.report import BerryResult
 from softarm.harvest.states import FaultReason
 from softarm.perception.bush_map import BushMap, MappedBerry
 
-__all__ = ["harvest_map"]
+__all__ = ["harvest_map", "map_record"]
 
 
 def harvest_map(
@@ -24,15 +27,19 @@ def harvest_map(
     rounds: int,
     on_result: Callable[[MappedBerry, BerryResult], None] | None = None,
     stop_on: Collection[FaultReason] = (),
+    on_look: Callable[[], None] | None = None,
 ) -> list[BerryResult]:
     """Each berry's result, in the order tried: at most ``rounds`` looks (``look``
     merges one C1 view into ``bush_map``), each followed by the leftmost ripe berry not
-    tried yet; ``on_result(entry, result)`` after each; a fault in ``stop_on`` ends it."""
+    tried yet; ``on_look()`` after each look, ``on_result(entry, result)`` after each
+    berry; a fault in ``stop_on`` ends it."""
     results: list[BerryResult] = []
     tried: set[int] = set()
     lost: set[int] = set()  # lost from view once: one more try
     for _ in range(rounds):
         look()
+        if on_look is not None:
+            on_look()
         ripe = bush_map.ripe()
         todo = [b for b in ripe if b.id not in tried] or [b for b in ripe if b.id in lost]
         if not todo:
@@ -49,3 +56,16 @@ def harvest_map(
         if result.fault in stop_on:
             break
     return results
+
+
+def map_record(bush_map: BushMap) -> dict[str, Any]:
+    """The map as the log's ``bush_map`` record holds it (units in
+    :data:`softarm.harvest.header.UNITS`): each berry's id, position, radius, ripeness
+    and sightings; each fitted cane's cubic coefficients and radius."""
+    berries = [
+        {"id": b.id, "position": np.asarray(b.position), "radius_m": b.radius,
+         "ripe": b.ripeness == "ripe", "sightings": b.sightings}
+        for b in bush_map.berries
+    ]  # fmt: skip
+    canes = [{"coeffs": np.asarray(c.coeffs), "radius_m": c.radius} for c in bush_map.canes]
+    return {"berries": berries, "canes": canes}

@@ -155,9 +155,11 @@ class SimRig:
         picked. The report keeps each berry's last attempt.
         """
         if self.scene is not None:
+            scene = self.scene
             report = harvest_bush(
-                self.scene, self.machine.run_berry, self.gripper.delivered, on_berry
-            )
+                scene, self.machine.run_berry, self.gripper.delivered, on_berry,
+                on_look=lambda: self.machine.log_map(scene.bush_map),
+            )  # fmt: skip
             return self._finish(report)
         report = HarvestReport()
         order = [b.tag_id for b in self.bush.berries]
