@@ -55,12 +55,9 @@ def test_the_hardware_path_sends_the_recorded_commands(recording: Path, tmp_path
         if '"pressure_command"' in line
     ]
     assert len(logged) >= dry["count"][0]  # and the close's vent
-    maps = [
-        line
-        for line in (tmp_path / "replay.jsonl").read_text().splitlines()
-        if '"bush_map"' in line
-    ]
-    first = json.loads(maps[0])  # the map after each look: what perception found
+    records = [json.loads(line) for line in (tmp_path / "replay.jsonl").read_text().splitlines()]
+    maps = [r for r in records if r["kind"] == "bush_map"]
+    first = maps[0]  # the map after each look: what perception found
     assert first["berries"] and {"id", "position", "radius_m", "ripe"} <= set(first["berries"][0])
     assert all(len(c["coeffs"]) == 3 for c in first["canes"])
 
