@@ -60,25 +60,29 @@ def start_log(log: Any, header: Mapping[str, Any]) -> None:
     log.event(HEADER, **header)
 
 
-def write_run_bag(records: list[Any], path: Path | None) -> None:
-    """Write the run's records to the MCAP bag ``path`` (nothing when None)."""
+def write_run_bag(records: list[Any], path: Path | None, frames: str | Path | None = None) -> None:
+    """Write the run's records to the MCAP bag ``path`` (nothing when None), with the
+    camera frames recorded in the folder ``frames`` (``--record-frames``) when given."""
     if path is None:
         return
     from softarm.viz.bag import write_bag
 
-    summary = write_bag(records, path)
-    print(f"bag: {path} ({summary.messages} messages on {len(summary.counts)} topics)")
+    summary = write_bag(records, path, frames)
+    images = sum(n for topic, n in summary.counts.items() if topic.endswith("/compressed"))
+    with_images = f", {images} images" if frames is not None else ""
+    print(f"bag: {path} ({summary.messages} messages on {len(summary.counts)} topics{with_images})")
 
 
-def write_log_bag(log: Path, path: Path | None) -> None:
+def write_log_bag(log: Path, path: Path | None, frames: Path | None = None) -> None:
     """Write the records of the run log ``log`` to the MCAP bag ``path`` (nothing when
-    None); a malformed record is an InputError naming the file and the record."""
+    None), with the frames recorded in ``frames``; a malformed record is an InputError
+    naming the file and the record."""
     if path is None:
         return
     from softarm.errors import InputError
     from softarm.harvest.log import read_log
 
     try:
-        write_run_bag(list(read_log(log)), path)
+        write_run_bag(list(read_log(log)), path, frames)
     except InputError as exc:
         raise type(exc)(f"{log}: {exc}") from None

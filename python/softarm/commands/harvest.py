@@ -208,7 +208,7 @@ def run_sim(
     if report_path is not None:
         report.save(report_path)
         print(f"report: {report_path}")
-    write_run_bag(rig.machine.log.records, bag)
+    write_run_bag(rig.machine.log.records, bag, rig_options.record_frames)
     if plot_path is not None:
         _plot(rig, report, plot_path)
         print(f"plot: {plot_path}")

@@ -4,11 +4,13 @@ and/or a ROS 2 bag (``--bag``, the ``ros`` extra)."""
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from softarm.commands._args import data_file, int_range, non_negative_int, output_file
 from softarm.commands._format import plural
 from softarm.commands._run_info import check_bag, write_log_bag
 from softarm.commands.harvest import MAX_BERRIES
+from softarm.errors import ParameterError
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -29,6 +31,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument(
         "--bag", type=output_file, metavar="RUN.mcap",
         help="write the log as a ROS 2 bag (rosbag2, MCAP; ros extra; docs/ros.md)",
+    )  # fmt: skip
+    p.add_argument(
+        "--frames", type=Path, metavar="DIR",
+        help="with --bag: add the camera frames recorded in DIR (`harvest --sim --world bush "
+        "--record-frames DIR`) as CompressedImage topics (docs/ros.md)",
     )  # fmt: skip
     p.add_argument(
         "--view",
@@ -54,14 +61,16 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def run(args: argparse.Namespace) -> int:
     """Write the bag and/or the recording; returns 0."""
     check_bag(args.bag)
+    if args.frames is not None and args.bag is None:
+        raise ParameterError("--frames: adds the recorded frames to a bag; give --bag too")
     if args.bag is not None and not args.view and args.record is None:
-        write_log_bag(args.log, args.bag)
+        write_log_bag(args.log, args.bag, args.frames)
         return 0
     from softarm.viz.replay import replay
     from softarm.viz.rerun_sdk import require_rerun
 
     require_rerun()  # before the bag is written
-    write_log_bag(args.log, args.bag)
+    write_log_bag(args.log, args.bag, args.frames)
     scene = None if args.sim_seed is None else (args.sim_seed, args.berries)
     n = replay(args.log, args.record, spawn=args.view or args.record is None, scene=scene)
     where = f"recording: {args.record}" if args.record is not None else "sent to the viewer"

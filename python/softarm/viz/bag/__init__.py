@@ -6,7 +6,8 @@ topics and frames.
 One file per job: :mod:`~softarm.viz.bag.deps` (the optional dependency),
 :mod:`~softarm.viz.bag.messages` (message builders), :mod:`~softarm.viz.bag.markers`
 (the scene as markers), :mod:`~softarm.viz.bag.scene` (what the header describes),
-:mod:`~softarm.viz.bag.convert` (records to messages) and
+:mod:`~softarm.viz.bag.convert` (records to messages),
+:mod:`~softarm.viz.bag.images` (recorded camera frames to images) and
 :mod:`~softarm.viz.bag.writer` (the MCAP file).
 """
 

@@ -3,7 +3,8 @@
 The stamps are the run's start (from the header) plus each record's ``t``; a record
 without one (``ripeness``, ``berry_result``) takes the last time seen, and the clock never
 runs backwards, so every topic's stamps are monotonic. Steps logged at the same ``t``
-(a stage ending and the next starting) are one message: the last one wins.
+(a stage ending and the next starting) are one message: the last one wins. A step's
+markers draw the latest ``bush_map`` logged at or before its time (what perception found).
 """
 
 from __future__ import annotations
@@ -21,13 +22,14 @@ from softarm.errors import InputError
 from softarm.harvest.header import HEADER, find_header
 from softarm.viz.bag.markers import scene_markers
 from softarm.viz.bag.messages import Messages
-from softarm.viz.bag.scene import RunScene
+from softarm.viz.bag.scene import CANE_SAMPLES, RunScene, cane_branch
 from softarm.viz.records import _LEVELS, _seconds, as_pose, as_vector
 
-__all__ = ["TOPICS", "Converter", "Message", "actuator_names"]
+__all__ = ["TOPICS", "Converter", "Detection", "Message", "actuator_names"]
 
-#: Topic -> message type of every topic a bag may hold (a camera's only when the header
-#: describes it).
+#: Topic -> message type of every topic a bag of the log alone may hold (a camera's only
+#: when the header describes it); recorded frames add
+#: :data:`softarm.viz.bag.images.IMAGE_TOPICS`.
 TOPICS: dict[str, str] = {
     "/tf_static": "tf2_msgs/msg/TFMessage",
     "/tf": "tf2_msgs/msg/TFMessage",
@@ -53,6 +55,17 @@ class Message:
     msg: Any
 
 
+@dataclass(frozen=True)
+class Detection:
+    """A berry of a ``bush_map`` record: its map id, position (m, base frame), radius
+    (m) and perceived ripeness."""
+
+    id: int
+    position: FloatArray
+    radius: float
+    ripe: bool
+
+
 @dataclass
 class DrawState:
     """What the markers show at the current time."""
@@ -62,6 +75,12 @@ class DrawState:
     goal: FloatArray | None = None
     plan: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     picked: set[int] = field(default_factory=set)
+    #: The latest bush map's berries, and its fitted canes as (points, radius m).
+    detections: list[Detection] = field(default_factory=list)
+    fitted: list[tuple[FloatArray, float]] = field(default_factory=list)
+    #: Every detection id and the most fitted canes any map so far drew (to delete).
+    drawn_ids: set[int] = field(default_factory=set)
+    fitted_slots: int = 0
 
 
 def actuator_names(n_sections: int, per_section: int = 3) -> list[str]:
@@ -199,9 +218,28 @@ class Converter:
         elif kind == "berry_result" and r.get("harvested") and isinstance(r.get("tag_id"), int):
             self.draw.picked.add(r["tag_id"])
             yield Message("/harvest/markers", ns, scene_markers(m, ns, self.scene, self.draw))
-        fields = {k: v for k, v in r.items() if k not in ("kind", "t", "q")}
-        text = f"{kind}: {json.dumps(fields, default=str)}"
+        elif kind == "bush_map":
+            self._bush_map(r)
+            yield Message("/harvest/markers", ns, scene_markers(m, ns, self.scene, self.draw))
+        if kind == "bush_map":  # the map is drawn; its line says what it holds
+            d = self.draw.detections
+            ripe = sum(b.ripe for b in d)
+            text = f"bush_map: {len(d)} berries ({ripe} ripe), {len(self.draw.fitted)} canes"
+        else:
+            fields = {k: v for k, v in r.items() if k not in ("kind", "t", "q")}
+            text = f"{kind}: {json.dumps(fields, default=str)}"
         yield Message("/rosout", ns, m.log(ns, _LEVELS.get(kind, "INFO"), NODE, text))
+
+    def _bush_map(self, r: Mapping[str, Any]) -> None:
+        """The berries and canes of a ``bush_map`` record become what the markers draw."""
+        berries, canes = r.get("berries", []), r.get("canes", [])
+        if not isinstance(berries, list) or not isinstance(canes, list):
+            raise InputError("bush_map berries and canes must be lists")
+        d = self.draw
+        d.detections = [_detection(b) for b in berries]
+        d.fitted = [_fitted_cane(c) for c in canes]
+        d.drawn_ids |= {b.id for b in d.detections}
+        d.fitted_slots = max(d.fitted_slots, len(d.fitted))
 
     def _plan(self, r: Mapping[str, Any]) -> None:
         qs = r.get("q")
@@ -210,6 +248,31 @@ class Converter:
         arm = self.scene.arm
         tips = [arm.forward(as_vector(q, "plan q", arm.n_actuators))[:3, 3] for q in qs]
         self.draw.plan = np.asarray(tips, dtype=np.float64).reshape(-1, 3)
+
+
+def _detection(value: Any) -> Detection:
+    if not isinstance(value, Mapping) or not isinstance(value.get("id"), int):
+        raise InputError(f"bush_map berries: each needs an integer id, got {value!r:.60}")
+    radius = _radius(value.get("radius_m"), "bush_map berry radius_m")
+    ripe = value.get("ripe")
+    if not isinstance(ripe, bool):
+        raise InputError(f"bush_map berry ripe must be true or false, got {ripe!r}")
+    position = as_vector(value.get("position"), "bush_map berry position", 3)
+    return Detection(value["id"], position, radius, ripe)
+
+
+def _fitted_cane(value: Any) -> tuple[FloatArray, float]:
+    if not isinstance(value, Mapping):
+        raise InputError(f"bush_map canes: each must be an object, got {value!r:.60}")
+    branch = cane_branch(value.get("coeffs"), "bush_map canes")
+    return branch.points(CANE_SAMPLES), _radius(value.get("radius_m"), "bush_map cane radius_m")
+
+
+def _radius(value: Any, name: str) -> float:
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    if not number or not (math.isfinite(value) and value > 0):
+        raise InputError(f"{name} must be a positive number of metres, got {value!r}")
+    return float(value)
 
 
 def _text(value: Any, scale: float | None) -> str:

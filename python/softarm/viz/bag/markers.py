@@ -1,7 +1,10 @@
 """The harvest drawn as a visualization_msgs/MarkerArray in the base frame: the model arm's
 backbone (one line strip per section, the rigid links grey), the canes, the berries
 coloured by ripeness (picked ones removed), the berry estimate, the servo's goal and the
-planned tip path."""
+planned tip path; and, once the markerless harvest has logged a ``bush_map``, what
+perception found: each detected berry a translucent sphere of its radius coloured by its
+perceived ripeness (``detections``), each fitted cane a translucent line strip as wide
+as the cane (``fitted_canes``)."""
 
 from __future__ import annotations
 
@@ -13,7 +16,7 @@ import numpy as np
 from softarm.viz.arm import arm_polylines
 from softarm.viz.bag.messages import Messages
 
-__all__ = ["berry_colour", "scene_markers"]
+__all__ = ["berry_colour", "perceived_markers", "scene_markers"]
 
 FRAME = "base"
 #: Section colours (RGBA 0..1): proximal red, medial green, distal blue, as in the paper.
@@ -24,6 +27,9 @@ ESTIMATE = (1.0, 0.0, 1.0, 0.9)
 GOAL = (1.0, 0.8, 0.0, 1.0)
 #: A berry's colour from unripe (green) to ripe (blackberry purple-black).
 UNRIPE, RIPE = np.array([0.2, 0.7, 0.2, 1.0]), np.array([0.3, 0.05, 0.35, 1.0])
+#: The opacity of what perception found, so the true berries and canes show through.
+PERCEIVED_ALPHA = 0.4
+FITTED_CANE = (1.0, 0.55, 0.1, PERCEIVED_ALPHA)
 
 
 def berry_colour(ripeness: float) -> tuple[float, ...]:
@@ -56,7 +62,30 @@ def scene_markers(m: Messages, ns: int, scene: Any, state: Any) -> Any:
         pts = [] if point is None else [point]
         out.append(_spheres(m, ns, name, 0, pts, [colour] * len(pts), size))
     out.append(_strip(m, ns, "plan", 0, state.plan, GOAL, 0.004))
+    out += perceived_markers(m, ns, state)
     return m.new("visualization_msgs/msg/MarkerArray", markers=out)
+
+
+def perceived_markers(m: Messages, ns: int, state: Any) -> list[Any]:
+    """The latest bush map's berries (one sphere each, its id the berry's) and fitted
+    canes; one a former map drew (``state.drawn_ids``, ``state.fitted_slots``) and this
+    one lacks is sent as DELETE. Nothing before the first map."""
+    out: list[Any] = []
+    current = {d.id: d for d in state.detections}
+    for berry_id in sorted(state.drawn_ids | set(current)):
+        d = current.get(berry_id)
+        if d is None:
+            out.append(_marker(m, ns, "detections", berry_id, "SPHERE", np.zeros((0, 3)), [],
+                               (0.0, 0.0, 0.0)))  # fmt: skip
+            continue
+        colour = (*berry_colour(1.0 if d.ripe else 0.0)[:3], PERCEIVED_ALPHA)
+        size = 2.0 * d.radius
+        out.append(_marker(m, ns, "detections", berry_id, "SPHERE", np.zeros((0, 3)), [colour],
+                           (size, size, size), position=d.position))  # fmt: skip
+    for i in range(max(state.fitted_slots, len(state.fitted))):
+        points, radius = state.fitted[i] if i < len(state.fitted) else (np.zeros((0, 3)), 0.0)
+        out.append(_strip(m, ns, "fitted_canes", i, points, FITTED_CANE, 2.0 * radius))
+    return out
 
 
 def _strip(
@@ -77,17 +106,22 @@ def _spheres(
 def _marker(
     m: Messages, ns: int, name: str, i: int, kind: str, points: np.ndarray,
     colours: Sequence[Sequence[float]], scale: tuple[float, float, float],
+    position: Any = None,
 ) -> Any:  # fmt: skip
-    """One marker; an empty one is sent as DELETE, so the viewer clears what it drew."""
+    """One marker (a single shape at ``position``, or a list of ``points``); one with
+    neither is sent as DELETE, so the viewer clears what it drew."""
     Marker = m.types["visualization_msgs/msg/Marker"]
-    action = Marker.ADD if len(points) else Marker.DELETE
+    action = Marker.ADD if len(points) or position is not None else Marker.DELETE
+    pose = np.eye(4)
+    if position is not None:
+        pose[:3, 3] = position
     return Marker(
         header=m.header(ns, FRAME),
         ns=name,
         id=i,
         type=getattr(Marker, kind),
         action=action,
-        pose=m.pose(),
+        pose=m.pose(pose),
         scale=m.vector(scale),
         color=m.color(colours[0] if len(colours) else (1.0, 1.0, 1.0, 1.0)),
         lifetime=m.new("builtin_interfaces/msg/Duration", sec=0, nanosec=0),

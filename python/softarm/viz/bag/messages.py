@@ -1,5 +1,6 @@
 """ROS 2 messages built from numbers: stamps, transforms, joint states, arrays, camera
-info, log lines and diagnostics, as rosbags' standard message classes."""
+info, compressed images, log lines and diagnostics, as rosbags' standard message
+classes."""
 
 from __future__ import annotations
 
@@ -100,13 +101,19 @@ class Messages:
     def string(self, text: str) -> Any:
         return self.new("std_msgs/msg/String", data=text)
 
-    def camera_info(self, ns: int, frame: str, camera: Mapping[str, Any]) -> Any:
-        """CameraInfo of a header camera (width, height, K, D: the plumb_bob model)."""
+    def camera_info(
+        self, ns: int, frame: str, camera: Mapping[str, Any],
+        roi: tuple[int, int, int, int] = (0, 0, 0, 0),
+    ) -> Any:  # fmt: skip
+        """CameraInfo of a header camera (width, height, K, D: the plumb_bob model);
+        ``roi`` (x_offset, y_offset, width, height) places a window of the full frame
+        (all zero: the full frame)."""
         k = np.asarray(camera["K"], dtype=np.float64).reshape(3, 3)
         p = np.hstack([k, np.zeros((3, 1))])
-        roi = self.new(
+        x, y, w, h = (int(v) for v in roi)
+        roi_msg = self.new(
             "sensor_msgs/msg/RegionOfInterest",
-            x_offset=0, y_offset=0, height=0, width=0, do_rectify=False,
+            x_offset=x, y_offset=y, height=h, width=w, do_rectify=False,
         )  # fmt: skip
         return self.new(
             "sensor_msgs/msg/CameraInfo",
@@ -120,7 +127,17 @@ class Messages:
             p=p.ravel(),
             binning_x=0,
             binning_y=0,
-            roi=roi,
+            roi=roi_msg,
+        )
+
+    def compressed_image(self, ns: int, frame: str, fmt: str, data: bytes) -> Any:
+        """A CompressedImage of encoded ``data`` (PNG or JPEG bytes), ``fmt`` as
+        compressed_image_transport writes it (``bgr8; png compressed bgr8``)."""
+        return self.new(
+            "sensor_msgs/msg/CompressedImage",
+            header=self.header(ns, frame),
+            format=fmt,
+            data=np.frombuffer(data, dtype=np.uint8),
         )
 
     def log(self, ns: int, level: str, name: str, text: str) -> Any:

@@ -19,7 +19,7 @@ from softarm.sim.bush import Branch
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.viz.records import as_pose, as_vector
 
-__all__ = ["BerryMark", "RunScene"]
+__all__ = ["CANE_SAMPLES", "BerryMark", "RunScene", "cane_branch"]
 
 #: Points along each cane's line strip.
 CANE_SAMPLES = 40
@@ -125,12 +125,18 @@ def _frame(name: str, value: Any) -> tuple[str, FloatArray]:
 
 
 def _cane(coeffs: Any) -> Branch:
+    return cane_branch(coeffs, "header world.canes")
+
+
+def cane_branch(coeffs: Any, name: str) -> Branch:
+    """A cane of 3 x k polynomial coefficients (ascending powers of u in [0, 1]);
+    ``name`` says where it came from in the error."""
     try:
         c = np.asarray(coeffs, dtype=np.float64)
     except (TypeError, ValueError):
         c = np.zeros(0)
     if c.ndim != 2 or c.shape[0] != 3 or not np.all(np.isfinite(c)):
-        raise InputError(f"header world.canes: each cane must be 3 x k coefficients, got {c.shape}")
+        raise InputError(f"{name}: each cane must be 3 x k coefficients, got {c.shape}")
     return Branch(c)
 
 

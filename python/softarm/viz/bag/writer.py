@@ -3,13 +3,16 @@
 rosbags writes a bag directory (``metadata.yaml`` and ``<name>.mcap``); the MCAP file
 also carries that metadata in its own ``rosbag2`` record, as ROS 2 writes it, so the
 single file is the bag: Foxglove opens it and ``ros2 bag info run.mcap`` reads it. It
-is written beside the target and renamed over it once complete.
+is written beside the target and renamed over it once complete. With a frames folder
+(:mod:`~softarm.viz.bag.images`) the recorded camera frames go in too, merged with the
+log's messages in the order of their stamps.
 """
 
 from __future__ import annotations
 
+import heapq
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,10 +21,12 @@ from softarm.errors import InputError, OutputError
 from softarm.files import atomic_path, check_target
 from softarm.viz.bag.convert import TOPICS, Converter
 from softarm.viz.bag.deps import require_rosbags, typestore
+from softarm.viz.bag.images import IMAGE_TOPICS, FrameImages
 from softarm.viz.bag.messages import Messages
 
 __all__ = ["BagSummary", "check_bag_path", "write_bag"]
 
+ALL_TOPICS = {**TOPICS, **IMAGE_TOPICS}
 #: rosbag2's metadata version (9: Jazzy and later; the MCAP readers of older releases
 #: read the file through its own summary).
 VERSION = 9
@@ -52,12 +57,17 @@ def check_bag_path(path: str | Path) -> Path:
     return p
 
 
-def write_bag(records: Iterable[Any], path: str | Path) -> BagSummary:
+def write_bag(
+    records: Iterable[Any], path: str | Path, frames: str | Path | None = None
+) -> BagSummary:
     """Write the messages of ``records`` (a run log's, header first) to the MCAP bag
-    ``path``; an existing file is replaced only once the new one is complete.
+    ``path``, with the camera frames recorded in the folder ``frames`` (``--record-frames``)
+    when given; an existing file is replaced only once the new one is complete.
 
     Raises:
         InputError: a record is malformed (the message names its number and field).
+        ConfigError: the frames folder is broken: no index, a frame file missing or not
+            an image (the file named).
         MissingDependencyError: rosbags (the ``ros`` extra) is not installed.
         OutputError: the file cannot be written.
     """
@@ -65,13 +75,21 @@ def write_bag(records: Iterable[Any], path: str | Path) -> BagSummary:
     rosbag2 = require_rosbags()
     m = Messages(typestore())
     recs = list(records)
+    converter = Converter.for_records(m, recs)
+    # The folder is checked before any writing; the cameras are as the frames were taken.
+    images = None if frames is None else FrameImages(m, frames, converter.scene)
+    if images is not None:
+        converter.scene = images.scene
+    messages: Iterator[Any] = converter.messages(recs)
+    if images is not None:
+        messages = heapq.merge(messages, images.messages(), key=lambda item: item.ns)
     with (
         atomic_path(target, "bag") as tmp,
         tempfile.TemporaryDirectory(prefix=".bag-", dir=target.parent) as folder,
     ):
         bag = Path(folder) / target.stem
         writer = rosbag2.Writer(bag, version=VERSION, storage_plugin=rosbag2.StoragePlugin.MCAP)
-        counts = _write(writer, m, Converter.for_records(m, recs).messages(recs))
+        counts = _write(writer, m, messages)
         mcap = next(bag.glob("*.mcap"), None)
         if mcap is None:
             raise OutputError(f"cannot write bag {str(path)!r}: rosbags wrote no .mcap file")
@@ -88,7 +106,7 @@ def _write(writer: Any, m: Messages, messages: Iterable[Any]) -> tuple[dict[str,
         for item in messages:
             if item.topic not in connections:
                 connections[item.topic] = writer.add_connection(
-                    item.topic, TOPICS[item.topic], typestore=m.typestore,
+                    item.topic, ALL_TOPICS[item.topic], typestore=m.typestore,
                     offered_qos_profiles=_qos(item.topic),
                 )  # fmt: skip
             writer.write(connections[item.topic], item.ns, m.serialize(item.msg))
