@@ -52,3 +52,12 @@ def test_the_tolerance_is_the_rigs_config() -> None:
     assert Tolerance.of(None) == Tolerance() == Tolerance(0.5, 5.0)
     t = Tolerance.of(HarvestConfig(fine_tolerance=0.002, angle_tolerance_deg=9.0))
     assert t == Tolerance(2.0, 9.0)
+
+
+def test_a_run_that_never_moved_has_no_cane_gap() -> None:
+    # A rendered bush whose map holds no ripe berry: no step ran, the gap is unknown
+    # (the report's JSON has None for the watch's infinite gap).
+    report = HarvestReport(berries=[])
+    report.extra.update(min_branch_gap_m=None, branch_contact_steps=0, sim_time_s=0.0)
+    text = summary(report.to_dict())
+    assert "harvested 0/0" in text and "min cane gap -, 0 contact steps" in text

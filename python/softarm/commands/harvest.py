@@ -460,10 +460,9 @@ def summary(d: dict[str, Any], tol: Tolerance | None = None) -> str:
     if off:
         extra += f", {plural(off, 'berry')} OUTSIDE TOLERANCE"
     if "min_branch_gap_m" in d:
-        extra += (
-            f", min cane gap {1e3 * d['min_branch_gap_m']:.1f} mm, "
-            f"{d['branch_contact_steps']} contact steps"
-        )
+        gap = d["min_branch_gap_m"]  # None: the arm never moved (no ripe berry in the map)
+        gap_s = "-" if gap is None else f"{1e3 * gap:.1f} mm"
+        extra += f", min cane gap {gap_s}, {d['branch_contact_steps']} contact steps"
     if d.get("sim_time_s") is not None:
         extra += f", {d['sim_time_s']:.1f} s simulated"
     return (
