@@ -224,8 +224,15 @@ def sim_settings(rig: Any, options: Any) -> dict[str, Any]:
             "cube": frame("gripper", cams.T_ee_cube),
             "base_tag": frame("base", cams.T_base_tag),
         },
-        "cameras": {"camera_c1": camera(cams.model(1)), "camera_c2": camera(cams.model(2))},
+        "cameras": {"camera_c1": camera(cams.model(1)), "camera_c2": camera(_c2(rig, cams))},
     }
+
+
+def _c2(rig: Any, cams: Any) -> Any:
+    """C2's intrinsics as the rig renders it: the rendered bush's (half size), else the
+    synthetic cameras'."""
+    scene = getattr(rig, "scene", None)
+    return cams.model(2) if scene is None else scene.world.c2
 
 
 def hardware_settings(config: Any, config_path: str | Path) -> dict[str, Any]:
