@@ -6,7 +6,6 @@ the frames' times. Nothing is rendered: the logs and the images are written here
 from __future__ import annotations
 
 import json
-from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -16,11 +15,12 @@ import pytest
 
 pytest.importorskip("rosbags")
 
-from rosbags.highlevel import AnyReader
 
 from softarm.cli import main
 from softarm.viz.bag.images import IMAGE_TOPICS, image_format, scaled_camera
 from softarm.viz.bag.markers import PERCEIVED_ALPHA, RIPE, UNRIPE
+
+from .test_bag import _read
 
 NS = 1_000_000_000
 Q = [0.0] * 9
@@ -42,14 +42,6 @@ CANE = {"coeffs": [[0.0, 0.1, 0.0, 0.0], [0.3, 0.0, 0.0, 0.0], [0.0, 0.6, 0.0, 0
 def _log(path: Path, records: list[dict[str, Any]]) -> Path:
     path.write_text("".join(json.dumps(r) + "\n" for r in records))
     return path
-
-
-def _read(bag: Path) -> dict[str, list[tuple[int, Any]]]:
-    out: dict[str, list[tuple[int, Any]]] = defaultdict(list)
-    with AnyReader([bag]) as reader:
-        for conn, stamp, raw in reader.messages():
-            out[conn.topic].append((stamp, reader.deserialize(raw, conn.msgtype)))
-    return dict(out)
 
 
 def _ns(stamp: Any) -> int:

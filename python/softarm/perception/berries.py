@@ -23,7 +23,13 @@ from softarm.checks import FloatArray
 from softarm.errors import VisionError
 from softarm.vision.camera_model import CameraModel
 
-__all__ = ["BerryDetection", "DetectorSettings", "detect_berries", "fruit_mask"]
+__all__ = [
+    "BerryDetection",
+    "DetectorSettings",
+    "detect_berries",
+    "detections_in_masks",
+    "fruit_mask",
+]
 
 Ripeness = Literal["ripe", "unripe"]
 # What OpenCV returns for a uint8 image (its stubs say any number array).
@@ -88,6 +94,19 @@ def detect_berries(
     _check(image, depth)
     hsv = cast(_U8, cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV))
     ripe, unripe = _colour_masks(hsv, s)
+    return detections_in_masks(ripe, unripe, camera, depth, s)
+
+
+def detections_in_masks(
+    ripe: npt.NDArray[np.uint8],
+    unripe: npt.NDArray[np.uint8],
+    camera: CameraModel,
+    depth: npt.NDArray[np.floating] | None,
+    s: DetectorSettings,
+) -> list[BerryDetection]:
+    """The berries of the ``ripe`` and ``unripe`` pixel masks, whatever made them (the
+    colour thresholds, a pixel network): closed, split into fruit-shaped blobs, each
+    placed and sized (the shape stage every detector shares)."""
     out = []
     for mask in (ripe, unripe):
         for blob in _blobs(_close(mask), s):

@@ -25,10 +25,9 @@ from softarm.errors import VisionError
 from softarm.perception.berries import (
     BerryDetection,
     DetectorSettings,
-    _blobs,
     _check,
     _close,
-    _detection,
+    detections_in_masks,
 )
 from softarm.vision.camera_model import CameraModel
 
@@ -139,10 +138,4 @@ class NetDetector:
         s = settings or DetectorSettings()
         _check(image, depth)
         ripe, unripe = self.masks(image)
-        out = []
-        for mask in (ripe, unripe):
-            for blob in _blobs(_close(mask), s):
-                det = _detection(blob, ripe, unripe, camera, depth, s)
-                if det is not None:
-                    out.append(det)
-        return out
+        return detections_in_masks(ripe, unripe, camera, depth, s)
