@@ -100,3 +100,15 @@ def test_the_dry_run_options_outside_their_mode_are_refused(
     os.chdir(tmp_path)
     assert main(["harvest", *args]) == 2
     assert named in capsys.readouterr().err
+
+
+def test_the_dry_runs_bag_carries_the_frames_it_replayed(recording: Path, tmp_path: Path) -> None:
+    pytest.importorskip("rosbags")
+    from rosbags.highlevel import AnyReader
+
+    bag = tmp_path / "dry.mcap"
+    argv = ["harvest", "--config", str(recording / "hw.toml"), "--frames", str(recording)]
+    assert main([*argv, "--dry-run", "--bag", str(bag), "-q"]) == 0
+    with AnyReader([bag]) as reader:
+        topics = {c.topic for c in reader.connections}
+    assert "/camera_c2/image/compressed" in topics and "/harvest/markers" in topics

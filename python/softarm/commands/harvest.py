@@ -335,7 +335,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
     if args.report:
         report.save(args.report)
         print(f"report: {args.report}")
-    write_run_bag(log.records, args.bag)
+    write_run_bag(log.records, args.bag, args.frames)  # --dry-run: the frames it replayed
     return status
 
 
