@@ -10,7 +10,11 @@ eye, the shading by the background behind the fruit and the highlights on it (wh
 with the eye). Their mean is taken where they agree within a pixel; where they do not,
 the match is on a neighbour or on a fruit half hidden in one eye, and the berry is left
 without a position for a later look (on the diagnosis bushes 200–219: p95 8.6 mm with
-the outline alone, 6.9 with the shading alone, 6.0 with both, 93 % localised). With f ≈
+the outline alone, 6.9 with the shading alone, 6.0 with both, 93 % localised). Where the
+shading has no unique match at all (a dark fruit on a dark ground), the outline's
+stands if the shading's cost there is within the uniqueness margin of its best: the
+shading does not contradict it (diagnosed on harvest bushes 736 and 739, where whole
+berries in view were otherwise never mapped). With f ≈
 900 px and B = 0.12 m a pixel of disparity is about 13 mm of depth at 1.2 m. The
 silhouette of a round fruit is its equator, so the triangulated point is taken as the
 centre. The drupelets that form the outline differ between the two eyes, which leaves
@@ -77,10 +81,12 @@ def locate_berries(
     d_hi = rect.focal * rect.baseline / DEPTH_RANGE[0]
     out = []
     for det in detections:
-        d = _agreed(
-            match_disparity(sil_l, sil_r, det, (d_lo, d_hi)),
-            match_disparity(grey_l, grey_r, det, (d_lo, d_hi)),
-        )
+        by_outline = match_disparity(sil_l, sil_r, det, (d_lo, d_hi))
+        by_shading = match_disparity(grey_l, grey_r, det, (d_lo, d_hi))
+        d = _agreed(by_outline, by_shading)
+        if d is None and by_outline is not None and by_shading is None:
+            allowed = _shading_allows(grey_l, grey_r, det, (d_lo, d_hi), by_outline)
+            d = by_outline if allowed else None
         position = radius_m = None
         if d is not None and _plausible(d, det.radius, rect.baseline):
             centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
@@ -98,6 +104,31 @@ def match_disparity(
 ) -> float | None:
     """The disparity (px) of ``det`` between rectified grey images, or None when the
     search window leaves the image or the match is flat."""
+    curve = _cost_curve(left, right, det, disparity_range)
+    if curve is None:
+        return None
+    cost, x0, s0 = curve
+    k = int(np.argmin(cost))
+    if k == 0 or k == cost.size - 1 or not _unique(cost, k):
+        return None
+    a, b, c = cost[k - 1], cost[k], cost[k + 1]
+    curvature = a - 2 * b + c
+    if curvature <= 0:
+        return None
+    sub = 0.5 * (a - c) / curvature  # the parabola's vertex, in [-0.5, 0.5]
+    x_right = s0 + k + sub
+    return float(x0 - x_right)
+
+
+def _cost_curve(
+    left: npt.NDArray[np.float32],
+    right: npt.NDArray[np.float32],
+    det: BerryDetection,
+    disparity_range: tuple[float, float],
+) -> tuple[npt.NDArray[np.float32], int, int] | None:
+    """The masked template's squared-difference cost along the rows of the right
+    image, with the template's left column ``x0`` and the strip's ``s0`` (a cost index
+    k is the disparity ``x0 - s0 - k``); None when the window leaves the image."""
     x, y, w, h = det.box
     pad = 2
     x0, y0, x1, y1 = x - pad, y - pad, x + w + pad, y + h + pad
@@ -115,16 +146,28 @@ def match_disparity(
         return None
     strip = right[y0:y1, s0:s1]
     cost = cv2.matchTemplate(strip, template, cv2.TM_SQDIFF, mask=mask)[0]
-    k = int(np.argmin(cost))
-    if k == 0 or k == cost.size - 1 or not _unique(cost, k):
-        return None
-    a, b, c = cost[k - 1], cost[k], cost[k + 1]
-    curvature = a - 2 * b + c
-    if curvature <= 0:
-        return None
-    sub = 0.5 * (a - c) / curvature  # the parabola's vertex, in [-0.5, 0.5]
-    x_right = s0 + k + sub
-    return float(x0 - x_right)
+    return cost, x0, s0
+
+
+def _shading_allows(
+    left: npt.NDArray[np.float32],
+    right: npt.NDArray[np.float32],
+    det: BerryDetection,
+    disparity_range: tuple[float, float],
+    disparity: float,
+) -> bool:
+    """Whether the shading, which found no unique match of its own, does not contradict
+    the outline's ``disparity``: its cost within a pixel of it is within UNIQUENESS of
+    its best (a dark fruit on a dark ground matches its shading almost anywhere along
+    the rows; a match on a neighbour would cost it more)."""
+    curve = _cost_curve(left, right, det, disparity_range)
+    if curve is None:
+        return False
+    cost, x0, s0 = curve
+    k = round(x0 - disparity - s0)
+    if k < 1 or k >= cost.size - 1:
+        return False
+    return float(cost[k - 1 : k + 2].min()) <= (1.0 + UNIQUENESS) * float(cost.min())
 
 
 def _agreed(by_outline: float | None, by_shading: float | None) -> float | None:
