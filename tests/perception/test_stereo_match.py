@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from softarm.perception.berries import BerryDetection
-from softarm.perception.stereo import UNIQUENESS, _shading_allows, match_disparity
+from softarm.perception.stereo import UNIQUENESS, _cost_allows, _Cues, match_disparity
 
 RANGE = (5.0, 80.0)
 
@@ -46,6 +46,30 @@ def test_the_shading_vetoes_an_outline_it_contradicts() -> None:
     right[35:60, 62:82] = 200.0
     berry = _berry()
     assert match_disparity(left, right, berry, RANGE) is None
-    assert _shading_allows(left, right, berry, RANGE, 31.0)
-    assert not _shading_allows(left, right, berry, RANGE, 50.0)
+    assert _cost_allows(left, right, berry, RANGE, 31.0)
+    assert not _cost_allows(left, right, berry, RANGE, 50.0)
     assert 0.0 < UNIQUENESS < 1.0
+
+
+def test_the_cues_together() -> None:
+    rng = np.random.default_rng(1)
+    textured = rng.uniform(0, 255, (100, 240)).astype(np.float32)
+    flat = np.full((100, 240), 20.0, np.float32)
+    berry = _berry()
+    both = _Cues(
+        (textured, _shifted(textured, 31)), (textured, _shifted(textured, 31)), berry, RANGE
+    )
+    assert both.disparity() is not None and abs(both.disparity() - 31.0) < 0.2  # type: ignore[operator]
+    # The outline flat (no unique match) and not contradicting: the shading's stands.
+    shading_only = _Cues(
+        (flat, _shifted(flat, 31)), (textured, _shifted(textured, 31)), berry, RANGE
+    )
+    assert shading_only.by_outline is None and shading_only.disparity() is not None
+    # Both unique, 1.5 px apart: the shading's; 3 px apart: neither.
+    near = _Cues(
+        (textured, _shifted(textured, 33)), (textured, _shifted(textured, 31)), berry, RANGE
+    )
+    near.by_outline = 32.5
+    assert near.disparity() == near.by_shading
+    near.by_outline = 34.5
+    assert near.disparity() is None
