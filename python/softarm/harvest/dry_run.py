@@ -13,6 +13,7 @@ plant's declared lag, ``[perception]``) with its camera files. ``softarm harvest
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +36,7 @@ from softarm.harvest.frame_files import FrameRecorder
 from softarm.harvest.report import BerryResult
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
+from softarm.perception.stereo_camera import StereoCamera
 from softarm.perception_config import PerceptionConfig
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
@@ -107,26 +109,31 @@ class RecordedSensor:
         return value
 
 
+@dataclass(frozen=True)
 class RigDescription:
-    """What a hardware configuration needs to know of a simulated rig."""
+    """What a hardware configuration needs to know of a simulated rig: C1 as the
+    ``scene`` registered it, the rest as the rig was built."""
 
-    def __init__(
-        self,
-        model: SoftArm,
-        harvest: HarvestConfig,
-        gains: dict[str, Any],
-        plant: IdentifiedPlant,
-        scene: BushScene,
-        c2: CameraModel,
-        T_ee_c2: FloatArray,
-        T_ee_cube: FloatArray,
-        berry_tag: float,
-        T_base_tag: FloatArray,
-    ) -> None:
-        self.model, self.harvest, self.gains, self.plant = model, harvest, gains, plant
-        self.stereo, self.T_C1_base = scene.c1(), scene.T_C1_base
-        self.c2, self.T_ee_c2, self.T_ee_cube = c2, T_ee_c2, T_ee_cube
-        self.berry_tag, self.T_base_tag = berry_tag, T_base_tag
+    model: SoftArm
+    harvest: HarvestConfig
+    gains: dict[str, Any]
+    plant: IdentifiedPlant
+    scene: BushScene
+    c2: CameraModel
+    T_ee_c2: FloatArray
+    T_ee_cube: FloatArray
+    berry_tag: float
+    T_base_tag: FloatArray
+
+    @property
+    def stereo(self) -> StereoCamera:
+        """C1 as the registration placed it."""
+        return self.scene.c1()
+
+    @property
+    def T_C1_base(self) -> FloatArray | None:
+        """The base in C1, as the registration found it."""
+        return self.scene.T_C1_base
 
     def config(self) -> Config:
         """The hardware configuration: the rig's arm, the default channels (the
