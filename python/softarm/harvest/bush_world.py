@@ -114,10 +114,9 @@ class BushScene:
         """C1's left eye and C2 as ``(time) -> image`` with the arm drawn as it is."""
 
         def c1(t: float) -> np.ndarray:
-            # The window around the cube (where it truly is, as the tag world's
-            # render_crop does); the cube is all the tracking looks for in C1.
+            # The window around the cube; the cube is all the tracking looks for in C1.
             self._draw()
-            return self.world.c1_left_window(self._cube_pixel())
+            return self.world.cube_window(self.plant.pose() @ self.world.T_ee_cube)
 
         def c2(t: float) -> np.ndarray:
             self._draw()
@@ -130,13 +129,6 @@ class BushScene:
         in it)."""
         self._draw()
         return self.world.c1_left().colour
-
-    def _cube_pixel(self) -> tuple[float, float]:
-        stereo = self.world.stereo
-        cube = self.plant.pose() @ self.world.T_ee_cube
-        p = invert(stereo.T_base_left) @ cube[:, 3]
-        u, v = stereo.left.project(p[None, :3])[0]
-        return float(u), float(v)
 
     def picture(self) -> np.ndarray:
         """C1's left image now, with the map's berries and fitted canes drawn on it."""

@@ -16,6 +16,7 @@ from xml.sax.saxutils import quoteattr
 
 import cv2
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
@@ -37,6 +38,12 @@ FRUIT_MATERIALS = (
     '<material name="glossy" specular="0.9" shininess="0.9"/>'
     '<material name="waxy" specular="0.3" shininess="0.4"/>'
 )
+#: Multisamples per pixel of the offscreen buffer: none. Mesa's software rasteriser
+#: shades every sample, and four of them cost as much as the scene's geometry again
+#: (a C1 window around the cube: 17 against 10 ms); the cube tracking, the berries
+#: and the canes measured alike on the same bushes with and without
+#: (docs/perception.md).
+OFFSCREEN_SAMPLES = 0
 #: OpenCV's camera frame (z forward, y down) in MuJoCo's (z backward, y up).
 CV_TO_MJ = np.diag([1.0, -1.0, -1.0])
 
@@ -77,10 +84,11 @@ def scene_xml(spec: SceneSpec) -> tuple[str, dict[str, bytes]]:
     """The MJCF text of ``spec`` and its texture assets (PNG bytes by file name)."""
     rng = np.random.default_rng([spec.look.seed, 0xB05])
     assets = _tag_assets(spec)
+    berries = [_berry(b, spec.look, rng) for b in spec.bush.berries]
     parts = [
         _background(spec.look),
         *(_cane(i, b.points(24), spec.look) for i, b in enumerate(spec.bush.branches)),
-        *(_berry(b, spec.look, rng) for b in spec.bush.berries),
+        *(body for body, _ in berries),
         _leaves(spec, rng),
         _clutter(spec.look, rng),
         _quad("arm_basetag", spec.T_base_tag, 1.25 * spec.tag_length, f"tag{spec.base_tag_id}"),
@@ -90,10 +98,11 @@ def scene_xml(spec: SceneSpec) -> tuple[str, dict[str, bytes]]:
     look = spec.look
     amb = look.ambient
     meshes = "".join(_quad_mesh(1.25 * m) for m in {spec.cube_marker, spec.tag_length})
+    meshes += "".join(mesh for _, mesh in berries)
     head = (
         f'<mujoco model="bush"><compiler angle="radian"/>'
         f'<visual><global offwidth="1280" offheight="720"/>'
-        f'<quality shadowsize="0" offsamples="4" numslices="14" numstacks="8"/>'
+        f'<quality shadowsize="0" offsamples="{OFFSCREEN_SAMPLES}" numslices="14" numstacks="8"/>'
         f'<headlight ambient="{amb} {amb} {amb}" diffuse="0 0 0" specular="0 0 0"/>'
         f'<map znear="0.005" zfar="30"/></visual>'
         f'<statistic extent="1" center="0 0.3 0.3"/>'
@@ -102,6 +111,42 @@ def scene_xml(spec: SceneSpec) -> tuple[str, dict[str, bytes]]:
         f'diffuse="{_v(look.light_colour * look.light_intensity)}" specular="0.5 0.5 0.5"/>'
     )
     return head + "".join(parts) + "</worldbody></mujoco>", assets
+
+
+def _icosphere() -> tuple[FloatArray, npt.NDArray[np.int64]]:
+    """The unit icosahedron with each face split in four, its new vertices pushed out
+    onto the sphere: (42, 3) vertices and (80, 3) faces, counter-clockwise seen from
+    outside."""
+    t = (1.0 + np.sqrt(5.0)) / 2.0
+    verts = [
+        (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+        (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1),
+    ]  # fmt: skip
+    faces = [
+        (0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+        (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+        (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1),
+    ]  # fmt: skip
+    points = [np.array(v, float) / np.linalg.norm(v) for v in verts]
+    middle: dict[tuple[int, int], int] = {}
+
+    def mid(a: int, b: int) -> int:
+        key = (min(a, b), max(a, b))
+        if key not in middle:
+            m = points[a] + points[b]
+            points.append(m / np.linalg.norm(m))
+            middle[key] = len(points) - 1
+        return middle[key]
+
+    split = []
+    for a, b, c in faces:
+        ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+        split += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+    return np.array(points), np.array(split, dtype=np.int64)
+
+
+#: The drupelets' sphere (:func:`_sphere_mesh`).
+ICOSPHERE = _icosphere()
 
 
 def _v(x: Sequence[float] | FloatArray) -> str:
@@ -158,11 +203,13 @@ def _cane(index: int, points: FloatArray, look: BushLook) -> str:
     )
 
 
-def _berry(berry: Berry, look: BushLook, rng: np.random.Generator) -> str:
-    """A fruit hanging down: an ellipsoid core and drupelets on its surface."""
+def _berry(berry: Berry, look: BushLook, rng: np.random.Generator) -> tuple[str, str]:
+    """A fruit hanging down: an ellipsoid core and drupelets on its surface; the body's
+    MJCF and its drupelet mesh's (an asset)."""
     tag, pos = berry.tag_id, berry.position
     ripe = berry.ripeness >= 0.5
     half = BERRY_HALF * rng.uniform(*look.berry_scale)
+    drupelet = f"drupelet{tag}"
     colour = look.ripe_colour if ripe else look.unripe_colour(rng)
     spec = 'material="glossy"' if ripe else 'material="waxy"'
     core = colour * 0.8
@@ -178,12 +225,25 @@ def _berry(berry: Berry, look: BushLook, rng: np.random.Generator) -> str:
         unit = np.array([r * np.cos(golden * k), r * np.sin(golden * k), z])
         shade = colour * rng.uniform(0.85, 1.15)
         out.append(
-            f'<geom name="berry{tag}_{k + 1}" type="sphere" size="{half[0] * 0.34:.5g}" '
+            f'<geom name="berry{tag}_{k + 1}" type="mesh" mesh="{drupelet}" '
             f'pos="{_v(unit * half * 0.85)}" rgba="{_rgba(shade)}" {spec} '
             f'group="1" contype="0" conaffinity="0"/>'
         )
     out.append("</body>")
-    return "".join(out)
+    return "".join(out), _sphere_mesh(drupelet, half[0] * 0.34)
+
+
+def _sphere_mesh(name: str, radius: float) -> str:
+    """A sphere of ``radius`` as a mesh asset: an icosahedron subdivided once (80
+    faces). The 26 drupelets of each of a bush's berries are most of its triangles;
+    MuJoCo's own spheres (``numslices`` × ``numstacks`` of the scene's quality, 224
+    faces) cost the software rasteriser three times as much for a 2-4 px drupelet at
+    C1's range, and are no rounder to the eye at C2's few centimetres."""
+    vertices, faces = ICOSPHERE
+    return (
+        f'<mesh name="{name}" vertex="{_v((vertices * radius).ravel())}" '
+        f'face="{" ".join(str(i) for i in faces.ravel())}"/>'
+    )
 
 
 def _leaves(spec: SceneSpec, rng: np.random.Generator) -> str:

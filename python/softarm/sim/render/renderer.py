@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import itertools
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,6 +21,7 @@ from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
 from softarm.errors import SoftarmError
+from softarm.sim.render.culling import in_frustum
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.mjcf import (
     ARM_SEGMENTS_PER_SECTION,
@@ -34,6 +36,9 @@ FAR_AWAY = np.array([0.0, -50.0, 0.0])
 PIXEL = 1e-6
 #: The geom group of everything that can hide a berry (leaves, canes, clutter, the arm).
 OCCLUDER_GROUP = 2
+#: The geom group a geom outside a render's frustum is moved to for that render: MuJoCo's
+#: default visualisation options, and those :meth:`BushRenderer.render` builds, hide it.
+CULLED_GROUP = 5
 
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
@@ -103,6 +108,10 @@ class BushRenderer:
         self._leaves = np.flatnonzero(self.labels.kind == KINDS.index("leaf"))
         self._leaf_home = self.model.geom_pos[self._leaves].copy()
         self._leaf_half = self.model.geom_size[self._leaves, 0].copy()
+        # The arm's geoms change size as it bends (their bounding spheres would go
+        # stale): only the rest of the scene is culled.
+        self._groups = self.model.geom_group.copy()
+        self._cullable = np.flatnonzero(self.labels.kind != KINDS.index("arm"))
 
     def push_leaves(self, body: FloatArray, radius: FloatArray) -> None:
         """Move aside every leaf that the arm's body (spheres at ``body`` (N, 3) with
@@ -159,6 +168,14 @@ class BushRenderer:
         r = self._renderer(spec)
         option = mj.MjvOption()
         option.geomgroup[OCCLUDER_GROUP] = int(occluders)
+        with self._culled(camera, spec.size, spec.principal):
+            return self._render_passes(r, camera, option, depth, geoms)
+
+    def _render_passes(
+        self, r: Any, camera: str, option: Any, depth: bool, geoms: bool
+    ) -> RenderedFrame:
+        """Colour, and depth and geom ids if asked, of ``camera`` with renderer ``r``."""
+        mj = self._mj
         r.update_scene(self.data, camera=camera, scene_option=option)
         rgb = r.render()
         colour = np.ascontiguousarray(rgb[..., ::-1])
@@ -201,10 +218,31 @@ class BushRenderer:
             mj.mj_camlight(m, self.data)
             window = CameraSpec(camera, spec.T_parent_camera, (side, side), spec.focal, (0, 0))
             r = self._renderer(window)
-            r.update_scene(self.data, camera=camera)
-            return np.ascontiguousarray(r.render()[..., ::-1])
+            principal = (spec.principal[0] - origin[0], spec.principal[1] - origin[1])
+            with self._culled(camera, (side, side), principal):
+                r.update_scene(self.data, camera=camera)
+                return np.ascontiguousarray(r.render()[..., ::-1])
         finally:
             m.cam_resolution[cam], m.cam_sensorsize[cam], m.cam_intrinsic[cam] = saved
+
+    @contextmanager
+    def _culled(
+        self, camera: str, size: tuple[int, int], principal: tuple[float, float]
+    ) -> Iterator[None]:
+        """Within the block, every geom that cannot show in ``camera``'s ``size``
+        picture with ``principal`` point (px) is in :data:`CULLED_GROUP`
+        (:mod:`softarm.sim.render.culling`; the camera's pose is the data's, after
+        ``mj_camlight``)."""
+        mj, m, d = self._mj, self.model, self.data
+        cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
+        centres = (d.geom_xpos[self._cullable] - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
+        radii = m.geom_rbound[self._cullable]
+        shown = in_frustum(centres, radii, size, self.cameras[camera].focal, principal)
+        m.geom_group[self._cullable[~shown]] = CULLED_GROUP
+        try:
+            yield
+        finally:
+            m.geom_group[:] = self._groups
 
     def close(self) -> None:
         """Free the OpenGL contexts."""

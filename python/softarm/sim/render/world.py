@@ -32,6 +32,7 @@ from softarm.sim.render.mjcf import (
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
+from softarm.vision.poses import invert
 
 __all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
 
@@ -40,10 +41,16 @@ ZED2_BASELINE = 0.12
 #: The cube's and the gripper's reach (m) from their centres, for the leaves they push.
 CUBE_REACH = 0.07
 GRIPPER_REACH = 0.04
-#: Side (px) of the C1 window rendered around the marker cube while tracking it; the
-#: pinhole window rendered for it is WINDOW_MARGIN px larger (the distortion's shift).
-WINDOW = 256
+#: The C1 window rendered around the marker cube while tracking it holds the cube's
+#: bounding sphere with WINDOW_PAD px to spare on each side (the tags' quiet zone and
+#: the detector's adaptive threshold reach past the outline); its side is a multiple of
+#: WINDOW_STEP px (one renderer, an OpenGL context, per side). The pinhole window
+#: rendered for it is WINDOW_MARGIN px larger (the distortion's shift).
+WINDOW_PAD = 16
+WINDOW_STEP = 32
 WINDOW_MARGIN = 24
+#: The cube's faces are 1.25 times its tags (mjcf: 80 mm tags on 100 mm faces).
+CUBE_FACE_PER_TAG = 1.25
 
 
 def arm_sections(arm: SoftArm, q: FloatArray) -> list[FloatArray]:
@@ -106,6 +113,8 @@ class RenderedBush:
         self.stereo = StereoCamera(c1, c1, T_base_c1, T_left_right)
         self.c2 = c2
         self.T_ee_cube = T_ee_cube
+        half = 0.5 * CUBE_FACE_PER_TAG * cube_marker
+        self._cube_corners = half * np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
         right = T_base_c1 @ T_left_right
         spec = SceneSpec(
             bush=bush,
@@ -153,7 +162,24 @@ class RenderedBush:
         """C1's left eye alone (the cube tracking needs one eye)."""
         return self._frame("c1_left", "c1", truth)
 
-    def c1_left_window(self, centre: tuple[float, float], side: int = WINDOW) -> ImageCrop:
+    def cube_window(self, T_base_cube: FloatArray) -> ImageCrop:
+        """C1's left eye around the marker cube at ``T_base_cube`` (where it truly is,
+        as the tag world's crop): the smallest square of WINDOW_STEP px steps, centred
+        on the cube, that holds the cube's eight corners with WINDOW_PAD px to spare.
+        A software rasteriser's cost goes with the pixels."""
+        T_c1_cube = invert(self.stereo.T_base_left) @ T_base_cube
+        points = np.vstack([T_c1_cube[:3, 3], self._cube_corners @ T_c1_cube[:3, :3].T])
+        points[1:] += T_c1_cube[:3, 3]
+        if np.any(points[:, 2] <= 0.0):  # the cube at or behind C1: nothing to see
+            return self.c1_left_window((0.0, 0.0), WINDOW_STEP)
+        pixels = self.stereo.left.project(points)
+        reach = float(np.abs(pixels[1:] - pixels[0]).max()) + WINDOW_PAD
+        side = WINDOW_STEP * int(np.ceil(2.0 * reach / WINDOW_STEP))
+        w, h = self.stereo.left.image_size or (side, side)
+        centre = (float(pixels[0, 0]), float(pixels[0, 1]))
+        return self.c1_left_window(centre, min(side, w, h))
+
+    def c1_left_window(self, centre: tuple[float, float], side: int) -> ImageCrop:
         """The ``side``-pixel square of C1's left eye around ``centre`` (px, clamped into
         the frame), with lens distortion, as an :class:`ImageCrop` that detectors read in
         full-frame coordinates. Only the pinhole pixels the window needs are rendered

@@ -1,0 +1,92 @@
+"""Frustum culling: a sphere is left out only if it covers no pixel, and a culled render
+equals the full one pixel for pixel."""
+
+from __future__ import annotations
+
+import numpy as np
+from tests.perception.perception_world import rendered_world
+
+import softarm
+from softarm.sim.render.culling import MARGIN_PX, in_frustum
+
+FOCAL, PRINCIPAL, SIZE = 900.0, (639.5, 359.5), (1280, 720)
+
+
+def _sphere_at_pixel(u: float, v: float, depth: float, radius: float) -> np.ndarray:
+    """The centre (MuJoCo's camera frame: y up, looking along -z) of a sphere whose
+    centre projects to pixel (u, v) at ``depth``."""
+    x = (u - PRINCIPAL[0]) / FOCAL * depth
+    y = -(v - PRINCIPAL[1]) / FOCAL * depth
+    return np.array([x, y, -depth])
+
+
+def test_a_sphere_that_projects_into_the_picture_is_kept() -> None:
+    rng = np.random.default_rng(5)
+    centres = np.array(
+        [_sphere_at_pixel(rng.uniform(0, 1280), rng.uniform(0, 720), rng.uniform(0.2, 5), 0.0)
+         for _ in range(200)]
+    )  # fmt: skip
+    assert in_frustum(centres, np.full(200, 1e-3), SIZE, FOCAL, PRINCIPAL).all()
+
+
+def test_a_sphere_reaching_in_from_outside_is_kept_and_one_clear_of_it_is_not() -> None:
+    depth, radius = 1.0, 0.01  # 9 px at 1 m
+    beyond = SIZE[0] - 0.5 + MARGIN_PX
+    reaching = _sphere_at_pixel(beyond + 8.0, 300, depth, radius)
+    clear = _sphere_at_pixel(beyond + 16.0, 300, depth, radius)  # 9 px x sec(35 deg) off
+    above = _sphere_at_pixel(600, -0.5 - MARGIN_PX - 10.0, depth, radius)
+    behind = np.array([0.0, 0.0, 0.02])
+    kept = in_frustum(
+        np.array([reaching, clear, above, behind]), np.full(4, radius), SIZE, FOCAL, PRINCIPAL
+    )
+    assert kept.tolist() == [True, False, False, False]
+
+
+def test_an_unbounded_geom_is_always_kept() -> None:
+    far_off = np.array([[100.0, 0.0, 1.0]])
+    assert in_frustum(far_off, np.array([0.0]), SIZE, FOCAL, PRINCIPAL).all()
+
+
+def _uncull(world: object) -> None:
+    renderer = world.renderer  # type: ignore[attr-defined]
+    renderer._cullable = renderer._cullable[:0]
+
+
+def test_culled_renders_equal_the_full_ones() -> None:
+    culled, full = rendered_world(31, 8), rendered_world(31, 8)
+    _uncull(full)
+    arm = softarm.SoftArm.blackberry()
+    q = np.asarray(culled.bush.berries[0].q) * 0.95
+    from softarm.sim.render.world import arm_sections
+
+    for world in (culled, full):
+        world.set_arm(arm_sections(arm, q), arm.forward(q))
+    a, b = culled.c1_left(truth=True), full.c1_left(truth=True)
+    np.testing.assert_array_equal(a.colour, b.colour)
+    np.testing.assert_array_equal(a.geoms, b.geoms)
+    np.testing.assert_array_equal(a.depth, b.depth)
+    np.testing.assert_array_equal(culled.c2_frame().colour, full.c2_frame().colour)
+    for centre in ((640.0, 360.0), (200.0, 150.0), (1100.0, 600.0)):
+        np.testing.assert_array_equal(
+            np.asarray(culled.c1_left_window(centre, 192)),
+            np.asarray(full.c1_left_window(centre, 192)),
+        )
+
+
+def test_a_window_leaves_most_of_the_bush_out() -> None:
+    world = rendered_world(32, 8)
+    renderer = world.renderer
+    seen = []
+    original = renderer._culled
+
+    def spy(camera: str, size: tuple[int, int], principal: tuple[float, float]):  # type: ignore[no-untyped-def]
+        seen.append(renderer.model.geom_group.copy())
+        return original(camera, size, principal)
+
+    renderer._culled = spy
+    world.c1_left_window((640.0, 360.0), 192)
+    assert seen  # the window went through the culling
+    with original("c1_left", (64, 64), (600.0, 400.0)):
+        hidden = int((renderer.model.geom_group == 5).sum())
+    assert hidden > renderer.model.ngeom // 2, hidden
+    assert (renderer.model.geom_group != 5).all()  # restored after the render
