@@ -48,3 +48,33 @@ def test_berries_per_c2_frame(benchmark, world) -> None:  # type: ignore[no-unty
 def test_render_c1_stereo_pair(benchmark, world) -> None:  # type: ignore[no-untyped-def]
     world.hide_arm()
     benchmark.pedantic(world.c1, rounds=5, iterations=1)
+
+
+def _arm_at_a_berry(world):  # type: ignore[no-untyped-def]
+    """The arm 3 % short of the first berry's grasp, where fine positioning renders."""
+    import softarm
+    from softarm.sim.render.world import arm_sections
+
+    arm = softarm.SoftArm.blackberry()
+    q = world.bush.berries[0].q * 0.97
+    T_base_ee = arm.forward(q)
+    world.set_arm(arm_sections(arm, q), T_base_ee)
+    return T_base_ee
+
+
+def test_render_cube_window(benchmark, world) -> None:  # type: ignore[no-untyped-def]
+    """The C1 window the cube is tracked in, once per control period."""
+    T_base_cube = _arm_at_a_berry(world) @ world.T_ee_cube
+    world.cube_window(T_base_cube)  # its renderer made
+    benchmark(world.cube_window, T_base_cube)
+
+
+def test_render_c2_frame(benchmark) -> None:  # type: ignore[no-untyped-def]
+    """C2's frame at 320 x 240, as the harvest renders it, once per control period
+    near the berry."""
+    from softarm.harvest.sim_rig import C2_SCALE
+
+    world = rendered_world(310, c2_scale=C2_SCALE)
+    _arm_at_a_berry(world)
+    benchmark(world.c2_frame)
+    world.close()

@@ -13,9 +13,9 @@ from softarm.sim.bush import Bush
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 
-def rendered_world(seed: int, n_berries: int = 10):  # type: ignore[no-untyped-def]
-    """The rendered world of a fresh bush of ``seed`` seen by the simulated rig's cameras,
-    or a skip when this machine cannot render."""
+def rendered_world(seed: int, n_berries: int = 10, c2_scale: float = 1.0):  # type: ignore[no-untyped-def]
+    """The rendered world of a fresh bush of ``seed`` seen by the simulated rig's cameras
+    (C2's image scaled by ``c2_scale``), or a skip when this machine cannot render."""
     from softarm.harvest.sim_rig import default_cameras
     from softarm.harvest.sim_vision import BASE_TAG_ID
     from softarm.sim.render import RenderUnavailableError
@@ -27,7 +27,7 @@ def rendered_world(seed: int, n_berries: int = 10):  # type: ignore[no-untyped-d
         unripe_fraction=0.4,
     )  # fmt: skip
     try:
-        world = world_for(bush, cams, BASE_TAG_ID)
+        world = world_for(bush, cams, BASE_TAG_ID, c2_scale=c2_scale)
         world.c1_left()
     except RenderUnavailableError as exc:
         pytest.skip(str(exc))

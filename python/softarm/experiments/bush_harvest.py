@@ -4,13 +4,23 @@ unripe picked, true fine-positioning error, contacts, the cane map; and the wall
 per berry beside the tag world's on the same seeds when its reports and times are given.
 
     python -m softarm.experiments.bush_harvest docs/data/perception/bush_harvest_700-709
+
+``--run FIRST LAST BUSH_DIR TAG_DIR`` makes those folders first: for each seed, the
+bush world's harvest and then the tag world's on the same seed (so the two share the
+machine's load), each timed as a whole process, their reports and ``wall_times.txt``
+written (``--berries``, 8 by default)::
+
+    MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 770 779 \
+        docs/data/perception/bush_harvest_770-779 docs/data/perception/tag_harvest_770-779
 """
 
 from __future__ import annotations
 
 import json
 import statistics
+import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -59,8 +69,33 @@ def _reports(folder: Path) -> list[dict[str, Any]]:
     return [json.loads(p.read_text()) for p in sorted(folder.glob("r*.json"))]
 
 
+def run_pair(seeds: range, bush_dir: Path, tag_dir: Path, berries: int = 8) -> None:
+    """Harvest each seed in the bush world, then in the tag world, timing each whole
+    process (``python -m softarm harvest --sim ...``); reports and wall times into the
+    two folders."""
+    for folder in (bush_dir, tag_dir):
+        folder.mkdir(parents=True, exist_ok=True)
+    for seed in seeds:
+        for folder, world in ((bush_dir, ["--world", "bush"]), (tag_dir, [])):
+            report = folder / f"r{seed}.json"
+            command = [sys.executable, "-m", "softarm", "harvest", "--sim", *world,
+                       "--berries", str(berries), "--seed", str(seed),
+                       "--report", str(report), "--quiet"]  # fmt: skip
+            start = time.monotonic()
+            subprocess.run(command, check=False, stdout=subprocess.DEVNULL)
+            wall = time.monotonic() - start
+            with (folder / "wall_times.txt").open("a") as f:
+                f.write(f"{seed} wall {wall:.2f}\n")
+
+
 def main(argv: list[str]) -> None:
-    """Print the pooled figures of each folder of reports on the command line."""
+    """Print the pooled figures of each folder of reports on the command line (after
+    making them, with ``--run``)."""
+    if argv[:1] == ["--run"]:
+        berries = int(argv[argv.index("--berries") + 1]) if "--berries" in argv else 8
+        first, last, bush_dir, tag_dir = argv[1:5]
+        run_pair(range(int(first), int(last) + 1), Path(bush_dir), Path(tag_dir), berries)
+        argv = [bush_dir, tag_dir]
     for name in argv:
         folder = Path(name)
         reports = _reports(folder)
