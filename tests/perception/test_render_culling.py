@@ -90,3 +90,18 @@ def test_a_window_leaves_most_of_the_bush_out() -> None:
         hidden = int((renderer.model.geom_group == 5).sum())
     assert hidden > renderer.model.ngeom // 2, hidden
     assert (renderer.model.geom_group != 5).all()  # restored after the render
+
+
+def test_the_visible_share_of_an_object() -> None:
+    world = rendered_world(33, 8)
+    renderer = world.renderer
+    berries = [g for g in range(renderer.model.ngeom) if renderer.labels.kind[g] == 1]
+    background = [g for g in range(renderer.model.ngeom) if renderer.labels.kind[g] == 0]
+    share = renderer.visible_share("c1_left", berries)
+    assert 0.0 < share <= 1.0
+    assert renderer.visible_share("c1_left", background) < 1.0  # the bush stands before it
+    assert renderer.visible_share("c1_left", list(range(renderer.model.ngeom))) == 1.0
+    world.hide_arm()  # moved out of the picture
+    segments = [g for g in range(renderer.model.ngeom) if renderer.labels.kind[g] == 5][1:4]
+    assert renderer.visible_share("c1_left", segments) == 0.0
+    assert (renderer.model.geom_group != 5).all()  # restored

@@ -8,7 +8,10 @@ tracks the cube most (a random berry's grasp elongations, 0 to 10 % short of the
 placement and fine positioning); C1's left eye renders the
 window the harvest tracks the cube in (:meth:`RenderedBush.cube_window`), the cube's
 pose is estimated from it as the harvest does (:class:`~softarm.vision.MarkerCube`, no
-previous pose) and scored against the true one. ``--side N`` renders fixed N-pixel
+previous pose) and scored against the true one, over all poses and apart where the
+cube's tags are in full view (at least 99 % of their pixels: leaves, fruit or the arm
+hide some in the others; the tag world's figure is of a cube in full view). ``--side N``
+renders fixed N-pixel
 windows instead (the harvest's window before it was fitted to the cube), for
 comparison on the same poses.
 
@@ -26,6 +29,9 @@ from typing import Any
 import numpy as np
 
 __all__ = ["track_cubes"]
+
+#: The cube is in full view when this share of its faces' pixels is not hidden.
+UNHIDDEN = 0.99
 
 
 def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -> dict[str, Any]:
@@ -46,9 +52,12 @@ def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -
     cube = MarkerCube.standard(cams.cube_marker)
     detector = MarkerDetector(cube.dictionary)
     errors, sides, tried, seconds = [], [], 0, 0.0
+    unhidden: list[float] = []  # the cube's tags in full view
+    hidden: list[float] = []  # some of them hidden (leaves, fruit, the arm)
     for seed in seeds:
         bush = Bush.generate(arm, 8, seed, view_point=cams.T_base_c1[:3, 3])
         world = world_for(bush, cams, BASE_TAG_ID)
+        faces = [g for g in range(world.renderer.model.ngeom) if _is_cube_face(world, g)]
         rng = np.random.default_rng(seed)
         T_c1_base = invert(world.stereo.T_base_left)
         for _ in range(poses):
@@ -64,17 +73,34 @@ def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -
             seconds += time.perf_counter() - start
             sides.append(window.shape[0])
             est = cube.estimate(detector.detect(window, world.stereo.left), world.stereo.left)
+            share = world.renderer.visible_share("c1_left", faces)
             if est is not None:
-                errors.append(1e3 * np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3]))
+                error = 1e3 * np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3])
+                errors.append(error)
+                (unhidden if share >= UNHIDDEN else hidden).append(error)
         world.close()
     return {
         "poses": tried,
         "found": len(errors),
-        "median_mm": float(np.median(errors)) if errors else float("nan"),
+        "median_mm": _median(errors),
         "p95_mm": float(np.percentile(errors, 95)) if errors else float("nan"),
+        "in_full_view": len(unhidden),
+        "median_in_full_view_mm": _median(unhidden),
+        "median_partly_hidden_mm": _median(hidden),
         "window_ms": 1e3 * seconds / max(tried, 1),
         "mean_side_px": float(np.mean(sides)) if sides else float("nan"),
     }
+
+
+def _median(values: list[float]) -> float:
+    return float(np.median(values)) if values else float("nan")
+
+
+def _is_cube_face(world: Any, geom: int) -> bool:
+    import mujoco
+
+    name = mujoco.mj_id2name(world.renderer.model, mujoco.mjtObj.mjOBJ_GEOM, geom) or ""
+    return name.startswith("arm_cubeface")
 
 
 def _window(world: Any, T_base_cube: Any, side: int | None) -> Any:

@@ -196,6 +196,22 @@ class BushRenderer:
             d[s < 0] = np.nan
         return RenderedFrame(colour, d, s)
 
+    def visible_share(self, camera: str, geoms: Sequence[int]) -> float:
+        """The share of the pixels ``geoms`` cover in ``camera``'s image drawn alone
+        that they still cover with the whole scene drawn (0 when they are out of the
+        picture): how much of an object the rest of the scene hides."""
+        ids = np.asarray(geoms)
+        seen = self.render(camera, geoms=True).geoms
+        others = np.setdiff1d(np.arange(self.model.ngeom), ids)
+        self.model.geom_group[others] = CULLED_GROUP
+        try:
+            alone = self.render(camera, geoms=True).geoms
+        finally:
+            self.model.geom_group[:] = self._groups
+        assert seen is not None and alone is not None  # asked for
+        whole = int(np.isin(alone, ids).sum())
+        return 0.0 if whole == 0 else int(np.isin(seen, ids).sum()) / whole
+
     def render_window(self, camera: str, origin: tuple[int, int], side: int) -> np.ndarray:
         """Colour (side, side, 3) BGR of the ``side``-pixel square of ``camera``'s pinhole
         image whose top-left pixel is ``origin`` (x0, y0), which may reach past the frame:
