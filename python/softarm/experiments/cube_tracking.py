@@ -75,7 +75,7 @@ def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -
             est = cube.estimate(detector.detect(window, world.stereo.left), world.stereo.left)
             share = world.renderer.visible_share("c1_left", faces)
             if est is not None:
-                error = 1e3 * np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3])
+                error = 1e3 * float(np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3]))
                 errors.append(error)
                 (unhidden if share >= UNHIDDEN else hidden).append(error)
         world.close()
