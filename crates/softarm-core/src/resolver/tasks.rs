@@ -157,7 +157,14 @@ impl<K: Kinematics> Resolver<K> {
             *d = alpha * (g.hybrid_position * x + g.hybrid_orientation * t.dot(&yt));
         }
         let gamma = g.schedule.weight(g.hybrid_gamma, g.hybrid_switch, p_norm);
-        self.add_null_terms(ws, q, alpha * gamma, (&pa, [true; 3]), Some(&pt), (eps, lam));
+        self.add_null_terms(
+            ws,
+            q,
+            alpha * gamma,
+            (&pa, [true; 3]),
+            Some(&pt),
+            (eps, lam),
+        );
     }
 
     /// eq. (7): the conventional resolved rate, with the position Jacobian for a point
@@ -214,12 +221,12 @@ impl<K: Kinematics> Resolver<K> {
         if !second {
             return (pa, None);
         }
-        let m =
-            ws.nb
-                .iter()
-                .zip(&ws.na)
-                .fold(Mat3::zeros(), |s, (b, a)| s + b * a.transpose())
-                * pa;
+        let m = ws
+            .nb
+            .iter()
+            .zip(&ws.na)
+            .fold(Mat3::zeros(), |s, (b, a)| s + b * a.transpose())
+            * pa;
         for ((t, b), a) in ws.nt.iter_mut().zip(&ws.nb).zip(&ws.na) {
             *t = b - m * a;
         }
