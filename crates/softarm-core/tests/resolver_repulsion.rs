@@ -136,3 +136,22 @@ fn the_repulsion_holds_the_pose_grows_the_clearance_and_settles() {
     println!("drift {drift}, still moving {moving}, closer {closer} (of 200)");
     assert_eq!((drift, moving, closer), (0, 0, 0));
 }
+
+/// The cases traced for the saturation rounds' priority (seed 27, beyond the 200 above):
+/// the repulsion pushed four coordinates past their limits, and fixing them for every
+/// task left the hybrid tasks five coordinates for five rows, cycling by millimetres.
+#[test]
+fn coordinates_only_the_repulsion_saturates_stay_with_the_tasks() {
+    let arm = SoftArm::blackberry();
+    let Ok(res) = Resolver::new(arm.clone(), Mode::Hybrid, Gains::blackberry()) else {
+        panic!("the blackberry gains are valid");
+    };
+    let mut rng = StdRng::seed_from_u64(27);
+    for i in 0..=1679 {
+        let case = random_case(&mut rng, &arm);
+        if i == 317 || i == 1679 {
+            let (err, motion, dclear) = run_case(&res, &case);
+            assert!(err <= 5e-5 && motion <= 1e-4 && dclear >= -1e-6, "case {i}");
+        }
+    }
+}

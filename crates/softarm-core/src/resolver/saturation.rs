@@ -54,10 +54,11 @@ fn boundary_scale(
 }
 
 /// Clamps saturation round `round` (of `rounds`): a fixed coordinate keeps its fixed
-/// increment; a free one whose command `q + Δq` leaves `[lower, upper]` is fixed at the
-/// limit for the next round (none after the last). The first round records the unclamped
-/// command. Returns (whether a command left the limits, whether a coordinate was newly
-/// fixed).
+/// increment; a free one whose command `q + Δq` leaves `[lower, upper]` is taken, for the
+/// next round (none after the last), from the null-space terms only when the task part
+/// alone keeps it inside (the terms below the tasks pushed it out: the tasks keep it), else
+/// fixed at the limit for everything. The first round records the unclamped command.
+/// Returns (whether a command left the limits, whether a coordinate was newly taken).
 fn fix_saturated(
     ws: &mut Workspace,
     q: &[f64],
@@ -81,8 +82,15 @@ fn fix_saturated(
         if c != raw {
             saturated = true;
             if round + 1 < rounds {
-                ws.free[k] = false;
-                ws.fixed[k] = c - q[k];
+                let task = q[k] + ws.task[k];
+                if ws.null_free[k] && task.clamp(lower[k], upper[k]) == task {
+                    // Priority: a term below the tasks never takes a coordinate from them.
+                    ws.null_free[k] = false;
+                } else {
+                    ws.free[k] = false;
+                    ws.null_free[k] = false;
+                    ws.fixed[k] = c - q[k];
+                }
                 newly_fixed = true;
             }
         }
@@ -91,10 +99,16 @@ fn fix_saturated(
 }
 
 impl<K: Kinematics> Resolver<K> {
-    /// Saturation in the null space (Flacco et al. 2012), simplified: a coordinate whose
-    /// command would leave the limits is fixed at the limit, its column removed from every
-    /// task, what it still delivers subtracted from the task errors, and the step
-    /// recomputed with the other coordinates (at most n + 1 rounds). The conventional
+    /// Saturation in the null space (Flacco et al. 2012), simplified, by priority: a
+    /// coordinate whose command would leave the limits is taken from the null-space terms
+    /// (joint limits, obstacles) alone when the tasks' part keeps it inside, else fixed at
+    /// the limit, its column removed from every task and what it still delivers subtracted
+    /// from the task errors; the step is recomputed with the other coordinates (at most
+    /// 2n + 1 rounds: each takes a coordinate from the null-space terms or from all).
+    /// Fixing a coordinate that only the lowest terms pushed out would take it from the
+    /// tasks above them: next to a cane the repulsion pinned four coordinates on their
+    /// limits, and the tasks, left with five for five rows, ill-conditioned, cycled by up
+    /// to `max_step` about the pose (issue 27). The conventional
     /// controller is only clamped (it is unconstrained by definition): one round. Leaves
     /// the increment in `ws.dq`; returns whether any command left the limits.
     pub(super) fn saturation_rounds(
@@ -109,9 +123,10 @@ impl<K: Kinematics> Resolver<K> {
         let scale = Scale { alpha, eps, lam };
         let n = q.len();
         ws.free.iter_mut().for_each(|f| *f = true);
+        ws.null_free.iter_mut().for_each(|f| *f = true);
         ws.fixed.iter_mut().for_each(|v| *v = 0.0);
         let conventional = self.mode == Mode::Conventional;
-        let rounds = if conventional { 1 } else { n + 1 };
+        let rounds = if conventional { 1 } else { 2 * n + 1 };
         let mut saturated = false;
         for round in 0..rounds {
             let (e_p, e_w) = self.round_errors(ws, errors, round, alpha);
@@ -175,9 +190,12 @@ impl<K: Kinematics> Resolver<K> {
             q,
             lower,
             upper,
-            &ws.free,
+            &ws.null_free,
             BOUNDARY_FRACTION,
         ));
+        for (t, d) in ws.task.iter_mut().zip(&ws.dq) {
+            *t = s_task * d;
+        }
         let s_avoid = cap_scale(&ws.avoid, 0.5 * max);
         // The repulsion's part is kept as applied: the step may still cut it
         // (Resolver::hold_repulsion).

@@ -49,7 +49,18 @@ pub struct Workspace {
     pub(super) null: Vec<f64>,
     pub(super) unclamped: Vec<f64>,
     pub(super) free: Vec<bool>,
+    /// The coordinates the null-space terms may move: the tasks' free ones less those a
+    /// null-space term alone would take out of the limits (saturation rounds).
+    pub(super) null_free: Vec<bool>,
     pub(super) fixed: Vec<f64>,
+    /// The task part of the last round's increment, as capped.
+    pub(super) task: Vec<f64>,
+    /// The tasks' columns of the coordinates in `null_free` (`na`: the first task's,
+    /// `nb`: the second's, `nt`: J̃ of eq. 17 from them), when those are fewer than the
+    /// tasks' own.
+    pub(super) na: Vec<Vec3>,
+    pub(super) nb: Vec<Vec3>,
+    pub(super) nt: Vec<Vec3>,
     pub(super) avoid: Vec<f64>,
     pub(super) row: Vec<f64>,
     pub(super) trial: Vec<f64>,
@@ -71,7 +82,12 @@ impl Workspace {
             null: vec![0.0; n],
             unclamped: vec![0.0; n],
             free: vec![true; n],
+            null_free: vec![true; n],
             fixed: vec![0.0; n],
+            task: vec![0.0; n],
+            na: vec![Vec3::zeros(); n],
+            nb: vec![Vec3::zeros(); n],
+            nt: vec![Vec3::zeros(); n],
             avoid: vec![0.0; n],
             row: vec![0.0; n],
             trial: vec![0.0; n],

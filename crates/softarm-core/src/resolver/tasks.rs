@@ -95,7 +95,7 @@ impl<K: Kinematics> Resolver<K> {
             .weight(g.position_gamma, g.position_switch, p_norm);
         let pa = normal_inverse3(&gram(&ws.a), [true; 3], eps, lam);
         add_tr_mul(&mut ws.dq, alpha, &ws.a, &(pa * e_p));
-        self.add_null_terms(ws, q, alpha * gamma, &pa, None, (eps, lam));
+        self.add_null_terms(ws, q, alpha * gamma, (&pa, [true; 3]), None, (eps, lam));
     }
 
     /// eq. (13), task 2 (orientation, masked angular Jacobian) over task 3 and the
@@ -117,7 +117,7 @@ impl<K: Kinematics> Resolver<K> {
         add_tr_mul(&mut ws.dq, alpha, &ws.b, &(pb * e_w));
         // The null-space terms project with `ws.a`: the orientation task's columns.
         std::mem::swap(&mut ws.a, &mut ws.b);
-        self.add_null_terms(ws, q, alpha * gamma, &pb, None, (eps, lam));
+        self.add_null_terms(ws, q, alpha * gamma, (&pb, g.axis_mask), None, (eps, lam));
         std::mem::swap(&mut ws.a, &mut ws.b);
     }
 
@@ -157,7 +157,14 @@ impl<K: Kinematics> Resolver<K> {
             *d = alpha * (g.hybrid_position * x + g.hybrid_orientation * t.dot(&yt));
         }
         let gamma = g.schedule.weight(g.hybrid_gamma, g.hybrid_switch, p_norm);
-        self.add_null_terms(ws, q, alpha * gamma, &pa, Some(&pt), (eps, lam));
+        self.add_null_terms(
+            ws,
+            q,
+            alpha * gamma,
+            (&pa, [true; 3]),
+            Some(&pt),
+            (eps, lam),
+        );
     }
 
     /// eq. (7): the conventional resolved rate, with the position Jacobian for a point
@@ -193,20 +200,71 @@ impl<K: Kinematics> Resolver<K> {
         ws.dq.copy_from_slice(dq.as_slice());
     }
 
+    /// The projector of the null-space terms when they may move fewer coordinates than the
+    /// tasks (`ws.null_free`, saturation rounds): the tasks' columns of those coordinates
+    /// only, into `ws.na` (and `ws.nb`, `ws.nt` for the second task of eq. 17), with their
+    /// normal inverses. A vector that is zero on the other coordinates stays zero there
+    /// through it, and lies in the null space of the tasks' whole Jacobians.
+    fn reduced_projector(
+        &self,
+        ws: &mut Workspace,
+        rows: [bool; 3],
+        second: bool,
+        (eps, lam): Dls,
+    ) -> (Mat3, Option<Mat3>) {
+        for k in 0..ws.na.len() {
+            let f = if ws.null_free[k] { 1.0 } else { 0.0 };
+            ws.na[k] = ws.a[k] * f;
+            ws.nb[k] = ws.b[k] * f;
+        }
+        let pa = normal_inverse3(&gram(&ws.na), rows, eps, lam);
+        if !second {
+            return (pa, None);
+        }
+        let m = ws
+            .nb
+            .iter()
+            .zip(&ws.na)
+            .fold(Mat3::zeros(), |s, (b, a)| s + b * a.transpose())
+            * pa;
+        for ((t, b), a) in ws.nt.iter_mut().zip(&ws.nb).zip(&ws.na) {
+            *t = b - m * a;
+        }
+        let pt = normal_inverse3(&gram(&ws.nt), self.gains.axis_mask, eps, lam);
+        (pa, Some(pt))
+    }
+
     /// The null-space terms of eq. (13) / (20), each projected by
-    /// `I − A⁺A − T⁺T` (`A⁺ = Aᵀ pa` with A = `ws.a`; `T⁺ = Tᵀ pt` with T = `ws.t`, if
-    /// given): `ws.null = s (I − A⁺A − T⁺T) ∇H` (skipped when the schedule gives `s = 0`)
-    /// and `ws.avoid = Σ_j c_j f_j / ‖c_j‖²` with `c_j = (I − A⁺A − T⁺T) ∇g_j` (eq. 9 as a
-    /// one-row task on each gap, see [`avoid`]; never scheduled).
+    /// `I − A⁺A − T⁺T` (`A⁺ = Aᵀ pa` with A = `ws.a`, whose active rows are `pa`'s second
+    /// element; `T⁺ = Tᵀ pt` with T = `ws.t`, if given): `ws.null = s (I − A⁺A − T⁺T) ∇H`
+    /// (skipped when the schedule gives `s = 0`) and `ws.avoid = Σ_j c_j f_j / ‖c_j‖²`
+    /// with `c_j = (I − A⁺A − T⁺T) ∇g_j` (eq. 9 as a one-row task on each gap, see
+    /// [`avoid`]; never scheduled). Both move only the coordinates of `ws.null_free`: where
+    /// those are fewer than the tasks' free ones, the projector is the tasks' on them
+    /// ([`Self::reduced_projector`]).
     fn add_null_terms(
         &self,
         ws: &mut Workspace,
         q: &[f64],
         s: f64,
-        pa: &Mat3,
+        (pa, rows): (&Mat3, [bool; 3]),
         pt: Option<&Mat3>,
-        (eps, _): Dls,
+        dls: Dls,
     ) {
+        if s == 0.0 && ws.repulsions.is_empty() {
+            return;
+        }
+        let reduced = ws.null_free != ws.free;
+        let (pa, pt) = if reduced {
+            self.reduced_projector(ws, rows, pt.is_some(), dls)
+        } else {
+            (*pa, pt.copied())
+        };
+        let (a, t) = if reduced {
+            (&ws.na, &ws.nt)
+        } else {
+            (&ws.a, &ws.t)
+        };
         if s != 0.0 {
             joint_limits::gradient_into(
                 q,
@@ -215,19 +273,19 @@ impl<K: Kinematics> Resolver<K> {
                 self.gains.limit_margin,
                 &mut ws.eta,
             );
-            for ((e, d), free) in ws.eta.iter().zip(ws.null.iter_mut()).zip(&ws.free) {
+            for ((e, d), free) in ws.eta.iter().zip(ws.null.iter_mut()).zip(&ws.null_free) {
                 *d = if *free { s * e } else { 0.0 };
             }
-            project(&mut ws.null, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
+            project(&mut ws.null, a, &pa, pt.as_ref().map(|p| (&t[..], p)));
         }
         // Planning paper eq. (9) as a one-row task on each gap, solved in the null space
         // of the tasks (eq. 20): c = P ∇g, Δq = c f / ‖c‖². Projecting the gap's row
         // first, not the three-row push J_s⁺ F after, makes each obstacle's step an
         // ascent of its own gap that vanishes where the gap is stationary (avoid.rs).
         for j in 0..ws.repulsions.len() {
-            avoid::gap_row_into(&ws.repulsions[j], &ws.free, &mut ws.row);
-            project(&mut ws.row, &ws.a, pa, pt.map(|p| (&ws.t[..], p)));
-            avoid::add_gap_step(&ws.row, ws.repulsions[j].ask, eps, &mut ws.avoid);
+            avoid::gap_row_into(&ws.repulsions[j], &ws.null_free, &mut ws.row);
+            project(&mut ws.row, a, &pa, pt.as_ref().map(|p| (&t[..], p)));
+            avoid::add_gap_step(&ws.row, ws.repulsions[j].ask, dls.0, &mut ws.avoid);
         }
     }
 }
