@@ -16,6 +16,7 @@ from softarm.errors import ConfigError, HardwareUnavailableError
 from softarm.harvest.rig_parts import a_cane
 from softarm.perception.bush_map import BushMap
 from softarm.perception.canes import fit_canes
+from softarm.perception.sight_lines import sight_lines
 from softarm.perception.stereo import locate_berries
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.perception_config import PerceptionConfig
@@ -79,9 +80,13 @@ class StereoC1:
         return left, right
 
     def look(self) -> int:
-        """One stereo view merged into the map; the number of berries new to it."""
+        """One stereo view merged into the map; the number of berries new to it. The
+        ripe fruit it cannot place are kept as sight lines, for C2 to place."""
         left, right = self.pair()
-        return self.bush_map.update(locate_berries(left, right, self.stereo))
+        detections = locate_berries(left, right, self.stereo)
+        new = self.bush_map.update(detections)
+        self.bush_map.note_unplaced(sight_lines(detections, self.stereo))
+        return new
 
     def fit_canes(self, parts: FloatArray, reach: float) -> list[PolynomialCurve]:
         """The canes of one stereo view, the rig's own ``parts`` and what lies beyond

@@ -1,7 +1,9 @@
 """The bush map: the berries found so far, ripe ones to pick and unripe ones to leave,
 each with its position in the base frame and how often it was seen, and the canes
 fitted from C1. Built from C1 at IDLE and refreshed each time the arm is home, since the
-arm and the fruit already picked hide parts of the bush."""
+arm and the fruit already picked hide parts of the bush. The ripe fruit C1 finds but
+cannot place are kept as sight lines until C2 places them
+(:mod:`softarm.perception.sight_lines`)."""
 
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.perception.berries import BerryDetection, Ripeness
+from softarm.perception.sight_lines import Placing, SightLine, same_line
 
 if TYPE_CHECKING:
     from softarm.perception.canes import CaneFit
@@ -49,6 +52,8 @@ class BushMap:
     merge_distance: float = 0.02
     berries: list[MappedBerry] = field(default_factory=list)
     canes: list[CaneFit] = field(default_factory=list)
+    #: The ripe fruit C1 found without a position, each with C2's crossings so far.
+    unplaced: list[Placing] = field(default_factory=list)
 
     def update(self, detections: Iterable[BerryDetection]) -> int:
         """Merge one view's detections (positions in the base frame); the number of
@@ -71,6 +76,33 @@ class BushMap:
                 known.sightings = n + 1
         return new
 
+    def note_unplaced(self, lines: Iterable[SightLine]) -> None:
+        """Keep the ripe ones of one view's sight lines: a line that passes within
+        ``merge_distance`` of a mapped berry is that berry; one near a kept line is it
+        seen again."""
+        for line in lines:
+            if not line.ripe or self._on_line(line):
+                continue
+            known = next((p.line for p in self.unplaced if same_line(p.line, line)), None)
+            if known is None:
+                self.unplaced.append(Placing(line))
+            else:
+                known.ripe_votes += line.ripe_votes
+                known.sightings += line.sightings
+
+    def place(self, placing: Placing, position: FloatArray) -> MappedBerry:
+        """Map the fruit of ``placing`` at ``position`` (C2 placed it); it leaves the
+        unplaced ones."""
+        line = placing.line
+        distance = float(np.linalg.norm(position - line.origin))
+        berry = MappedBerry(
+            len(self.berries), np.asarray(position, dtype=np.float64).copy(),
+            distance * float(np.sin(line.half_angle)), line.ripe_votes, line.sightings,
+        )  # fmt: skip
+        self.berries.append(berry)
+        self.unplaced.remove(placing)
+        return berry
+
     def get(self, berry_id: int) -> MappedBerry | None:
         """The berry of ``berry_id``, or None."""
         return next((b for b in self.berries if b.id == berry_id), None)
@@ -78,6 +110,15 @@ class BushMap:
     def ripe(self) -> list[MappedBerry]:
         """The berries to pick."""
         return [b for b in self.berries if b.ripeness == "ripe"]
+
+    def _on_line(self, line: SightLine) -> bool:
+        """Whether a mapped berry lies within ``merge_distance`` of ``line``."""
+        for b in self.berries:
+            along = b.position - line.origin
+            off = along - (along @ line.direction) * line.direction
+            if float(np.linalg.norm(off)) <= self.merge_distance:
+                return True
+        return False
 
     def _near(self, position: FloatArray) -> MappedBerry | None:
         if not self.berries:

@@ -1,0 +1,152 @@
+"""Fruit C1 finds but cannot place, placed where C2's rays cross its sight line: the
+geometry against closed forms, the agreement rule, and the map's bookkeeping."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softarm.perception.berries import BerryDetection
+from softarm.perception.bush_map import BushMap, MappedBerry
+from softarm.perception.sight_lines import (
+    CROSSINGS,
+    Placing,
+    SightLine,
+    crossing,
+    sight_lines,
+)
+from softarm.perception.stereo_camera import StereoCamera
+from softarm.vision.camera_model import CameraModel
+
+K1 = np.array([[900.0, 0, 639.5], [0, 900.0, 359.5], [0, 0, 1]])
+C1 = CameraModel(K1, np.zeros(5), (1280, 720))
+K2 = np.array([[300.0, 0, 319.5], [0, 300.0, 239.5], [0, 0, 1]])
+C2 = CameraModel(K2, np.zeros(5), (640, 480))
+FRUIT = np.array([0.05, 0.40, 0.30])  # base frame
+
+
+def _look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """An OpenCV camera pose (z forward, y down) at ``eye`` looking at ``target``."""
+    z = (target - eye) / np.linalg.norm(target - eye)
+    x = np.cross([0.0, 0.0, -1.0], z)
+    x /= np.linalg.norm(x)
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+    T[:3, 3] = eye
+    return T
+
+
+def _stereo() -> StereoCamera:
+    T_left_right = np.eye(4)
+    T_left_right[0, 3] = 0.12
+    return StereoCamera(C1, C1, _look_at(np.array([0.6, -0.5, 0.5]), FRUIT), T_left_right)
+
+
+def _det(center: tuple[float, float], radius: float, ripe: bool = True) -> BerryDetection:
+    return BerryDetection(
+        center, radius, (0, 0, 1, 1), np.zeros((1, 1), bool), 1.0,
+        "ripe" if ripe else "unripe", 0.9,
+    )  # fmt: skip
+
+
+def _seen(T_base_camera: np.ndarray, camera: CameraModel, point: np.ndarray) -> tuple[float, float]:
+    p = (np.linalg.inv(T_base_camera) @ np.append(point, 1.0))[:3]
+    u, v = camera.project(p[None, :])[0]
+    return float(u), float(v)
+
+
+def _line() -> SightLine:
+    stereo = _stereo()
+    left = _seen(stereo.T_base_left, C1, FRUIT)
+    rectified = stereo.rectification.to_rectified_pixels(np.array([left]))[0]
+    (line,) = sight_lines([_det((float(rectified[0]), float(rectified[1])), 9.0)], stereo)
+    return line
+
+
+def _c2(eye: np.ndarray) -> np.ndarray:
+    return _look_at(eye, FRUIT + np.array([0.0, 0.0, 0.01]))
+
+
+def _distance_to_line(line: SightLine, point: np.ndarray) -> float:
+    along = point - line.origin
+    return float(np.linalg.norm(along - (along @ line.direction) * line.direction))
+
+
+def test_the_sight_line_passes_through_the_fruit() -> None:
+    line = _line()
+    assert _distance_to_line(line, FRUIT) < 1e-6
+    np.testing.assert_allclose(line.origin, _stereo().T_base_left[:3, 3])
+    assert line.half_angle == pytest.approx(np.arctan2(9.0, 900.0))
+
+
+def test_placed_fruit_keep_their_position() -> None:
+    stereo = _stereo()
+    left = _seen(stereo.T_base_left, C1, FRUIT)
+    rectified = stereo.rectification.to_rectified_pixels(np.array([left]))[0]
+    placed = BerryDetection(
+        (float(rectified[0]), float(rectified[1])), 9.0, (0, 0, 1, 1), np.zeros((1, 1), bool),
+        1.0, "ripe", 0.9, position=FRUIT,
+    )  # fmt: skip
+    assert sight_lines([placed], stereo) == []
+
+
+def test_c2_rays_cross_the_sight_line_at_the_fruit() -> None:
+    line = _line()
+    T = _c2(np.array([0.0, 0.15, 0.32]))
+    point = crossing(line, _det(_seen(T, C2, FRUIT), 12.0), T, C2)
+    assert point is not None
+    np.testing.assert_allclose(point, FRUIT, atol=1e-6)
+
+
+def test_a_ray_that_misses_the_line_or_runs_along_it_gives_nothing() -> None:
+    line = _line()
+    T = _c2(np.array([0.0, 0.15, 0.32]))
+    beside = FRUIT + np.array([0.0, 0.0, 0.03])  # another fruit 3 cm off the line
+    assert crossing(line, _det(_seen(T, C2, beside), 12.0), T, C2) is None
+    along = _look_at(line.origin - 0.2 * line.direction, FRUIT)  # C2 behind C1, in line
+    assert crossing(line, _det(_seen(along, C2, FRUIT), 12.0), along, C2) is None
+
+
+def test_a_size_that_fits_no_fruit_gives_nothing() -> None:
+    line = _line()
+    T = _c2(np.array([0.0, 0.15, 0.32]))
+    centre = _seen(T, C2, FRUIT)
+    assert crossing(line, _det(centre, 12.0), T, C2) is not None
+    assert crossing(line, _det(centre, 80.0), T, C2) is None  # 8 cm across at 25 cm
+
+
+def test_a_fruit_is_placed_by_agreeing_crossings_from_poses_apart() -> None:
+    placing = Placing(_line())
+    for k in range(CROSSINGS):
+        placing.add(FRUIT + 1e-3 * k, np.array([0.0, 0.15, 0.32]))
+    assert placing.position() is None  # all from one pose: chance is not ruled out
+    placing = Placing(_line())
+    placing.add(FRUIT + 0.05, np.array([0.1, 0.1, 0.3]))  # another fruit, once
+    for k in range(CROSSINGS - 1):
+        placing.add(FRUIT, np.array([0.01 * k, 0.15, 0.32]))
+    assert placing.position() is None
+    placing.add(FRUIT + 0.002, np.array([0.05, 0.15, 0.32]))
+    position = placing.position()
+    assert position is not None
+    np.testing.assert_allclose(position, FRUIT + 0.002 / CROSSINGS, atol=1e-12)
+
+
+def test_the_map_keeps_ripe_unplaced_fruit_once_and_places_it() -> None:
+    line = _line()
+    unripe = SightLine(line.origin, line.direction, line.half_angle, 0.1)
+    bush_map = BushMap()
+    bush_map.note_unplaced([line, unripe])
+    bush_map.note_unplaced([SightLine(line.origin, line.direction, line.half_angle, 0.9)])
+    assert len(bush_map.unplaced) == 1 and bush_map.unplaced[0].line.sightings == 2
+    berry = bush_map.place(bush_map.unplaced[0], FRUIT)
+    assert bush_map.unplaced == [] and bush_map.ripe() == [berry]
+    expected = np.linalg.norm(FRUIT - line.origin) * np.sin(line.half_angle)
+    assert berry.radius == pytest.approx(expected)
+    bush_map.note_unplaced([line])  # now mapped: the line is that berry
+    assert bush_map.unplaced == []
+
+
+def test_a_line_through_a_mapped_berry_is_that_berry() -> None:
+    bush_map = BushMap(berries=[MappedBerry(0, FRUIT + 0.01, 0.01, 1.0)])
+    bush_map.note_unplaced([_line()])
+    assert bush_map.unplaced == []
