@@ -63,6 +63,7 @@ pub struct Workspace {
     pub(super) nt: Vec<Vec3>,
     pub(super) avoid: Vec<f64>,
     pub(super) row: Vec<f64>,
+    pub(super) row2: Vec<f64>,
     pub(super) trial: Vec<f64>,
     pub(super) pieces: Vec<Piece>,
     pub(super) repulsions: Vec<Repulsion>,
@@ -90,6 +91,7 @@ impl Workspace {
             nt: vec![Vec3::zeros(); n],
             avoid: vec![0.0; n],
             row: vec![0.0; n],
+            row2: vec![0.0; n],
             trial: vec![0.0; n],
             pieces: Vec::new(),
             repulsions: Vec::new(),
@@ -272,13 +274,12 @@ impl<K: Kinematics> Resolver<K> {
         let errors = self.task_errors(ws, q, &model, &goal, input);
         // Planning paper eq. (9): the obstacles' repulsions at q, on the model.
         let clearance = avoid::repulsions_into(
-            &self.arm,
+            (&self.arm, &self.body),
             q,
             input.obstacles,
             &self.gains,
             &ws.jac,
-            &mut ws.pieces,
-            &mut ws.repulsions,
+            (&mut ws.pieces, &mut ws.repulsions),
         );
         // The lag bound applies to a step that closes the loop through the plant without
         // a predictor accounting for the lag.
