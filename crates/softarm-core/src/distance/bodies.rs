@@ -160,32 +160,6 @@ pub fn closest_piece_within(
     best
 }
 
-/// The two pieces of `pieces` (held by `bound`) whose surfaces are nearest `obstacle`,
-/// nearer than `cutoff`: the nearest, and the next one when its surface is within `band`
-/// of the nearest's. Exact, far pieces skipped by bounding spheres.
-pub fn two_nearest_within(
-    pieces: &[Piece],
-    bound: &BodyBox,
-    obstacle: &Obstacle,
-    cutoff: f64,
-    band: f64,
-) -> (Option<BodyClosest>, Option<BodyClosest>) {
-    let (mut first, mut second): (Option<BodyClosest>, Option<BodyClosest>) = (None, None);
-    scan(pieces, bound, obstacle, cutoff, band, |hit| match first {
-        Some(f) if hit.surface >= f.surface => {
-            if second.is_none_or(|s| hit.surface < s.surface) {
-                second = Some(hit);
-            }
-        }
-        _ => {
-            second = first;
-            first = Some(hit);
-        }
-    });
-    let near = |s: &BodyClosest| first.is_some_and(|f| s.surface - f.surface < band);
-    (first, second.filter(near))
-}
-
 /// Passes to `each` the closest pair of every piece whose surface is nearer `obstacle`
 /// than `cutoff` and than the nearest passed so far plus `slack` (0: each one passed is
 /// the nearest so far, the last the nearest of all).

@@ -35,7 +35,7 @@ use nalgebra::DMatrix;
 use super::Gains;
 use crate::body::{Body, Part};
 use crate::chain::{forward_unchecked, point_unchecked};
-use crate::distance::bodies::{two_nearest_within, BodyBox, BodyClosest, Piece};
+use crate::distance::bodies::{closest_piece_within, BodyBox, BodyClosest, Piece};
 use crate::distance::Obstacle;
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
@@ -64,11 +64,6 @@ pub struct Repulsion {
     pub normal: Vec3,
     /// The gap increase eq. (9) asks for this step, `f` (m).
     pub ask: f64,
-    /// For the second-nearest piece of the same obstacle as the repulsion before it, the
-    /// weight of the joint step ([`add_pair_step`]) in the pair's step: 1 where the two
-    /// surfaces are equally near, falling linearly to 0 where the second's is one step's
-    /// largest ask farther; 0 for a nearest piece.
-    pub pair: f64,
 }
 
 fn columns(j: &nalgebra::Matrix3xX<f64>) -> Vec<Vec3> {
@@ -99,28 +94,14 @@ pub fn repulsions_into<K: Kinematics + ?Sized>(
     // The surface distance (the piece's radius off its backbone) an obstacle's centre line
     // must come within to repel: its own radius and the influence distance.
     let cutoff = gains.obstacle_radius + rho;
-    // Within this of the nearest surface, the next nearest piece is raised with it: one
-    // step's largest ask.
-    let band = 0.5 * gains.max_step;
     let mut clearance = f64::INFINITY;
     for ob in obstacles {
-        let (first, second) = two_nearest_within(pieces, &bound, ob, cutoff, band);
-        let Some(first) = first else {
+        let Some(hit) = closest_piece_within(pieces, &bound, ob, cutoff) else {
             continue;
         };
-        clearance = clearance.min(first.surface - gains.obstacle_radius);
-        let Some(r) = repulsion((arm, body), q, gains, jac, pieces, &first) else {
-            continue;
-        };
-        out.push(r);
-        if let Some(mut r) = second.and_then(|h| repulsion((arm, body), q, gains, jac, pieces, &h))
-        {
-            // Blended in continuously: a pair that came and went at the band's edge made
-            // the step jump, and the arm cycled across the edge.
-            r.pair = 1.0 - (r.gap - (first.surface - gains.obstacle_radius)) / band;
-            if r.pair > 0.0 {
-                out.push(r);
-            }
+        clearance = clearance.min(hit.surface - gains.obstacle_radius);
+        if let Some(r) = repulsion((arm, body), q, gains, jac, pieces, &hit) {
+            out.push(r);
         }
     }
     clearance
@@ -156,7 +137,6 @@ fn repulsion<K: Kinematics + ?Sized>(
         jac: point_columns((arm, body), q, jac, pieces, hit),
         normal: away / d,
         ask,
-        pair: 0.0,
     })
 }
 
@@ -223,50 +203,6 @@ pub fn add_gap_step(c: &[f64], ask: f64, threshold: f64, out: &mut [f64]) {
     let k = ask * (1.0 - t2 / sigma2) / sigma2;
     for (o, x) in out.iter_mut().zip(c) {
         *o += k * x;
-    }
-}
-
-/// The joint step of two gap rows of one obstacle (its two nearest pieces): `out +=
-/// Σ_i Cᵀe_i (e_iᵀ f)(1 − ε²/λ_i)/λ_i` over the eigenpairs (λ_i, e_i) of the rows' Gram
-/// matrix `C Cᵀ` (C = [`a`; `b`], f = [`fa`, `fb`]) with λ_i above ε², nothing along the
-/// others: the pseudo-inverse of the two rows, faded like [`add_gap_step`] (which it is
-/// for one row). It raises each gap by its ask where the null space can raise both, and
-/// does not trade one for the other where it cannot: along a direction that raises one
-/// and closes the other, the asks cancel. Stepping on the nearest piece's row alone, a
-/// step closed the runner-up, which was nearest at the next step, whose step closed the
-/// first: the pair cycled by up to a step's cap (issue 27: the gripper and the distal arc,
-/// each with its own radius).
-pub fn add_pair_step(a: &[f64], b: &[f64], (fa, fb): (f64, f64), threshold: f64, out: &mut [f64]) {
-    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
-    let (gaa, gab, gbb) = (dot(a, a), dot(a, b), dot(b, b));
-    let t2 = threshold * threshold;
-    // Eigenpairs of [[gaa, gab], [gab, gbb]] in closed form.
-    let mean = 0.5 * (gaa + gbb);
-    let half = (0.25 * (gaa - gbb).powi(2) + gab * gab).sqrt();
-    for lambda in [mean + half, mean - half] {
-        if lambda <= t2 {
-            continue;
-        }
-        // An eigenvector: (gab, λ − gaa) or (λ − gbb, gab), the better conditioned.
-        let (u, v) = if (lambda - gaa).abs() + gab.abs() >= (lambda - gbb).abs() + gab.abs() {
-            (gab, lambda - gaa)
-        } else {
-            (lambda - gbb, gab)
-        };
-        let norm = (u * u + v * v).sqrt();
-        if norm == 0.0 {
-            // A multiple of the identity (orthogonal rows of equal length): every vector
-            // is an eigenvector; the rows themselves are the pair.
-            for (x, f) in [(a, fa), (b, fb)] {
-                add_gap_step(x, f.max(0.0), threshold, out);
-            }
-            return;
-        }
-        let (u, v) = (u / norm, v / norm);
-        let k = (u * fa + v * fb) * (1.0 - t2 / lambda) / lambda;
-        for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
-            *o += k * (u * x + v * y);
-        }
     }
 }
 

@@ -282,28 +282,10 @@ impl<K: Kinematics> Resolver<K> {
         // of the tasks (eq. 20): c = P ∇g, Δq = c f / ‖c‖². Projecting the gap's row
         // first, not the three-row push J_s⁺ F after, makes each obstacle's step an
         // ascent of its own gap that vanishes where the gap is stationary (avoid.rs).
-        // The two nearest pieces of one obstacle are raised jointly (avoid::add_pair_step).
-        let n = ws.repulsions.len();
-        for j in 0..n {
-            if ws.repulsions[j].pair > 0.0 {
-                continue;
-            }
-            let proj = |r: &avoid::Repulsion, row: &mut [f64]| {
-                avoid::gap_row_into(r, &ws.null_free, row);
-                project(row, a, &pa, pt.as_ref().map(|p| (&t[..], p)));
-            };
-            proj(&ws.repulsions[j], &mut ws.row);
-            let ask = ws.repulsions[j].ask;
-            // A pair's step blends the nearest piece's own step into the joint one by the
-            // pair's weight w: (1 − w) own + w joint, continuous as the pair comes and goes.
-            let second = ws.repulsions.get(j + 1).filter(|r| r.pair > 0.0);
-            let w = second.map_or(0.0, |r| r.pair);
-            avoid::add_gap_step(&ws.row, (1.0 - w) * ask, dls.0, &mut ws.avoid);
-            if let Some(second) = second {
-                proj(second, &mut ws.row2);
-                let asks = (w * ask, w * second.ask);
-                avoid::add_pair_step(&ws.row, &ws.row2, asks, dls.0, &mut ws.avoid);
-            }
+        for j in 0..ws.repulsions.len() {
+            avoid::gap_row_into(&ws.repulsions[j], &ws.null_free, &mut ws.row);
+            project(&mut ws.row, a, &pa, pt.as_ref().map(|p| (&t[..], p)));
+            avoid::add_gap_step(&ws.row, ws.repulsions[j].ask, dls.0, &mut ws.avoid);
         }
     }
 }
