@@ -33,8 +33,9 @@
 use nalgebra::DMatrix;
 
 use super::Gains;
+use crate::body::{Body, Part};
 use crate::chain::{forward_unchecked, point_unchecked};
-use crate::distance::bodies::{closest_piece_within, placed_pieces_into, BodyBox, Piece};
+use crate::distance::bodies::{closest_piece_within, BodyBox, BodyClosest, Piece};
 use crate::distance::Obstacle;
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
@@ -70,74 +71,112 @@ fn columns(j: &nalgebra::Matrix3xX<f64>) -> Vec<Vec3> {
 }
 
 /// Fills `out` with the repulsion of every obstacle within the influence distance of the
-/// model arm at `q` (`jac`: the end-effector Jacobian at `q`). Returns the smallest
-/// surface gap among them, `+∞` when none is that close.
+/// model arm at `q`, measured on `body` (`jac`: the end-effector Jacobian at `q`; `pieces`:
+/// a buffer for the body's pieces). Returns the smallest surface gap among them, `+∞` when
+/// none is that close.
 pub fn repulsions_into<K: Kinematics + ?Sized>(
-    arm: &K,
+    (arm, body): (&K, &Body),
     q: &[f64],
     obstacles: &[Obstacle],
     gains: &Gains,
     jac: &DMatrix<f64>,
-    pieces: &mut Vec<Piece>,
-    out: &mut Vec<Repulsion>,
+    (pieces, out): (&mut Vec<Piece>, &mut Vec<Repulsion>),
 ) -> f64 {
     out.clear();
     if obstacles.is_empty() || gains.influence_distance <= 0.0 {
         return f64::INFINITY;
     }
-    placed_pieces_into(arm, q, pieces);
-    // One box around the whole body per step; each obstacle is tested against it first.
+    body.pieces_into(arm, q, pieces);
+    // One box around the whole body's surface per step; each obstacle is tested against
+    // it first.
     let bound = BodyBox::around(pieces);
-    let cutoff = gains.body_radius + gains.influence_distance;
     let rho = gains.influence_distance;
+    // The surface distance (the piece's radius off its backbone) an obstacle's centre line
+    // must come within to repel: its own radius and the influence distance.
+    let cutoff = gains.obstacle_radius + rho;
     let mut clearance = f64::INFINITY;
-    let n_sections = arm.n_sections();
     for ob in obstacles {
         let Some(hit) = closest_piece_within(pieces, &bound, ob, cutoff) else {
             continue;
         };
-        let c = hit.closest;
-        let gap = c.distance - gains.body_radius;
-        clearance = clearance.min(gap);
-        let away = c.arm_point - c.obstacle_point;
-        let d = away.norm();
-        if gap >= rho || d == 0.0 {
-            // At d = 0 the backbone crosses the obstacle: no direction to push in.
-            continue;
+        clearance = clearance.min(hit.surface - gains.obstacle_radius);
+        if let Some(r) = repulsion((arm, body), q, gains, jac, pieces, &hit) {
+            out.push(r);
         }
-        let g = gap.max(MIN_GAP);
-        // The ask is a gap increase for ONE step: never more than a step may move (half
-        // of max_step, the repulsion's cap). Eq. (9) asks 1.45 m per step at the 1 mm
-        // clamp, which would keep every step at its cap, also where P ∇g is small.
-        let khatib = gains.repulsion_gain * (1.0 / g - 1.0 / rho) / (g * g);
-        let ask = khatib.max(TAIL * (rho - gap)).min(0.5 * gains.max_step);
-        let cols = if !hit.rigid {
-            columns(&point_unchecked(arm, q, c.section, c.s).1)
-        } else {
-            // A point of a rigid part moves as the affine combination of the part's ends.
+    }
+    clearance
+}
+
+/// The repulsion of one piece's closest pair `hit` (its surface gap within the influence
+/// distance), or `None` where the backbone crosses the obstacle (no direction to push in).
+fn repulsion<K: Kinematics + ?Sized>(
+    (arm, body): (&K, &Body),
+    q: &[f64],
+    gains: &Gains,
+    jac: &DMatrix<f64>,
+    pieces: &[Piece],
+    hit: &BodyClosest,
+) -> Option<Repulsion> {
+    let rho = gains.influence_distance;
+    let c = &hit.closest;
+    let gap = hit.surface - gains.obstacle_radius;
+    let away = c.arm_point - c.obstacle_point;
+    let d = away.norm();
+    if gap >= rho || d == 0.0 {
+        return None;
+    }
+    let g = gap.max(MIN_GAP);
+    // The ask is a gap increase for ONE step: never more than a step may move (half of
+    // max_step, the repulsion's cap). Eq. (9) asks 1.45 m per step at the 1 mm clamp,
+    // which would keep every step at its cap, also where P ∇g is small.
+    let khatib = gains.repulsion_gain * (1.0 / g - 1.0 / rho) / (g * g);
+    let ask = khatib.max(TAIL * (rho - gap)).min(0.5 * gains.max_step);
+    Some(Repulsion {
+        gap,
+        arm_point: c.arm_point,
+        jac: point_columns((arm, body), q, jac, pieces, hit),
+        normal: away / d,
+        ask,
+    })
+}
+
+/// The columns of the Jacobian of the arm point of `hit` (on `pieces`, the pieces of
+/// `body` at `q`; `jac`: the end-effector Jacobian at `q`).
+fn point_columns<K: Kinematics + ?Sized>(
+    (arm, body): (&K, &Body),
+    q: &[f64],
+    jac: &DMatrix<f64>,
+    pieces: &[Piece],
+    hit: &BodyClosest,
+) -> Vec<Vec3> {
+    let c = &hit.closest;
+    match body.part_of(pieces, hit.piece) {
+        Part::Arc => columns(&point_unchecked(arm, q, c.section, c.s).1),
+        Part::Plate => {
+            // A point of a plate moves as the affine combination of the plate's ends.
             let start = columns(&point_unchecked(arm, q, c.section, 1.0).1);
-            let end: Vec<Vec3> = if c.section + 1 < n_sections {
-                columns(&point_unchecked(arm, q, c.section + 1, 0.0).1)
-            } else {
-                (0..jac.ncols())
-                    .map(|k| Vec3::new(jac[(0, k)], jac[(1, k)], jac[(2, k)]))
-                    .collect()
-            };
+            let end = columns(&point_unchecked(arm, q, c.section + 1, 0.0).1);
             start
                 .iter()
                 .zip(&end)
                 .map(|(a, b)| a * (1.0 - c.s) + b * c.s)
                 .collect()
-        };
-        out.push(Repulsion {
-            gap,
-            arm_point: c.arm_point,
-            jac: cols,
-            normal: away / d,
-            ask,
-        });
+        }
+        Part::Gripper => {
+            // A point fixed to the end-effector frame: ṗ = v + ω × (p − p_ee), with the
+            // frame's origin `gripper_back` along the gripper from its start.
+            let piece = &pieces[hit.piece];
+            let z = piece.arc.frame.rot.column(2).into_owned();
+            let r = c.arm_point - (piece.arc.frame.pos + z * body.gripper_back());
+            (0..jac.ncols())
+                .map(|k| {
+                    let v = Vec3::new(jac[(0, k)], jac[(1, k)], jac[(2, k)]);
+                    let w = Vec3::new(jac[(3, k)], jac[(4, k)], jac[(5, k)]);
+                    v + w.cross(&r)
+                })
+                .collect()
+        }
     }
-    clearance
 }
 
 /// Writes the gap's gradient `∇g = J_sᵀ n` of `r` into `row`, with the coordinates that

@@ -272,13 +272,12 @@ impl<K: Kinematics> Resolver<K> {
         let errors = self.task_errors(ws, q, &model, &goal, input);
         // Planning paper eq. (9): the obstacles' repulsions at q, on the model.
         let clearance = avoid::repulsions_into(
-            &self.arm,
+            (&self.arm, &self.body),
             q,
             input.obstacles,
             &self.gains,
             &ws.jac,
-            &mut ws.pieces,
-            &mut ws.repulsions,
+            (&mut ws.pieces, &mut ws.repulsions),
         );
         // The lag bound applies to a step that closes the loop through the plant without
         // a predictor accounting for the lag.
