@@ -2,8 +2,8 @@
 //!
 //! Every clearance of the project measures this body: the harvest's planning and contact
 //! gaps (`softarm.harvest.clearance`), the Cosserat rod's ground truth of contact
-//! (`softarm.sim.cosserat.clearance`, on the rod's own centre line) and the default body
-//! radius of the resolver's obstacle task ([`crate::Gains::for_arm`]). It is
+//! (`softarm.sim.cosserat.clearance`, on the rod's own centre line) and the resolver's
+//! obstacle task ([`crate::Resolver::with_body`], piece by piece). It is
 //!
 //! - each section's arc, a tube of radius [`Body::section_radii`] about the backbone: the
 //!   ring of actuators' radius `r_i` plus one actuator's, [`ACTUATOR_RADIUS`];

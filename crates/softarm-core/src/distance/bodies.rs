@@ -160,6 +160,20 @@ pub fn closest_piece_within(
     best
 }
 
+/// Appends to `out` the closest pair of every piece of `pieces` (held by `bound`) whose
+/// surface is nearer `obstacle` than `cutoff` and than the nearest surface plus `slack`
+/// (m), in the pieces' order. Every piece that qualifies is appended; a few appended
+/// early may lie beyond the nearest plus `slack` (the nearest is only known at the end).
+pub fn pieces_within(
+    pieces: &[Piece],
+    bound: &BodyBox,
+    obstacle: &Obstacle,
+    (cutoff, slack): (f64, f64),
+    out: &mut Vec<BodyClosest>,
+) {
+    scan(pieces, bound, obstacle, cutoff, slack, |hit| out.push(hit));
+}
+
 /// Passes to `each` the closest pair of every piece whose surface is nearer `obstacle`
 /// than `cutoff` and than the nearest passed so far plus `slack` (0: each one passed is
 /// the nearest so far, the last the nearest of all).
