@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softarm import Gains, PolynomialCurve, SoftArm, _core, geometry
+from softarm import Gains, PolynomialCurve, Resolver, SoftArm, _core, geometry
 from softarm._core import Body, lead_gain, play, predicted_loop_alpha
 from softarm.errors import NonFiniteError, ParameterError, ShapeError
 from softarm.harvest.clearance import Clearance
@@ -30,8 +30,8 @@ def test_one_declaration_of_the_radii() -> None:
     np.testing.assert_array_equal(body.section_radii, want)
     assert body.gripper_radius == _core.GRIPPER_RADIUS
     assert body.gripper_back == ARM.sections[-1].offset and body.grasp_offset == 0.03
-    # The resolver's default body radius is the body's widest, with a cane.
-    assert Gains.default_for(ARM).body_radius == body.widest + _core.CANE_RADIUS
+    # The resolver's default body is the arm's, the gripper ending at the end effector.
+    assert Resolver(ARM).body == Body.for_arm(ARM, 0.0)
     assert Clearance(ARM, [], 0.03).body == body
 
 

@@ -67,7 +67,7 @@ def numpy_eq20(arm: softarm.SoftArm, g: Gains, q: np.ndarray, target: np.ndarray
 def test_defaults_presets_and_replace(arm: softarm.SoftArm) -> None:
     res = Resolver(arm)
     assert res.mode == "hybrid"
-    assert res.gains == Gains.default_for(arm) == Gains()
+    assert res.gains == Gains()
     p = Gains.paper()
     assert (p.position_alpha, p.position_gamma, p.position_switch) == (0.074, -0.01, 0.030)
     assert (p.hybrid_alpha, p.hybrid_position, p.hybrid_orientation) == (0.05, 1.0, 0.1)

@@ -79,7 +79,7 @@ def test_far_but_sane_targets_still_step() -> None:
         ("lag_periods", 1e9),
         ("repulsion_gain", 1.0),
         ("influence_distance", math.nan),
-        ("body_radius", -0.1),
+        ("obstacle_radius", -0.1),
     ],
 )
 def test_every_gain_is_bounded(field: str, value: float) -> None:

@@ -105,10 +105,12 @@ def test_the_gripper_and_plates_repel_too() -> None:
     c = POSE[:3, 3] - 0.02 * z + 0.045 * x
     y = np.cross(z, x)
     cane = Segment(c - 0.1 * y, c + 0.1 * y)
-    g = Gains(lag_periods=0.0, body_radius=0.03, influence_distance=0.03)
-    assert softarm.closest(ARM, Q, cane).distance - 0.03 > 0.03
+    g = Gains(lag_periods=0.0, influence_distance=0.025)
+    arcs = softarm.closest(ARM, Q, cane)
+    radius = Resolver(ARM).body.section_radii[arcs.section] + g.obstacle_radius
+    assert arcs.distance - radius > 0.025
     r = Resolver(ARM, "hybrid", g).step(Q, POSE, obstacles=[cane])
-    assert r.clearance < 0.03
+    assert r.clearance < 0.025
     # The gripper is rigid with the end effector: with the pose held (hybrid) it can only
     # turn about the uncontrolled y axis; with the orientation free it is pushed off.
     r = Resolver(ARM, "position", g).step(Q, POSE[:3, 3], obstacles=[cane])

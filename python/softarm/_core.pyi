@@ -147,9 +147,11 @@ class Gains:
     ``singular_threshold`` in a step given a measured pose (closed loop, with or without
     ``plant_q``): larger, because the plant is not the model along the ill-conditioned
     directions of the damped pseudo-inverses (docs/control.md). ``repulsion_gain`` (k_r),
-    ``influence_distance`` (rho_0, m) and ``body_radius`` (m) set the obstacle repulsion of
-    planning paper eq. (9): a push of k_r (1/g - 1/rho_0) / g^2 m per step on the closest
-    arm point, g = distance - body_radius. Every field is bounded (see ``Gains.validate``
+    ``influence_distance`` (rho_0, m) and ``obstacle_radius`` (m, a cane's by default) set
+    the obstacle repulsion of planning paper eq. (9): the surface gap g of the resolver's
+    ``Body`` (piece by piece, the backbone distance less the piece's radius and
+    ``obstacle_radius``) is asked to grow by k_r (1/g - 1/rho_0) / g^2 m per step
+    (docs/control.md, section 4). Every field is bounded (see ``Gains.validate``
     in the Rust docs).
     """
 
@@ -179,7 +181,7 @@ class Gains:
         lag_periods: float = ...,
         repulsion_gain: float = ...,
         influence_distance: float = ...,
-        body_radius: float = ...,
+        obstacle_radius: float = ...,
     ) -> Gains: ...
     @staticmethod
     def for_lag(tau_s: float, period_s: float) -> Gains:
@@ -192,11 +194,6 @@ class Gains:
     @staticmethod
     def paper() -> Gains:
         """The paper's printed gains, eq. (23)-(25), read in the units above."""
-    @staticmethod
-    def default_for(arm: SoftArm) -> Gains:
-        """The blackberry-tuned preset with ``body_radius`` from ``arm``: its widest
-        section's actuator radius + 8 mm (actuator) + 5 mm (a cane), at most 1 m. Equal
-        to ``Gains()`` for ``SoftArm.blackberry()``."""
     def replace(self, **changes: object) -> Gains:
         """A copy with some fields changed (same keywords as the constructor)."""
     def as_dict(self) -> dict[str, object]: ...
@@ -247,7 +244,7 @@ class Gains:
     @property
     def influence_distance(self) -> float: ...
     @property
-    def body_radius(self) -> float: ...
+    def obstacle_radius(self) -> float: ...
     def __eq__(self, value: object, /) -> bool: ...
     def __ne__(self, value: object, /) -> bool: ...
     __hash__: None  # type: ignore[assignment]
@@ -338,19 +335,32 @@ class Resolver:
 
     ``mode``: "conventional" (eq. 7; full Jacobian for a pose target, position Jacobian
     for a point), "position" / "orientation" (eq. 13, over joint-limit avoidance) or
-    "hybrid" (eq. 20). ``gains=None`` uses ``Gains()``; ``Gains.default_for(arm)`` sizes
-    the body radius for another arm.
+    "hybrid" (eq. 20). ``gains=None`` uses ``Gains()``. ``body`` is the :class:`Body` the
+    obstacle repulsion keeps off the obstacles, piece by piece (None: ``Body.for_arm(arm,
+    0.0)``, the gripper ending at the end-effector frame); a body with another number of
+    sections than ``arm`` is a ``ShapeError`` naming ``body``, anything but a ``Body`` an
+    ``InputError`` naming it.
     """
 
-    def __new__(cls, arm: SoftArm, mode: str | None = None, gains: Gains | None = None) -> Resolver:
-        """``mode`` None means "hybrid"; ``gains`` None means ``Gains()``."""
-    def __reduce__(self) -> tuple[type[Resolver], tuple[SoftArm, str, Gains]]: ...
+    def __new__(
+        cls,
+        arm: SoftArm,
+        mode: str | None = None,
+        gains: Gains | None = None,
+        body: Body | None = None,
+    ) -> Resolver:
+        """``mode`` None means "hybrid"; ``gains`` None means ``Gains()``; ``body`` None
+        means ``Body.for_arm(arm, 0.0)``."""
+    def __reduce__(self) -> tuple[type[Resolver], tuple[SoftArm, str, Gains, Body]]: ...
     @property
     def mode(self) -> str: ...
     @property
     def gains(self) -> Gains: ...
     @property
     def arm(self) -> SoftArm: ...
+    @property
+    def body(self) -> Body:
+        """The body the obstacle repulsion measures."""
     def step(
         self,
         q: _ArrayLike,

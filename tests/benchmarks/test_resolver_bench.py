@@ -15,7 +15,7 @@ import pytest
 import softarm
 
 ARM = softarm.SoftArm.blackberry()
-GAINS = softarm.Gains.default_for(ARM)
+GAINS = softarm.Gains()
 RES = softarm.Resolver(ARM, "hybrid", GAINS)
 Q = np.array([0.016, 0.012, 0.020, 0.018, 0.015, 0.014, 0.017, 0.019, 0.013])
 TARGET = ARM.forward([0.017, 0.013, 0.019, 0.019, 0.014, 0.015, 0.016, 0.020, 0.012])

@@ -2,8 +2,8 @@
 //!
 //! Every clearance of the project measures this body: the harvest's planning and contact
 //! gaps (`softarm.harvest.clearance`), the Cosserat rod's ground truth of contact
-//! (`softarm.sim.cosserat.clearance`, on the rod's own centre line) and the default body
-//! radius of the resolver's obstacle task ([`crate::Gains::for_arm`]). It is
+//! (`softarm.sim.cosserat.clearance`, on the rod's own centre line) and the resolver's
+//! obstacle task ([`crate::Resolver::with_body`], piece by piece). It is
 //!
 //! - each section's arc, a tube of radius [`Body::section_radii`] about the backbone: the
 //!   ring of actuators' radius `r_i` plus one actuator's, [`ACTUATOR_RADIUS`];
@@ -19,8 +19,9 @@
 
 use crate::arc::ArcParams;
 use crate::chain::check_q;
+use crate::chain::SectionModel;
 use crate::distance::arc_point::PlacedArc;
-use crate::distance::bodies::placed_pieces_into;
+use crate::distance::bodies::{placed_pieces_into, Piece};
 use crate::distance::{closest_to_arcs_within, Closest, Obstacle};
 use crate::error::{check_parameter, Error, Result};
 use crate::kinematics::Kinematics;
@@ -154,30 +155,46 @@ impl Body {
             .fold(self.gripper_radius, |a, &b| a.max(b))
     }
 
-    /// The pieces of the body of `model` at `q` (already checked), each with its radius
-    /// and kind: every arc, every inner plate, then the gripper.
-    fn pieces<K: Kinematics + ?Sized>(
+    /// The bare backbone of an arm of `n_sections` sections: every radius 0 and no
+    /// gripper beyond the distal arc (the body of a model that declares no radii, such as
+    /// [`crate::ArcChain`]).
+    pub fn bare(n_sections: usize) -> Self {
+        Body {
+            section_radii: vec![0.0; n_sections],
+            gripper_radius: 0.0,
+            gripper_back: 0.0,
+            grasp_offset: 0.0,
+        }
+    }
+
+    /// Writes the pieces of this body on `model` at `q` (already checked; `model` has as
+    /// many sections as the body) into `out`, each with its radius: every arc, every inner
+    /// end plate, then the gripper, a straight piece along the end-effector's z axis from
+    /// `gripper_back` behind its frame to `grasp_offset` ahead (left out when both are 0:
+    /// then it is the distal arc's tip). No allocation once `out` has the room.
+    pub fn pieces_into<K: SectionModel + ?Sized>(
         &self,
         model: &K,
         q: &[f64],
-    ) -> Vec<(PlacedArc, usize, f64, Part)> {
-        let mut placed = Vec::with_capacity(2 * model.n_sections());
-        placed_pieces_into(model, q, &mut placed);
+        out: &mut Vec<Piece>,
+    ) {
+        placed_pieces_into(model, q, out);
         let last = model.n_sections() - 1;
-        let mut out: Vec<(PlacedArc, usize, f64, Part)> = placed
-            .iter()
-            .filter(|p| !(p.rigid && p.section == last))
-            .map(|p| {
-                let part = if p.rigid { Part::Plate } else { Part::Arc };
-                (p.arc, p.section, self.section_radii[p.section], part)
-            })
-            .collect();
+        // The distal offset's piece, if any, is the last; the gripper replaces it.
+        if out.last().is_some_and(|p| p.rigid) {
+            out.pop();
+        }
+        for p in out.iter_mut() {
+            p.radius = self.section_radii[p.section];
+        }
+        let length = self.gripper_back + self.grasp_offset;
+        let Some(distal) = out.last() else {
+            return;
+        };
+        if length <= 0.0 {
+            return;
+        }
         // The distal arc's tip frame; the end-effector frame is `offset` along its z.
-        let distal = placed
-            .iter()
-            .rev()
-            .find(|p| !p.rigid)
-            .expect("every model has a section");
         let tip = distal.arc.frame.compose(&distal.arc.arc.params.frame(1.0));
         let offset = model.section_state(last, &q[3 * last..3 * last + 3]).offset;
         let start = Frame {
@@ -185,17 +202,26 @@ impl Body {
             pos: tip.pos + tip.rot.column(2) * (offset - self.gripper_back),
         };
         let straight = ArcParams {
-            length: self.gripper_back + self.grasp_offset,
+            length,
             ux: 0.0,
             uy: 0.0,
         };
-        out.push((
-            PlacedArc::new(start, straight),
-            last,
-            self.gripper_radius,
-            Part::Gripper,
-        ));
-        out
+        let mut gripper = Piece::new(PlacedArc::new(start, straight), last, true);
+        gripper.radius = self.gripper_radius;
+        out.push(gripper);
+    }
+
+    /// The kind of piece `i` of [`Body::pieces_into`]'s `pieces`.
+    pub fn part_of(&self, pieces: &[Piece], i: usize) -> Part {
+        let p = &pieces[i];
+        let last = self.section_radii.len() - 1;
+        if !p.rigid {
+            Part::Arc
+        } else if p.section == last {
+            Part::Gripper
+        } else {
+            Part::Plate
+        }
     }
 
     /// The smallest surface gap between this body on `model` at `q` and `obstacle`, an
@@ -223,20 +249,22 @@ impl Body {
                 model.n_sections().to_string(),
             ));
         }
+        let mut pieces = Vec::with_capacity(2 * model.n_sections());
+        self.pieces_into(model, q, &mut pieces);
         let mut best: Option<BodyGap> = None;
-        for (arc, section, radius, part) in self.pieces(model, q) {
+        for (i, p) in pieces.iter().enumerate() {
             // Only a backbone closer than (best gap + radius) can improve on the best.
-            let cutoff = best.map_or(f64::INFINITY, |b| b.gap + obstacle_radius + radius);
-            let Some(c) = closest_to_arcs_within(std::slice::from_ref(&arc), obstacle, cutoff)
+            let cutoff = best.map_or(f64::INFINITY, |b| b.gap + obstacle_radius + p.radius);
+            let Some(c) = closest_to_arcs_within(std::slice::from_ref(&p.arc), obstacle, cutoff)
             else {
                 continue;
             };
-            let gap = c.distance - radius - obstacle_radius;
+            let gap = c.distance - p.radius - obstacle_radius;
             if best.is_none_or(|b| gap < b.gap) {
                 best = Some(BodyGap {
                     gap,
-                    closest: c.in_section(section),
-                    part,
+                    closest: c.in_section(p.section),
+                    part: self.part_of(&pieces, i),
                 });
             }
         }
@@ -268,9 +296,11 @@ mod tests {
 
     /// Points of the body's pieces, each with its radius: `n` per piece.
     fn sampled_body(body: &Body, arm: &SoftArm, q: &[f64], n: usize) -> Vec<(Vec3, f64)> {
-        body.pieces(arm, q)
+        let mut pieces = Vec::new();
+        body.pieces_into(arm, q, &mut pieces);
+        pieces
             .iter()
-            .flat_map(|(arc, _, r, _)| (0..=n).map(move |k| (arc.point(k as f64 / n as f64), *r)))
+            .flat_map(|p| (0..=n).map(move |k| (p.arc.point(k as f64 / n as f64), p.radius)))
             .collect()
     }
 
@@ -295,10 +325,15 @@ mod tests {
         let arm = SoftArm::blackberry();
         let body = Body::for_arm(&arm, 0.03).unwrap();
         let q = [0.01, 0.02, 0.005, 0.015, 0.0, 0.02, 0.01, 0.01, 0.03];
-        let pieces = body.pieces(&arm, &q);
+        let mut pieces = Vec::new();
+        body.pieces_into(&arm, &q, &mut pieces);
         assert_eq!(pieces.len(), 6); // 3 arcs, 2 plates, the gripper
-        let (g, section, r, part) = pieces.last().unwrap();
-        assert_eq!((*section, *part, *r), (2, Part::Gripper, GRIPPER_RADIUS));
+        let last = pieces.last().unwrap();
+        let (g, section, r) = (&last.arc, last.section, last.radius);
+        assert_eq!(
+            (section, body.part_of(&pieces, 5), r),
+            (2, Part::Gripper, GRIPPER_RADIUS)
+        );
         let ee = arm.forward(&q).unwrap();
         let z = Vec3::new(ee[(0, 2)], ee[(1, 2)], ee[(2, 2)]);
         let p = Vec3::new(ee[(0, 3)], ee[(1, 3)], ee[(2, 3)]);

@@ -2,6 +2,7 @@
 
 use nalgebra::{DMatrix, Matrix3xX};
 
+use crate::body::Body;
 use crate::chain::{self, SectionModel};
 use crate::error::Result;
 use crate::math::{Mat4, Vec3};
@@ -12,6 +13,14 @@ pub trait Kinematics: SectionModel {
     fn lower(&self) -> &[f64];
     /// Upper limit of every coordinate.
     fn upper(&self) -> &[f64];
+
+    /// The body a [`crate::Resolver`] on this model measures unless it is given another
+    /// ([`crate::Resolver::with_body`]): the bare backbone ([`Body::bare`]) unless the
+    /// model declares its radii ([`SoftArm`]: [`Body::for_arm`] with the gripper ending
+    /// at the end-effector frame).
+    fn default_body(&self) -> Body {
+        Body::bare(self.n_sections())
+    }
 
     /// End-effector pose (4×4) in the base frame.
     ///

@@ -250,4 +250,10 @@ impl Kinematics for SoftArm {
     fn upper(&self) -> &[f64] {
         &self.upper
     }
+    /// [`crate::Body::for_arm`] with the gripper ending at the end-effector frame (a grasp
+    /// offset of 0).
+    fn default_body(&self) -> crate::Body {
+        // Every valid arm has a body: its radii and offsets are far below the body's bounds.
+        crate::Body::for_arm(self, 0.0).unwrap_or_else(|_| crate::Body::bare(self.sections().len()))
+    }
 }

@@ -19,7 +19,7 @@ use crate::kinematics::SoftArm;
 #[pyclass(module = "softarm._core", frozen, eq)]
 #[derive(PartialEq)]
 pub struct Body {
-    inner: core::Body,
+    pub(crate) inner: core::Body,
 }
 
 #[pymethods]

@@ -10,7 +10,8 @@ use softarm_core::error::MAX_ITERATIONS;
 use softarm_core::resolver::{self as core, Mode, Schedule, SolveOptions, Target};
 use softarm_core::SoftArm as CoreArm;
 
-use crate::convert::{array, as_array, shape_err, shape_str, type_of};
+use crate::body::Body;
+use crate::convert::{array, as_array, shape_err, shape_str, type_of, wrong_type};
 use crate::distance::obstacle_from;
 use crate::errors::{
     fielded, given_text, parameter_err, range_err, unknown_termination, Given, InputError,
@@ -119,15 +120,6 @@ impl Gains {
     fn paper() -> Self {
         Gains {
             inner: core::Gains::paper(),
-        }
-    }
-
-    /// The blackberry-tuned preset with the body radius of `arm` (its widest section
-    /// plus an actuator and a cane).
-    #[staticmethod]
-    fn default_for(arm: PyRef<'_, SoftArm>) -> Self {
-        Gains {
-            inner: core::Gains::for_arm(&arm.inner),
         }
     }
 
@@ -423,11 +415,12 @@ pub struct Resolver {
 #[pymethods]
 impl Resolver {
     #[new]
-    #[pyo3(signature = (arm, mode = None, gains = None))]
+    #[pyo3(signature = (arm, mode = None, gains = None, body = None))]
     fn new(
         arm: PyRef<'_, SoftArm>,
         mode: Option<&Bound<'_, PyAny>>,
         gains: Option<PyRef<'_, Gains>>,
+        body: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         // None is the default mode; anything but a string is a typed error naming `mode`.
         let mode: String = match mode.filter(|m| !m.is_none()) {
@@ -440,9 +433,31 @@ impl Resolver {
         };
         let mode = Mode::parse(&mode).py()?;
         let gains = gains.map_or_else(core::Gains::blackberry, |g| g.inner);
-        Ok(Resolver {
-            inner: core::Resolver::new(arm.inner.clone(), mode, gains).py()?,
-        })
+        // None measures the arm's default body; anything but a Body names `body`.
+        let body = match body.filter(|b| !b.is_none()) {
+            None => None,
+            Some(b) => Some(
+                b.cast::<Body>()
+                    .map_err(|_| wrong_type(b, "body", "a Body"))?
+                    .get()
+                    .inner
+                    .clone(),
+            ),
+        };
+        let inner = core::Resolver::new(arm.inner.clone(), mode, gains).py()?;
+        let inner = match body {
+            Some(b) => inner.with_body(b).py()?,
+            None => inner,
+        };
+        Ok(Resolver { inner })
+    }
+
+    /// The body the obstacle repulsion measures.
+    #[getter]
+    fn body(&self) -> Body {
+        Body {
+            inner: self.inner.body().clone(),
+        }
     }
 
     /// "conventional", "position", "orientation" or "hybrid".
@@ -558,7 +573,7 @@ impl Resolver {
     /// Pickles as `Resolver(arm, mode, gains)`: the resolver holds no other state.
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> (Bound<'py, PyType>, (SoftArm, &'static str, Gains)) {
+    ) -> (Bound<'py, PyType>, (SoftArm, &'static str, Gains, Body)) {
         let r = slf.get();
         (
             slf.get_type(),
@@ -569,6 +584,9 @@ impl Resolver {
                 r.inner.mode().name(),
                 Gains {
                     inner: *r.inner.gains(),
+                },
+                Body {
+                    inner: r.inner.body().clone(),
                 },
             ),
         )

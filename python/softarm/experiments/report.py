@@ -160,7 +160,7 @@ def _figures(figures: str) -> list[str]:
         f"![IV-D hybrid (cf. Fig. 9)]({figures}/hybrid.png)",
         "",
         "The simulation is not the hardware: its error floor is set by the assumed tracker",
-        "noise and hysteresis, and the gains are ours (`Gains.default_for`), not the",
+        "noise and hysteresis, and the gains are ours (`Gains()`), not the",
         "paper's (`Gains.paper()`, whose units the paper does not give).",
         "",
     ]

@@ -177,7 +177,9 @@ def _controller(
     def hybrid(gains: Gains) -> Resolver:
         if inputs.joint_limit_gain is not None:
             gains = gains.replace(hybrid_gamma=inputs.joint_limit_gain)
-        return Resolver(inputs.model, mode="hybrid", gains=gains_over(gains, inputs.gains))
+        # The repulsion measures the body the way check and the contact gaps measure.
+        gains = gains_over(gains, inputs.gains)
+        return Resolver(inputs.model, mode="hybrid", gains=gains, body=clearance.body)
 
     lag = inputs.lag_s
     bounded = hybrid(Gains() if lag is None else Gains.for_lag(lag, cfg.period))

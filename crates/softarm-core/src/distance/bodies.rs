@@ -24,6 +24,9 @@ pub struct Piece {
     pub section: usize,
     /// True for the rigid plate or gripper after the arc.
     pub rigid: bool,
+    /// The surface's radius about the piece's backbone (m): 0 for the bare backbone of
+    /// [`placed_pieces_into`], the body's radius in [`crate::body::Body::pieces_into`].
+    pub radius: f64,
     /// The midpoint of the piece's chord: with [`Piece::half`], a ball holding it.
     pub centre: Vec3,
     /// Half the piece's length L. Every point x of a curve of length L from A to B has
@@ -33,19 +36,21 @@ pub struct Piece {
 }
 
 impl Piece {
-    /// The piece `arc` of `section`, with its bounding ball.
-    fn new(arc: PlacedArc, section: usize, rigid: bool) -> Self {
+    /// The bare piece `arc` of `section` (radius 0), with its bounding ball.
+    pub(crate) fn new(arc: PlacedArc, section: usize, rigid: bool) -> Self {
         Piece {
             centre: arc.frame.pos + arc.frame.rot * (0.5 * arc.arc.tip()),
             half: 0.5 * arc.arc.params.length,
             arc,
             section,
             rigid,
+            radius: 0.0,
         }
     }
 }
 
-/// An axis-aligned box holding the whole body: the union of every piece's bounding ball.
+/// An axis-aligned box holding the whole body: the union of every piece's bounding ball,
+/// grown by the piece's radius (so that it holds the surfaces).
 /// Built once per configuration, it lets a far obstacle be dismissed with a handful of
 /// sphere tests instead of one per piece and sphere.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,12 +60,12 @@ pub struct BodyBox {
 }
 
 impl BodyBox {
-    /// The box around the bounding balls of `pieces` (empty, i.e. clear of everything,
-    /// when there are none).
+    /// The box around the bounding balls of `pieces`, each grown by its radius (empty,
+    /// i.e. clear of everything, when there are none).
     pub fn around(pieces: &[Piece]) -> Self {
         let inf = Vec3::repeat(f64::INFINITY);
         pieces.iter().fold(BodyBox { lo: inf, hi: -inf }, |b, p| {
-            let r = Vec3::repeat(p.half);
+            let r = Vec3::repeat(p.half + p.radius);
             BodyBox {
                 lo: b.lo.inf(&(p.centre - r)),
                 hi: b.hi.sup(&(p.centre + r)),
@@ -98,11 +103,15 @@ impl BodyBox {
 /// The closest pair between the arm's body (arcs and rigid parts) and an obstacle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyClosest {
-    /// The pair; `section` and `s` locate the arm point on `rigid`'s piece: a fraction of
-    /// the arc, or of the rigid offset after it.
+    /// The backbone pair; `section` and `s` locate the arm point on `rigid`'s piece: a
+    /// fraction of the arc, or of the rigid part after it.
     pub closest: Closest,
     /// Whether the arm point lies on a rigid part (plate or gripper).
     pub rigid: bool,
+    /// The piece's surface distance: `closest.distance` less the piece's radius (m).
+    pub surface: f64,
+    /// The piece's index in the slice it was found in.
+    pub piece: usize,
 }
 
 /// Writes every piece of the arm at `q` (already checked) into `out`: for each section
@@ -136,22 +145,53 @@ pub fn placed_pieces_into<K: SectionModel + ?Sized>(model: &K, q: &[f64], out: &
     }
 }
 
-/// The closest pair over `pieces` (held by `bound`, [`BodyBox::around`] them) to
-/// `obstacle`, when closer than `cutoff` (exact; far pieces are skipped by bounding
-/// spheres). `None` when every piece is at least `cutoff` away.
+/// The piece of `pieces` (held by `bound`, [`BodyBox::around`] them) whose SURFACE is
+/// nearest `obstacle` (the backbone distance less the piece's radius), when nearer than
+/// `cutoff`: exact, far pieces skipped by bounding spheres. With bare pieces (radius 0)
+/// it is the nearest backbone. `None` when every surface is at least `cutoff` away.
 pub fn closest_piece_within(
     pieces: &[Piece],
     bound: &BodyBox,
     obstacle: &Obstacle,
     cutoff: f64,
 ) -> Option<BodyClosest> {
+    let mut best: Option<BodyClosest> = None;
+    scan(pieces, bound, obstacle, cutoff, 0.0, |hit| best = Some(hit));
+    best
+}
+
+/// Appends to `out` the closest pair of every piece of `pieces` (held by `bound`) whose
+/// surface is nearer `obstacle` than `cutoff` and than the nearest surface plus `slack`
+/// (m), in the pieces' order. Every piece that qualifies is appended; a few appended
+/// early may lie beyond the nearest plus `slack` (the nearest is only known at the end).
+pub fn pieces_within(
+    pieces: &[Piece],
+    bound: &BodyBox,
+    obstacle: &Obstacle,
+    (cutoff, slack): (f64, f64),
+    out: &mut Vec<BodyClosest>,
+) {
+    scan(pieces, bound, obstacle, cutoff, slack, |hit| out.push(hit));
+}
+
+/// Passes to `each` the closest pair of every piece whose surface is nearer `obstacle`
+/// than `cutoff` and than the nearest passed so far plus `slack` (0: each one passed is
+/// the nearest so far, the last the nearest of all).
+fn scan(
+    pieces: &[Piece],
+    bound: &BodyBox,
+    obstacle: &Obstacle,
+    cutoff: f64,
+    slack: f64,
+    mut each: impl FnMut(BodyClosest),
+) {
     let curve = match obstacle {
         Obstacle::Curve(c) => Some(c),
         Obstacle::Segment(s) => Some(s.as_curve()),
         _ => None,
     };
     // The curve's interval spheres that reach the body's box (bit k for sphere k; a curve
-    // has at most 64 intervals). A sphere clear of the box is clear of every piece inside
+    // has at most 64 intervals). A sphere clear of the box is clear of every surface inside
     // it, so the usual far obstacle costs a few sphere tests and no per-piece work.
     let near = curve.map(|c| {
         let spheres = c.interval_spheres();
@@ -167,39 +207,43 @@ pub fn closest_piece_within(
             .fold(0u64, |m, (k, _)| m | (1 << k))
     });
     if near == Some(0) {
-        return None;
+        return;
     }
-    let mut best: Option<BodyClosest> = None;
     let mut limit = cutoff;
-    for p in pieces {
+    for (i, p) in pieces.iter().enumerate() {
+        // The backbone distance that would bring the surface within the limit.
+        let reach_backbone = limit + p.radius;
         if let (Some(c), Some(mut mask)) = (curve, near) {
             // Cull by the curve's per-interval bounding spheres (the whole-curve sphere of
             // a long cane holds most of the arm), those that reach the box: skip the piece
-            // when each is at least `limit` from the piece's ball. Squared, to spare a
-            // square root per interval: |centre − c| ≥ r + L/2 + limit.
+            // when each is at least `limit` from the piece's surface. Squared, to spare a
+            // square root per interval: |centre − c| ≥ r + L/2 + radius + limit.
             let spheres = c.interval_spheres();
             let mut far = true;
             while mask != 0 && far {
                 let (c, r) = spheres[mask.trailing_zeros() as usize];
                 mask &= mask - 1;
-                let reach = r + p.half + limit;
+                let reach = r + p.half + reach_backbone;
                 far = (p.centre - c).norm_squared() >= reach * reach;
             }
             if far {
                 continue;
             }
         }
-        if let Some(c) = closest_to_arcs_within(std::slice::from_ref(&p.arc), obstacle, limit) {
-            if c.distance < limit {
-                limit = c.distance;
-                best = Some(BodyClosest {
+        let arc = std::slice::from_ref(&p.arc);
+        if let Some(c) = closest_to_arcs_within(arc, obstacle, reach_backbone) {
+            let surface = c.distance - p.radius;
+            if surface < limit {
+                limit = limit.min(surface + slack);
+                each(BodyClosest {
                     closest: c.in_section(p.section),
                     rigid: p.rigid,
+                    surface,
+                    piece: i,
                 });
             }
         }
     }
-    best
 }
 
 /// The closest pair between the whole body of `model` at `q` (arcs, plates, gripper) and
@@ -217,12 +261,14 @@ pub fn closest_body<K: Kinematics + ?Sized>(
     let mut pieces = Vec::with_capacity(2 * model.n_sections());
     placed_pieces_into(model, q, &mut pieces);
     let mut best: Option<BodyClosest> = None;
-    for p in &pieces {
+    for (i, p) in pieces.iter().enumerate() {
         let c = closest_to_arcs(std::slice::from_ref(&p.arc), obstacle);
         if best.is_none_or(|b| c.distance < b.closest.distance) {
             best = Some(BodyClosest {
                 closest: c.in_section(p.section),
                 rigid: p.rigid,
+                surface: c.distance,
+                piece: i,
             });
         }
     }

@@ -1,8 +1,9 @@
 //! Obstacle avoidance as the lowest-priority task of the resolver (planning paper eq. 9).
 //!
-//! For each obstacle the exact closest pair to the arm's whole body (arcs, end plates,
-//! gripper: [`crate::distance::bodies`]) is found. Within the influence distance ρ₀ of
-//! the surface gap `g = d − body_radius`, the gap is asked to grow by
+//! For each obstacle the exact closest pair to each piece of the resolver's [`Body`] (arcs,
+//! end plates, gripper: [`crate::distance::bodies`]) is found. Within the influence
+//! distance ρ₀ of the surface gap `g = d − r_piece − obstacle_radius`, the gap is asked to
+//! grow by
 //! `f = k_r (1/g − 1/ρ₀) / g²` per step (the gradient of Khatib's potential, the
 //! repulsive term of eq. 9, with `g` clamped at 1 mm), by at least a tenth of the way to
 //! ρ₀ ([`TAIL`]) and by at most what a step may move (half of `max_step`).
@@ -33,8 +34,9 @@
 use nalgebra::DMatrix;
 
 use super::Gains;
+use crate::body::{Body, Part};
 use crate::chain::{forward_unchecked, point_unchecked};
-use crate::distance::bodies::{closest_piece_within, placed_pieces_into, BodyBox, Piece};
+use crate::distance::bodies::{pieces_within, BodyBox, BodyClosest, Piece};
 use crate::distance::Obstacle;
 use crate::kinematics::Kinematics;
 use crate::math::Vec3;
@@ -61,83 +63,176 @@ pub struct Repulsion {
     pub jac: Vec<Vec3>,
     /// Unit direction from the obstacle point to the arm point: ∂g/∂p.
     pub normal: Vec3,
-    /// The gap increase eq. (9) asks for this step, `f` (m).
+    /// The gap increase asked of this piece this step (m): for the obstacle's nearest
+    /// piece eq. (9)'s `f`, for a piece `a` farther `max(0, f − a)`, so that every tied
+    /// piece is asked up to one common level ([`repulsions_into`]).
     pub ask: f64,
+    /// How nearly this piece ties with its obstacle's nearest one ([`tie_weight`]): 1 for
+    /// the nearest, falling continuously to 0 at [`tie_band`] beyond it.
+    pub weight: f64,
+    /// The index of the obstacle (the repulsions of one obstacle are consecutive).
+    pub obstacle: usize,
+}
+
+/// The band (m) of surface gaps above an obstacle's nearest piece within which another
+/// piece ties with it: the largest gap increase one step asks (half of `max_step`, the
+/// repulsion's cap; at most ρ₀). A piece less than that farther than the nearest can be
+/// the nearest after one step, so the step must raise it too.
+pub fn tie_band(gains: &Gains) -> f64 {
+    (0.5 * gains.max_step).min(gains.influence_distance)
+}
+
+/// The weight of a piece whose surface lies `t` bands beyond its obstacle's nearest:
+/// `1 − 3t² + 2t³` on [0, 1] (1 at a tie, 0 from one band on, with zero slope at both
+/// ends), so that no piece's row enters or leaves the task abruptly.
+pub fn tie_weight(t: f64) -> f64 {
+    let t = t.clamp(0.0, 1.0);
+    1.0 - t * t * (3.0 - 2.0 * t)
 }
 
 fn columns(j: &nalgebra::Matrix3xX<f64>) -> Vec<Vec3> {
     j.column_iter().map(|c| c.into_owned()).collect()
 }
 
-/// Fills `out` with the repulsion of every obstacle within the influence distance of the
-/// model arm at `q` (`jac`: the end-effector Jacobian at `q`). Returns the smallest
-/// surface gap among them, `+∞` when none is that close.
+/// The buffers of [`repulsions_into`]: the body's pieces and one obstacle's near pieces.
+pub type Buffers<'a> = (&'a mut Vec<Piece>, &'a mut Vec<BodyClosest>);
+
+/// Fills `out` with the repulsions of every obstacle within the influence distance of the
+/// model arm at `q`, measured on `body` (`jac`: the end-effector Jacobian at `q`): for each
+/// obstacle, one per piece whose surface gap ties with the nearest one's ([`tie_band`]),
+/// weighted by [`tie_weight`]. Returns the smallest surface gap among them, `+∞` when
+/// none is that close.
 pub fn repulsions_into<K: Kinematics + ?Sized>(
-    arm: &K,
+    (arm, body): (&K, &Body),
     q: &[f64],
     obstacles: &[Obstacle],
     gains: &Gains,
     jac: &DMatrix<f64>,
-    pieces: &mut Vec<Piece>,
+    (pieces, hits): Buffers<'_>,
     out: &mut Vec<Repulsion>,
 ) -> f64 {
     out.clear();
     if obstacles.is_empty() || gains.influence_distance <= 0.0 {
         return f64::INFINITY;
     }
-    placed_pieces_into(arm, q, pieces);
-    // One box around the whole body per step; each obstacle is tested against it first.
+    body.pieces_into(arm, q, pieces);
+    // One box around the whole body's surface per step; each obstacle is tested against
+    // it first.
     let bound = BodyBox::around(pieces);
-    let cutoff = gains.body_radius + gains.influence_distance;
     let rho = gains.influence_distance;
+    // The surface distance (the piece's radius off its backbone) an obstacle's centre line
+    // must come within to repel: its own radius and the influence distance.
+    let cutoff = gains.obstacle_radius + rho;
+    let band = tie_band(gains);
     let mut clearance = f64::INFINITY;
-    let n_sections = arm.n_sections();
-    for ob in obstacles {
-        let Some(hit) = closest_piece_within(pieces, &bound, ob, cutoff) else {
+    for (j, ob) in obstacles.iter().enumerate() {
+        hits.clear();
+        pieces_within(pieces, &bound, ob, (cutoff, band), hits);
+        let Some(nearest) = hits.iter().map(|h| h.surface).reduce(f64::min) else {
             continue;
         };
-        let c = hit.closest;
-        let gap = c.distance - gains.body_radius;
-        clearance = clearance.min(gap);
-        let away = c.arm_point - c.obstacle_point;
-        let d = away.norm();
-        if gap >= rho || d == 0.0 {
-            // At d = 0 the backbone crosses the obstacle: no direction to push in.
-            continue;
+        clearance = clearance.min(nearest - gains.obstacle_radius);
+        // The common level every tied piece is raised to this step: the nearest one's gap
+        // plus its ask `f`. A piece `above` the nearest needs only `f − above`.
+        let f = ask_for(gains, nearest - gains.obstacle_radius);
+        for hit in hits.iter() {
+            let above = hit.surface - nearest;
+            let weight = tie_weight(above / band);
+            if weight <= 0.0 {
+                continue;
+            }
+            if let Some(r) = repulsion((arm, body), q, gains, jac, pieces, hit) {
+                let ask = (f - above).max(0.0);
+                out.push(Repulsion {
+                    weight,
+                    obstacle: j,
+                    ask,
+                    ..r
+                });
+            }
         }
-        let g = gap.max(MIN_GAP);
-        // The ask is a gap increase for ONE step: never more than a step may move (half
-        // of max_step, the repulsion's cap). Eq. (9) asks 1.45 m per step at the 1 mm
-        // clamp, which would keep every step at its cap, also where P ∇g is small.
-        let khatib = gains.repulsion_gain * (1.0 / g - 1.0 / rho) / (g * g);
-        let ask = khatib.max(TAIL * (rho - gap)).min(0.5 * gains.max_step);
-        let cols = if !hit.rigid {
-            columns(&point_unchecked(arm, q, c.section, c.s).1)
-        } else {
-            // A point of a rigid part moves as the affine combination of the part's ends.
+    }
+    clearance
+}
+
+/// The repulsion of one piece's closest pair `hit` (its surface gap within the influence
+/// distance), or `None` where the backbone crosses the obstacle (no direction to push in).
+fn repulsion<K: Kinematics + ?Sized>(
+    (arm, body): (&K, &Body),
+    q: &[f64],
+    gains: &Gains,
+    jac: &DMatrix<f64>,
+    pieces: &[Piece],
+    hit: &BodyClosest,
+) -> Option<Repulsion> {
+    let rho = gains.influence_distance;
+    let c = &hit.closest;
+    let gap = hit.surface - gains.obstacle_radius;
+    let away = c.arm_point - c.obstacle_point;
+    let d = away.norm();
+    if gap >= rho || d == 0.0 {
+        return None;
+    }
+    let ask = ask_for(gains, gap);
+    Some(Repulsion {
+        gap,
+        arm_point: c.arm_point,
+        jac: point_columns((arm, body), q, jac, pieces, hit),
+        normal: away / d,
+        ask,
+        weight: 1.0,
+        obstacle: 0,
+    })
+}
+
+/// The gap increase (m) eq. (9) asks of a surface gap `gap` in one step.
+fn ask_for(gains: &Gains, gap: f64) -> f64 {
+    let rho = gains.influence_distance;
+    let g = gap.max(MIN_GAP);
+    // The ask is a gap increase for ONE step: never more than a step may move (half of
+    // max_step, the repulsion's cap). Eq. (9) asks 1.45 m per step at the 1 mm clamp,
+    // which would keep every step at its cap, also where P ∇g is small.
+    let khatib = gains.repulsion_gain * (1.0 / g - 1.0 / rho) / (g * g);
+    khatib.max(TAIL * (rho - gap)).min(0.5 * gains.max_step)
+}
+
+/// The columns of the Jacobian of the arm point of `hit` (on `pieces`, the pieces of
+/// `body` at `q`; `jac`: the end-effector Jacobian at `q`).
+fn point_columns<K: Kinematics + ?Sized>(
+    (arm, body): (&K, &Body),
+    q: &[f64],
+    jac: &DMatrix<f64>,
+    pieces: &[Piece],
+    hit: &BodyClosest,
+) -> Vec<Vec3> {
+    let c = &hit.closest;
+    match body.part_of(pieces, hit.piece) {
+        Part::Arc => columns(&point_unchecked(arm, q, c.section, c.s).1),
+        Part::Plate => {
+            // A point of a plate moves as the affine combination of the plate's ends.
             let start = columns(&point_unchecked(arm, q, c.section, 1.0).1);
-            let end: Vec<Vec3> = if c.section + 1 < n_sections {
-                columns(&point_unchecked(arm, q, c.section + 1, 0.0).1)
-            } else {
-                (0..jac.ncols())
-                    .map(|k| Vec3::new(jac[(0, k)], jac[(1, k)], jac[(2, k)]))
-                    .collect()
-            };
+            let end = columns(&point_unchecked(arm, q, c.section + 1, 0.0).1);
             start
                 .iter()
                 .zip(&end)
                 .map(|(a, b)| a * (1.0 - c.s) + b * c.s)
                 .collect()
-        };
-        out.push(Repulsion {
-            gap,
-            arm_point: c.arm_point,
-            jac: cols,
-            normal: away / d,
-            ask,
-        });
+        }
+        Part::Gripper => {
+            // A point fixed to the end-effector frame: ṗ = v + ω × (p − p_ee), with the
+            // frame's origin `gripper_back` along the gripper from its start.
+            let piece = &pieces[hit.piece];
+            let z = piece.arc.frame.rot.column(2).into_owned();
+            let r = c.arm_point - (piece.arc.frame.pos + z * body.gripper_back());
+            (0..jac.ncols())
+                .map(|k| {
+                    let v = Vec3::new(jac[(0, k)], jac[(1, k)], jac[(2, k)]);
+                    let w = Vec3::new(jac[(3, k)], jac[(4, k)], jac[(5, k)]);
+                    v + w.cross(&r)
+                })
+                .collect()
+        }
     }
-    clearance
 }
 
 /// Writes the gap's gradient `∇g = J_sᵀ n` of `r` into `row`, with the coordinates that
@@ -167,6 +262,41 @@ pub fn add_gap_step(c: &[f64], ask: f64, threshold: f64, out: &mut [f64]) {
     }
 }
 
+/// The multi-row form of [`add_gap_step`], for the nearly tied pieces of one obstacle:
+/// `rows` holds m projected gap rows `b_k = √w_k c_k` (row-major, m × n with n =
+/// `out.len()`), `asks` their weighted asks `√w_k f_k`. With the Gram matrix
+/// `B Bᵀ = U Λ Uᵀ`, `out += Bᵀ U h(Λ) Uᵀ y` with `h(λ) = (1 − ε²/λ)/λ` above ε² and 0
+/// below: the pseudo-inverse of B applied to the asks, each singular direction faded as
+/// [`add_gap_step`] fades its one row (which it equals for m = 1). Where the rows are
+/// independent and well above ε, every piece's gap grows by its own ask, so that raising
+/// one never closes another; a row of small weight has a small singular value and fades
+/// in continuously (h is continuous and 0 below ε²), so no row switches in or out.
+pub fn add_rows_step(rows: &[f64], asks: &[f64], threshold: f64, out: &mut [f64]) {
+    let (m, n) = (asks.len(), out.len());
+    if m == 1 {
+        add_gap_step(&rows[..n], asks[0], threshold, out);
+        return;
+    }
+    if m == 0 || asks.iter().all(|f| *f <= 0.0) {
+        return;
+    }
+    let row = |k: usize| &rows[k * n..(k + 1) * n];
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let gram = DMatrix::from_fn(m, m, |i, j| dot(row(i), row(j)));
+    let eig = gram.symmetric_eigen();
+    let t2 = threshold * threshold;
+    let mut z = eig.eigenvectors.transpose() * nalgebra::DVector::from_column_slice(asks);
+    for (zi, &l) in z.iter_mut().zip(eig.eigenvalues.iter()) {
+        *zi *= if l > t2 { (1.0 - t2 / l) / l } else { 0.0 };
+    }
+    let z = &eig.eigenvectors * z;
+    for (k, zk) in z.iter().enumerate() {
+        for (o, x) in out.iter_mut().zip(row(k)) {
+            *o += zk * x;
+        }
+    }
+}
+
 /// How far (m) the repulsion's step may move the gripper, per metre of clearance it earns
 /// to first order ([`step_fraction`]). The step lies in the tasks' null space, so the
 /// gripper moves only by its second-order terms, ∝ t²; the tasks then take that motion
@@ -186,7 +316,8 @@ pub fn fraction_for_drift(slope: f64, drift: f64) -> f64 {
 }
 
 /// The fraction of the repulsion step `a` (its part of the increment) to take from `q`
-/// ([`fraction_for_drift`], with the largest first-order gain of a gap among `reps`):
+/// ([`fraction_for_drift`], with the largest first-order gain among the obstacles of
+/// `reps`, each obstacle's the mean of its pieces' weighted by [`tie_weight`]):
 /// the step is tried on the model, clamped into the limits, in `trial`. `tip` is the
 /// gripper's position at `q` where the position is a task (else 1: a null space without
 /// the position task moves the gripper at first order, on purpose).
@@ -203,10 +334,19 @@ pub fn step_fraction<K: Kinematics + ?Sized>(
     if reps.is_empty() || a.iter().all(|x| *x == 0.0) {
         return 1.0;
     }
-    let gain = reps
-        .iter()
-        .map(|r| r.jac.iter().zip(a).map(|(c, x)| r.normal.dot(c) * x).sum())
-        .fold(0.0_f64, f64::max);
+    let (mut gain, mut sum, mut weights) = (0.0_f64, 0.0, 0.0);
+    for (i, r) in reps.iter().enumerate() {
+        let g: f64 = r.jac.iter().zip(a).map(|(c, x)| r.normal.dot(c) * x).sum();
+        sum += r.weight * g;
+        weights += r.weight;
+        if reps
+            .get(i + 1)
+            .is_none_or(|next| next.obstacle != r.obstacle)
+        {
+            gain = gain.max(sum / weights);
+            (sum, weights) = (0.0, 0.0);
+        }
+    }
     let (lower, upper) = (arm.lower(), arm.upper());
     for k in 0..q.len() {
         trial[k] = (q[k] + a[k]).clamp(lower[k], upper[k]);
@@ -280,6 +420,48 @@ mod tests {
         let mut none = [0.0; 3];
         add_gap_step(&[1.0, 0.0, 0.0], 0.0, 0.05, &mut none);
         assert_eq!(none, [0.0; 3]);
+    }
+
+    /// The tied pieces' task: one row is `add_gap_step`; independent rows each earn their
+    /// ask (raising one never closes the other); a row whose weight falls to 0 leaves the
+    /// step continuously.
+    #[test]
+    fn tied_rows_each_earn_their_ask_and_fade_out_continuously() {
+        let (a, b) = ([0.3, 0.1, -0.2, 0.0], [-0.25, 0.2, 0.1, 0.05]);
+        let (mut one, mut same) = ([0.0; 4], [0.0; 4]);
+        add_gap_step(&a, 1e-3, 0.05, &mut one);
+        add_rows_step(&a, &[1e-3], 0.05, &mut same);
+        assert_eq!(one, same);
+        let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
+        let step = |w: f64| {
+            let s = w.sqrt();
+            let rows: Vec<f64> = a.iter().copied().chain(b.iter().map(|x| s * x)).collect();
+            let mut out = [0.0; 4];
+            add_rows_step(&rows, &[1e-3, s * 0.5e-3], 0.0, &mut out);
+            out
+        };
+        let both = step(1.0);
+        assert!((dot(&a, &both) - 1e-3).abs() < 1e-12);
+        assert!((dot(&b, &both) - 0.5e-3).abs() < 1e-12);
+        // With the threshold, the second row's singular value falls below it before its
+        // weight reaches 0: the step is then the first row's alone, and gets there
+        // continuously.
+        let fade = |w: f64| {
+            let s = w.sqrt();
+            let rows: Vec<f64> = a.iter().copied().chain(b.iter().map(|x| s * x)).collect();
+            let mut out = [0.0; 4];
+            add_rows_step(&rows, &[1e-3, s * 0.5e-3], 0.05, &mut out);
+            out
+        };
+        let mut alone = [0.0; 4];
+        add_gap_step(&a, 1e-3, 0.05, &mut alone);
+        let norm = dot(&alone, &alone).sqrt();
+        let off = |w: f64| {
+            let x = fade(w);
+            (dot(&x, &x) - 2.0 * dot(&x, &alone) + dot(&alone, &alone)).sqrt() / norm
+        };
+        let (o1, o2, o3) = (off(1e-2), off(1e-4), off(1e-6));
+        assert!(o1 > o2 && o2 > o3 && o3 < 1e-5, "{o1} {o2} {o3}");
     }
 
     #[test]

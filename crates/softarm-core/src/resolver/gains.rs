@@ -239,10 +239,10 @@ declare_gains! {
             pub repulsion_gain: f64 in (0.0, 1e-3, Closed, "[0, 1e-3] m⁴"),
             /// ρ₀ of eq. (9): surface gap (m) below which an obstacle repels.
             pub influence_distance: f64 in (0.0, 1.0, Closed, "[0, 1] m"),
-            /// Distance (m) from the arm's backbone to the surfaces that must not touch, the
-            /// obstacle's own radius included: the surface gap is the exact backbone distance
-            /// minus this.
-            pub body_radius: f64 in (0.0, 1.0, Closed, "[0, 1] m"),
+            /// Radius (m) of every obstacle about its centre line (a cane's by default). The
+            /// surface gap is, piece by piece of the resolver's body, the exact backbone
+            /// distance less the piece's radius and this.
+            pub obstacle_radius: f64 in (0.0, 1.0, Closed, "[0, 1] m"),
         }
         others {
             /// Step or smooth scheduling of every joint-limit weight.
@@ -310,7 +310,7 @@ impl Gains {
             lag_periods: 0.0,
             repulsion_gain: 1.5e-9,
             influence_distance: 0.03,
-            body_radius: 0.04,
+            obstacle_radius: CANE_RADIUS,
         }
     }
 
@@ -345,25 +345,7 @@ impl Gains {
             // 1 mm per step at a 1 cm gap, 0 at 3 cm (ρ₀).
             repulsion_gain: 1.5e-9,
             influence_distance: 0.03,
-            // Largest section radius (28 mm) + actuator (8 mm) + a cane (5 mm): what
-            // `Gains::for_arm` gives the blackberry arm.
-            body_radius: 0.041,
-        }
-    }
-
-    /// [`Gains::blackberry`] with the body radius of `arm`: the widest surface radius of
-    /// its [`crate::body::Body`] (its largest actuator radius plus [`ACTUATOR_RADIUS`], or
-    /// the gripper's where that is wider) plus [`CANE_RADIUS`] (capped at the field's
-    /// bound, 1 m). The repulsion measures every piece with this one radius, the body's
-    /// envelope.
-    /// The other gains are dimensionless or tuned per step and carry over to arms of
-    /// similar size. `for_arm(&SoftArm::blackberry())` equals [`Gains::blackberry`].
-    pub fn for_arm(arm: &crate::SoftArm) -> Self {
-        // Every valid arm has a body (its radii are far below the body's bounds).
-        let widest = crate::body::Body::for_arm(arm, 0.0).map_or(0.0, |b| b.widest());
-        Gains {
-            body_radius: (widest + CANE_RADIUS).min(1.0),
-            ..Gains::blackberry()
+            obstacle_radius: CANE_RADIUS,
         }
     }
 
@@ -416,7 +398,7 @@ impl Gains {
     /// the orientation one not in [0, π]; damping or threshold not in [0, 1];
     /// `limit_margin` not in [1e-6, 0.45]; `max_step` not in (0, 1] m or infinite;
     /// `lag_periods` not in [0, 10 000]; `repulsion_gain` not in [0, 1e-3];
-    /// `influence_distance` or `body_radius` not in [0, 1] m.
+    /// `influence_distance` or `obstacle_radius` not in [0, 1] m.
     pub fn validate(&self) -> Result<()> {
         for f in Self::FLOAT_FIELDS {
             let v = (f.get)(self);
@@ -462,25 +444,6 @@ mod tests {
         assert_eq!(s.weight(-1.0, 0.0, 0.0), 0.0);
         let (a, b) = (s.weight(-1.0, 0.03, 0.03), s.weight(-1.0, 0.03, 0.030_001));
         assert!((a - b).abs() < 1e-4);
-    }
-
-    #[test]
-    fn for_arm_takes_the_body_radius_from_the_widest_section() {
-        let arm = crate::SoftArm::blackberry();
-        assert_eq!(Gains::for_arm(&arm), Gains::blackberry());
-        let mut sections = arm.sections().to_vec();
-        sections[1].radius = 0.05;
-        let wide = crate::SoftArm::new(sections).unwrap();
-        let g = Gains::for_arm(&wide);
-        assert!((g.body_radius - 0.063).abs() < 1e-15, "{}", g.body_radius);
-        assert!(g.validate().is_ok());
-        assert_eq!(
-            Gains {
-                body_radius: 0.041,
-                ..g
-            },
-            Gains::blackberry()
-        );
     }
 
     #[test]

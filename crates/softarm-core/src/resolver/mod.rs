@@ -44,6 +44,7 @@ pub use lag::{
 pub use solve::{Solution, SolveOptions, SolveTermination};
 pub use step::{StepInfo, StepInput, Workspace};
 
+use crate::body::Body;
 use crate::error::{Error, Result};
 use crate::kinematics::Kinematics;
 use crate::math::{Mat4, Vec3};
@@ -103,23 +104,50 @@ pub enum Target {
     Position(Vec3),
 }
 
-/// A resolver for one arm, mode and set of gains. Immutable: steps take a
-/// [`Workspace`] (or allocate one), so one resolver can serve several threads.
+/// A resolver for one arm, mode, set of gains and body (the surfaces its obstacle task
+/// keeps off the obstacles, [`avoid`]). Immutable: steps take a [`Workspace`] (or
+/// allocate one), so one resolver can serve several threads.
 #[derive(Debug, Clone)]
 pub struct Resolver<K: Kinematics> {
     arm: K,
     mode: Mode,
     gains: Gains,
+    body: Body,
 }
 
 impl<K: Kinematics> Resolver<K> {
-    /// A resolver for `arm`.
+    /// A resolver for `arm`, measuring the arm's default body
+    /// ([`Kinematics::default_body`]: for a [`crate::SoftArm`], [`Body::for_arm`] with the
+    /// gripper ending at the end-effector frame).
     ///
     /// # Errors
     /// [`Error::Parameter`] for invalid gains (see [`Gains::validate`]).
     pub fn new(arm: K, mode: Mode, gains: Gains) -> Result<Self> {
         gains.validate()?;
-        Ok(Resolver { arm, mode, gains })
+        let body = arm.default_body();
+        Ok(Resolver {
+            arm,
+            mode,
+            gains,
+            body,
+        })
+    }
+
+    /// This resolver with the obstacle task measuring `body` (e.g. the harvest's, whose
+    /// gripper reaches the grasp point).
+    ///
+    /// # Errors
+    /// [`Error::Shape`] naming `body` when it has another number of sections than the arm.
+    pub fn with_body(self, body: Body) -> Result<Self> {
+        let n = self.arm.n_sections();
+        if body.section_radii().len() != n {
+            return Err(Error::shape(
+                "body",
+                format!("{n} section radii, one per section of the arm"),
+                body.section_radii().len().to_string(),
+            ));
+        }
+        Ok(Resolver { body, ..self })
     }
 
     /// The arm model.
@@ -133,6 +161,10 @@ impl<K: Kinematics> Resolver<K> {
     /// The gains.
     pub fn gains(&self) -> &Gains {
         &self.gains
+    }
+    /// The body the obstacle task measures.
+    pub fn body(&self) -> &Body {
+        &self.body
     }
 
     /// A workspace sized for this resolver's arm.

@@ -13,7 +13,7 @@ use super::avoid::{self, Repulsion};
 use super::orientation::{check_pose, orientation_error};
 use super::{Mode, Resolver, Step, Target};
 use crate::chain::{check_q, forward_jacobian_into};
-use crate::distance::bodies::Piece;
+use crate::distance::bodies::{BodyClosest, Piece};
 use crate::distance::Obstacle;
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::kinematics::Kinematics;
@@ -62,7 +62,10 @@ pub struct Workspace {
     pub(super) nb: Vec<Vec3>,
     pub(super) nt: Vec<Vec3>,
     pub(super) avoid: Vec<f64>,
-    pub(super) row: Vec<f64>,
+    /// One obstacle's projected gap rows (row-major) and their asks.
+    pub(super) rows: Vec<f64>,
+    pub(super) asks: Vec<f64>,
+    pub(super) hits: Vec<BodyClosest>,
     pub(super) trial: Vec<f64>,
     pub(super) pieces: Vec<Piece>,
     pub(super) repulsions: Vec<Repulsion>,
@@ -89,7 +92,9 @@ impl Workspace {
             nb: vec![Vec3::zeros(); n],
             nt: vec![Vec3::zeros(); n],
             avoid: vec![0.0; n],
-            row: vec![0.0; n],
+            rows: Vec::new(),
+            asks: Vec::new(),
+            hits: Vec::new(),
             trial: vec![0.0; n],
             pieces: Vec::new(),
             repulsions: Vec::new(),
@@ -272,12 +277,12 @@ impl<K: Kinematics> Resolver<K> {
         let errors = self.task_errors(ws, q, &model, &goal, input);
         // Planning paper eq. (9): the obstacles' repulsions at q, on the model.
         let clearance = avoid::repulsions_into(
-            &self.arm,
+            (&self.arm, &self.body),
             q,
             input.obstacles,
             &self.gains,
             &ws.jac,
-            &mut ws.pieces,
+            (&mut ws.pieces, &mut ws.hits),
             &mut ws.repulsions,
         );
         // The lag bound applies to a step that closes the loop through the plant without

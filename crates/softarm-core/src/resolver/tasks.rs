@@ -282,10 +282,28 @@ impl<K: Kinematics> Resolver<K> {
         // of the tasks (eq. 20): c = P ∇g, Δq = c f / ‖c‖². Projecting the gap's row
         // first, not the three-row push J_s⁺ F after, makes each obstacle's step an
         // ascent of its own gap that vanishes where the gap is stationary (avoid.rs).
-        for j in 0..ws.repulsions.len() {
-            avoid::gap_row_into(&ws.repulsions[j], &ws.null_free, &mut ws.row);
-            project(&mut ws.row, a, &pa, pt.as_ref().map(|p| (&t[..], p)));
-            avoid::add_gap_step(&ws.row, ws.repulsions[j].ask, dls.0, &mut ws.avoid);
+        // The nearly tied pieces of one obstacle are ONE task of several rows
+        // (avoid::add_rows_step), each row weighted by how nearly its piece ties.
+        let n = ws.avoid.len();
+        let mut start = 0;
+        while start < ws.repulsions.len() {
+            let ob = ws.repulsions[start].obstacle;
+            let m = ws.repulsions[start..]
+                .iter()
+                .take_while(|r| r.obstacle == ob)
+                .count();
+            ws.rows.resize(m * n, 0.0);
+            ws.asks.clear();
+            for (k, r) in ws.repulsions[start..start + m].iter().enumerate() {
+                let row = &mut ws.rows[k * n..(k + 1) * n];
+                avoid::gap_row_into(r, &ws.null_free, row);
+                project(row, a, &pa, pt.as_ref().map(|p| (&t[..], p)));
+                let s = r.weight.sqrt();
+                row.iter_mut().for_each(|x| *x *= s);
+                ws.asks.push(s * r.ask);
+            }
+            avoid::add_rows_step(&ws.rows, &ws.asks, dls.0, &mut ws.avoid);
+            start += m;
         }
     }
 }
