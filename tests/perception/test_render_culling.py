@@ -4,7 +4,7 @@ equals the full one pixel for pixel."""
 from __future__ import annotations
 
 import numpy as np
-from tests.perception.perception_world import rendered_world
+from perception_world import rendered_world
 
 import softarm
 from softarm.sim.render.culling import MARGIN_PX, in_frustum
