@@ -1,6 +1,7 @@
 """Per-period render costs of the rendered bush (``softarm harvest --sim --world bush``):
 C1's window around the marker cube and C2's 320 x 240 frame, with the arm 3 % short of
-a berry, 12 poses on bushes 310-312, each rendered 10 times; the medians in ms.
+a berry, 4 poses on each bush (310-312 unless ``--seeds``), each rendered 10 times; the
+medians in ms.
 
 It measures the softarm tree first on PYTHONPATH, so that an older tree can be measured
 beside this one (``git worktree add DIR COMMIT``, copy the built ``_core.abi3.so`` into
@@ -11,6 +12,7 @@ beside this one (``git worktree add DIR COMMIT``, copy the built ``_core.abi3.so
 
 from __future__ import annotations
 
+import argparse
 import time
 from collections.abc import Callable
 from typing import Any
@@ -45,13 +47,18 @@ def _median_ms(render: Callable[[], object]) -> float:
     return 1e3 * (time.perf_counter() - start) / REPEATS
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     """Print the tree measured and the two medians."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--seeds", type=int, nargs="+", default=[310, 311, 312], help="bushes (310 311 312)"
+    )
+    args = parser.parse_args(argv)
     print(softarm.__file__)
     arm = softarm.SoftArm.blackberry()
     cams = default_cameras()
     window, c2 = [], []
-    for seed in (310, 311, 312):
+    for seed in args.seeds:
         bush = Bush.generate(arm, 10, seed, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
         world = world_for(bush, cams, BASE_TAG_ID, c2_scale=C2_SCALE)
         for berry in bush.berries[:4]:

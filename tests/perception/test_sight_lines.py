@@ -123,7 +123,7 @@ def test_a_fruit_is_placed_by_agreeing_crossings_from_poses_apart() -> None:
     placing = Placing(_line())
     placing.add(FRUIT + 0.05, np.array([0.1, 0.1, 0.3]))  # another fruit, once
     for k in range(CROSSINGS - 1):
-        placing.add(FRUIT, np.array([0.01 * k, 0.15, 0.32]))
+        placing.add(FRUIT, np.array([0.015 * k, 0.15, 0.32]))
     assert placing.position() is None
     placing.add(FRUIT + 0.002, np.array([0.05, 0.15, 0.32]))
     position = placing.position()
@@ -150,3 +150,44 @@ def test_a_line_through_a_mapped_berry_is_that_berry() -> None:
     bush_map = BushMap(berries=[MappedBerry(0, FRUIT + 0.01, 0.01, 1.0)])
     bush_map.note_unplaced([_line()])
     assert bush_map.unplaced == []
+
+
+def _vision(bush_map: BushMap):  # type: ignore[no-untyped-def]
+    """C2-side vision with C2 the only camera that matters here (C1 at the stereo's
+    left eye)."""
+    from softarm.perception.bush_vision import BushVision
+    from softarm.vision import MarkerCube
+
+    return BushVision(
+        lambda t: None, lambda t: None, C1, C2, _stereo().T_base_left, np.eye(4), np.eye(4),
+        MarkerCube.standard(0.08), 0.03, 0.03, bush_map=bush_map,
+    )  # fmt: skip
+
+
+def test_c2_places_the_fruit_of_a_waiting_line_and_not_a_mapped_one() -> None:
+    bush_map = BushMap()
+    bush_map.note_unplaced([_line()])
+    vision = _vision(bush_map)
+    for k in range(CROSSINGS):
+        T = _c2(np.array([0.015 * k, 0.15, 0.32]))
+        vision._place_unplaced([_det(_seen(T, C2, FRUIT), 12.0)], T)
+    (berry,) = bush_map.berries
+    np.testing.assert_allclose(berry.position, FRUIT, atol=1e-6)
+    assert bush_map.unplaced == [] and berry.ripeness == "ripe"
+    # A second waiting line through the same fruit: C2's detection is the mapped berry.
+    bush_map.unplaced.clear()
+    bush_map.unplaced.append(Placing(_line()))
+    for k in range(CROSSINGS):
+        T = _c2(np.array([0.015 * k, 0.15, 0.32]))
+        vision._place_unplaced([_det(_seen(T, C2, FRUIT), 12.0)], T)
+    assert len(bush_map.berries) == 1 and bush_map.unplaced[0].points == []
+
+
+def test_unripe_detections_place_nothing() -> None:
+    bush_map = BushMap()
+    bush_map.note_unplaced([_line()])
+    vision = _vision(bush_map)
+    for k in range(CROSSINGS):
+        T = _c2(np.array([0.015 * k, 0.15, 0.32]))
+        vision._place_unplaced([_det(_seen(T, C2, FRUIT), 12.0, ripe=False)], T)
+    assert bush_map.berries == [] and bush_map.unplaced[0].points == []
