@@ -42,6 +42,9 @@ from softarm.vision.poses import (
 # (rms is per corner). 16.81 is the 99 % quantile of χ² with 6 degrees of freedom (a pose).
 CHI2_6DOF_99 = 16.81
 DEFAULT_CORNER_SIGMA_PX = 0.05
+#: A printed tag's square (its quiet zone around the marker) is this many times the
+#: marker's side: the paper's 80 mm tags on the cube's 100 mm faces.
+FACE_PER_MARKER = 1.25
 _LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
 
 
@@ -98,7 +101,7 @@ class MarkerCube:
         +z. ``cube_size`` (edge, m) defaults to 1.25 × ``marker_length`` (80 mm tags on a
         100 mm cube). The cube frame is at the cube's centre."""
         length = positive(marker_length, "marker_length")
-        size = 1.25 * length if cube_size is None else positive(cube_size, "cube_size")
+        size = FACE_PER_MARKER * length if cube_size is None else positive(cube_size, "cube_size")
         if size < length:
             raise ParameterError(f"cube_size must be >= marker_length, got {size} < {length}")
         markers = {}

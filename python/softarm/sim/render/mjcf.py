@@ -22,6 +22,7 @@ from scipy.spatial.transform import Rotation
 from softarm.checks import FloatArray
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.render.look import BushLook
+from softarm.vision.cube import FACE_PER_MARKER
 from softarm.vision.dictionaries import get_dictionary
 
 __all__ = ["ARM_SEGMENTS_PER_SECTION", "CameraSpec", "SceneSpec", "scene_xml", "z_to"]
@@ -91,13 +92,18 @@ def scene_xml(spec: SceneSpec) -> tuple[str, dict[str, bytes]]:
         *(body for body, _ in berries),
         _leaves(spec, rng),
         _clutter(spec.look, rng),
-        _quad("arm_basetag", spec.T_base_tag, 1.25 * spec.tag_length, f"tag{spec.base_tag_id}"),
+        _quad(
+            "arm_basetag",
+            spec.T_base_tag,
+            FACE_PER_MARKER * spec.tag_length,
+            f"tag{spec.base_tag_id}",
+        ),
         *(_camera(c) for c in spec.world_cameras),
         _arm(spec),
     ]
     look = spec.look
     amb = look.ambient
-    meshes = "".join(_quad_mesh(1.25 * m) for m in {spec.cube_marker, spec.tag_length})
+    meshes = "".join(_quad_mesh(FACE_PER_MARKER * m) for m in {spec.cube_marker, spec.tag_length})
     meshes += "".join(mesh for _, mesh in berries)
     head = (
         f'<mujoco model="bush"><compiler angle="radian"/>'
@@ -337,7 +343,7 @@ def _arm(spec: SceneSpec) -> str:
     )
     cams = "".join(_camera(c) for c in spec.hand_cameras)
     out.append(f'<body name="arm_ee" mocap="true">{fingers}{cams}</body>')
-    s = 1.25 * spec.cube_marker
+    s = FACE_PER_MARKER * spec.cube_marker
     faces = "".join(
         _quad(f"arm_cubeface{i}", _cube_face(k, s), s, f"tag{i}")
         for k, i in enumerate(spec.cube_ids)
@@ -402,7 +408,7 @@ def _tag_assets(spec: SceneSpec) -> dict[str, bytes]:
     ids = [*spec.cube_ids, spec.base_tag_id]
     lengths = [spec.cube_marker] * 4 + [spec.tag_length]
     return {
-        f"tag{i}.png": _tag_png(spec.dictionary, i, m, 1.25 * m)
+        f"tag{i}.png": _tag_png(spec.dictionary, i, m, FACE_PER_MARKER * m)
         for i, m in zip(ids, lengths, strict=True)
     }
 

@@ -32,6 +32,7 @@ from softarm.sim.render.mjcf import (
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
+from softarm.vision.cube import FACE_PER_MARKER
 from softarm.vision.poses import invert
 
 __all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
@@ -42,15 +43,13 @@ ZED2_BASELINE = 0.12
 CUBE_REACH = 0.07
 GRIPPER_REACH = 0.04
 #: The C1 window rendered around the marker cube while tracking it holds the cube's
-#: bounding sphere with WINDOW_PAD px to spare on each side (the tags' quiet zone and
+#: eight corners with WINDOW_PAD px to spare on each side (the tags' quiet zone and
 #: the detector's adaptive threshold reach past the outline); its side is a multiple of
 #: WINDOW_STEP px (one renderer, an OpenGL context, per side). The pinhole window
 #: rendered for it is WINDOW_MARGIN px larger (the distortion's shift).
 WINDOW_PAD = 16
 WINDOW_STEP = 32
 WINDOW_MARGIN = 24
-#: The cube's faces are 1.25 times its tags (mjcf: 80 mm tags on 100 mm faces).
-CUBE_FACE_PER_TAG = 1.25
 
 
 def arm_sections(arm: SoftArm, q: FloatArray) -> list[FloatArray]:
@@ -113,7 +112,7 @@ class RenderedBush:
         self.stereo = StereoCamera(c1, c1, T_base_c1, T_left_right)
         self.c2 = c2
         self.T_ee_cube = T_ee_cube
-        half = 0.5 * CUBE_FACE_PER_TAG * cube_marker
+        half = 0.5 * FACE_PER_MARKER * cube_marker
         self._cube_corners = half * np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
         right = T_base_c1 @ T_left_right
         spec = SceneSpec(
