@@ -74,6 +74,18 @@ class BerryDetection:
     position: FloatArray | None = None
     radius_m: float | None = None
 
+    @property
+    def ripe_vote(self) -> float:
+        """This detection's vote for ripe, in [0, 1]: ``probability`` when it says ripe,
+        its complement when it says unripe (what the bush map adds up over sightings)."""
+        return self.probability if self.ripeness == "ripe" else 1.0 - self.probability
+
+
+def ripe_by_votes(ripe_votes: float, sightings: int) -> bool:
+    """Ripe when most of a fruit's ``sightings`` said so (summed :attr:`BerryDetection.
+    ripe_vote`); the NIR sensor decides at the grasp."""
+    return ripe_votes >= 0.5 * sightings
+
 
 def detect_berries(
     image: npt.NDArray[np.uint8],

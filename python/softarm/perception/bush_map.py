@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.perception.berries import BerryDetection, Ripeness
+from softarm.perception.berries import BerryDetection, Ripeness, ripe_by_votes
 from softarm.perception.sight_lines import Placing, SightLine, same_line
 
 if TYPE_CHECKING:
@@ -41,7 +41,7 @@ class MappedBerry:
     @property
     def ripeness(self) -> Ripeness:
         """Ripe when most sightings said so (the NIR sensor decides at the grasp)."""
-        return "ripe" if self.ripe_votes >= 0.5 * self.sightings else "unripe"
+        return "ripe" if ripe_by_votes(self.ripe_votes, self.sightings) else "unripe"
 
 
 @dataclass
@@ -62,7 +62,7 @@ class BushMap:
         for d in detections:
             if d.position is None:
                 continue
-            vote = d.probability if d.ripeness == "ripe" else 1.0 - d.probability
+            vote = d.ripe_vote
             known = self._near(d.position)
             if known is None:
                 radius = d.radius_m or FRUIT_RADIUS

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.perception.berries import BerryDetection
+from softarm.perception.berries import BerryDetection, ripe_by_votes
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
 
@@ -55,7 +55,7 @@ class SightLine:
     @property
     def ripe(self) -> bool:
         """Ripe when most of C1's sightings said so."""
-        return self.ripe_votes >= 0.5 * self.sightings
+        return ripe_by_votes(self.ripe_votes, self.sightings)
 
 
 def sight_lines(detections: list[BerryDetection], stereo: StereoCamera) -> list[SightLine]:
@@ -69,13 +69,12 @@ def sight_lines(detections: list[BerryDetection], stereo: StereoCamera) -> list[
         if d.position is not None:
             continue
         ray = np.array([(d.center[0] - K[0, 2]) / K[0, 0], (d.center[1] - K[1, 2]) / K[1, 1], 1.0])
-        vote = d.probability if d.ripeness == "ripe" else 1.0 - d.probability
         out.append(
             SightLine(
                 stereo.T_base_left[:3, 3].copy(),
                 R @ ray / np.linalg.norm(ray),
                 float(np.arctan2(d.radius, K[0, 0])),
-                vote,
+                d.ripe_vote,
             )
         )
     return out

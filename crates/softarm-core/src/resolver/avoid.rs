@@ -433,26 +433,21 @@ mod tests {
         add_rows_step(&a, &[1e-3], 0.05, &mut same);
         assert_eq!(one, same);
         let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
-        let step = |w: f64| {
+        // The two rows, the second weighted by w, solved with singular threshold eps.
+        let weighted = |w: f64, eps: f64| {
             let s = w.sqrt();
             let rows: Vec<f64> = a.iter().copied().chain(b.iter().map(|x| s * x)).collect();
             let mut out = [0.0; 4];
-            add_rows_step(&rows, &[1e-3, s * 0.5e-3], 0.0, &mut out);
+            add_rows_step(&rows, &[1e-3, s * 0.5e-3], eps, &mut out);
             out
         };
-        let both = step(1.0);
+        let both = weighted(1.0, 0.0);
         assert!((dot(&a, &both) - 1e-3).abs() < 1e-12);
         assert!((dot(&b, &both) - 0.5e-3).abs() < 1e-12);
         // With the threshold, the second row's singular value falls below it before its
         // weight reaches 0: the step is then the first row's alone, and gets there
         // continuously.
-        let fade = |w: f64| {
-            let s = w.sqrt();
-            let rows: Vec<f64> = a.iter().copied().chain(b.iter().map(|x| s * x)).collect();
-            let mut out = [0.0; 4];
-            add_rows_step(&rows, &[1e-3, s * 0.5e-3], 0.05, &mut out);
-            out
-        };
+        let fade = |w: f64| weighted(w, 0.05);
         let mut alone = [0.0; 4];
         add_gap_step(&a, 1e-3, 0.05, &mut alone);
         let norm = dot(&alone, &alone).sqrt();
