@@ -114,3 +114,57 @@ def test_bad_cube_definitions() -> None:
         MarkerCube.standard(0.08, cube_size=0.05)
     with pytest.raises(ParameterError, match="dictionary"):
         MarkerCube.standard(dictionary="DICT_NOPE")
+
+
+def _turned_cube(distance: float, yaw_deg: float) -> np.ndarray:
+    """``T_camera_cube`` at ``distance`` on the optical axis, marker 0 face-on when
+    ``yaw_deg`` is 0, turned by ``yaw_deg`` about the cube's z (which points up: -y)."""
+    face_on = facing(distance) @ np.linalg.inv(MarkerCube.standard().markers[0])
+    face_on[:3, 3] = [0.0, 0.0, distance]
+    turn = np.eye(4)
+    turn[:3, :3] = Rotation.from_euler("z", yaw_deg, degrees=True).as_matrix()
+    return face_on @ turn
+
+
+def test_view_angles_closed_form(cube: MarkerCube) -> None:
+    # Turned by 30° about its vertical axis, the cube shows marker 0 at about 30° and
+    # marker 1 (the next face, a right angle on) at about 60°; the parallax of the faces'
+    # centres off the optical axis is atan(0.05 / 1.0) ≈ 2.9° at most.
+    angles = cube.view_angles(_turned_cube(1.0, 30.0), (0, 1, 2, 3))
+    np.testing.assert_allclose(angles[[0, 2]], [30.0, 150.0], atol=3.0)
+    np.testing.assert_allclose(angles[1] + angles[3], 180.0, atol=6.0)
+    assert min(angles[1], angles[3]) == pytest.approx(60.0, abs=3.0)
+    assert cube.frontal_ids(_turned_cube(1.0, 30.0), (0, 1, 2, 3)) == (0,)
+    # Every marker too oblique: the most frontal is kept.
+    edge_on = _turned_cube(1.0, 45.0)
+    narrow = MarkerCube.standard()
+    narrow.max_view_angle = 10.0
+    assert len(narrow.frontal_ids(edge_on, (0, 1, 2, 3))) == 1
+
+
+def test_grazing_marker_left_out_of_the_pose(camera: CameraModel) -> None:
+    # Marker 0 at ~20° and its neighbour at ~70°: the neighbour's corners carry a 0.5 px
+    # bias (a foreshortened marker's error). Left out (default 60°), the pose stays on the
+    # frontal marker's exact corners; kept (90°), the bias pulls the pose by millimetres.
+    truth = _turned_cube(1.0, 20.0)
+    picky = MarkerCube.standard()
+    lax = MarkerCube(picky.markers, 0.08, max_view_angle=90.0)
+    angles = picky.view_angles(truth, (0, 1, 3))
+    frontal, grazing = (0, 1, 3)[int(np.argmin(angles))], (1, 3)[int(np.argmin(angles[1:]))]
+    assert angles.min() < 25.0 and 65.0 < np.sort(angles)[1] < 75.0
+    dets = []
+    for i, bias in ((frontal, 0.0), (grazing, 0.5)):
+        corners = camera.project(transform_points(truth, picky.object_points(i)))
+        dets.append(Detection(i, corners + bias))
+    est, all_in = picky.estimate(dets, camera, truth), lax.estimate(dets, camera, truth)
+    assert est is not None and all_in is not None
+    assert est.marker_ids == (frontal,) and len(all_in.marker_ids) == 2
+    assert np.linalg.norm(est.T_camera_cube[:3, 3] - truth[:3, 3]) < 1e-5
+    assert np.linalg.norm(all_in.T_camera_cube[:3, 3] - truth[:3, 3]) > 1e-3
+
+
+def test_max_view_angle_checked() -> None:
+    with pytest.raises(ParameterError, match="max_view_angle"):
+        MarkerCube(MarkerCube.standard().markers, 0.08, max_view_angle=0.0)
+    with pytest.raises(ParameterError, match="max_view_angle"):
+        MarkerCube(MarkerCube.standard().markers, 0.08, max_view_angle=95.0)

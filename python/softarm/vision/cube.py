@@ -42,6 +42,11 @@ from softarm.vision.poses import (
 # (rms is per corner). 16.81 is the 99 % quantile of χ² with 6 degrees of freedom (a pose).
 CHI2_6DOF_99 = 16.81
 DEFAULT_CORNER_SIGMA_PX = 0.05
+#: A marker seen more than this far (degrees) from face-on is left out of the pose when a
+#: more frontal one is seen: foreshortened by cos θ, its corners' error grows as 1 / cos θ
+#: along the compressed axis (twice the face-on error at 60°), and in the joint fit it
+#: pulls the pose along the line of sight, the axis a marker's size measures worst.
+DEFAULT_MAX_VIEW_ANGLE_DEG = 60.0
 #: A printed tag's square (its quiet zone around the marker) is this many times the
 #: marker's side: the paper's 80 mm tags on the cube's 100 mm faces.
 FACE_PER_MARKER = 1.25
@@ -61,7 +66,9 @@ class MarkerCube:
     """A rigid set of square markers: ``markers`` maps id → (4, 4) pose of the marker in
     the cube frame (ArUco marker convention: z out of the face); all share ``marker_length``
     (m) and ``dictionary``. ``corner_sigma`` (px) is the expected corner noise, which sets
-    how close in reprojection error two solutions must be to count as ambiguous."""
+    how close in reprojection error two solutions must be to count as ambiguous;
+    markers seen more than ``max_view_angle`` (degrees) from face-on are left out of the
+    pose while a more frontal one is seen (:data:`DEFAULT_MAX_VIEW_ANGLE_DEG`)."""
 
     def __init__(
         self,
@@ -69,12 +76,16 @@ class MarkerCube:
         marker_length: float,
         dictionary: str = "DICT_4X4_50",
         corner_sigma: float = DEFAULT_CORNER_SIGMA_PX,
+        max_view_angle: float = DEFAULT_MAX_VIEW_ANGLE_DEG,
     ) -> None:
         if not markers:
             raise ParameterError("markers must name at least one marker, got none")
         self.marker_length = positive(marker_length, "marker_length")
         self.dictionary = dictionary
         self.corner_sigma = positive(corner_sigma, "corner_sigma")
+        self.max_view_angle = positive(max_view_angle, "max_view_angle")
+        if self.max_view_angle > 90.0:
+            raise ParameterError(f"max_view_angle must be at most 90 degrees, got {max_view_angle}")
         self.markers: dict[int, FloatArray] = {
             check_marker_id(dictionary, k): as_pose(v, f"markers[{k}]") for k, v in markers.items()
         }
@@ -138,18 +149,44 @@ class MarkerCube:
         camera: CameraModel,
         previous: npt.ArrayLike | None = None,
     ) -> CubePose | None:
-        """Like :meth:`estimate_pose` from existing detections, with fit details."""
+        """Like :meth:`estimate_pose` from existing detections, with fit details: the
+        pose from all the cube's markers, then, if some are seen too obliquely, again
+        from the frontal ones alone (the first pose breaking their planar ambiguity)."""
         prev = None if previous is None else as_pose(previous, "previous", tol=1e-4)
-        cands = self.candidates(detections, camera)
+        pick = self._pick(self.candidates(detections, camera), prev)
+        if pick is None or len(pick.marker_ids) < 2:
+            return pick
+        frontal = self.frontal_ids(pick.T_camera_cube, pick.marker_ids)
+        if len(frontal) == len(pick.marker_ids):
+            return pick
+        kept = [d for d in detections if d.marker_id in frontal]
+        return self._pick(self.candidates(kept, camera), pick.T_camera_cube) or pick
+
+    def view_angles(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> FloatArray:
+        """Degrees between each marker ``ids``'s normal and the line of sight to its centre
+        when the cube is at ``T_camera_cube`` (0 face-on, 90 edge-on)."""
+        poses = np.stack([T_camera_cube @ self.markers[i] for i in ids])
+        normals, centres = poses[:, :3, 2], poses[:, :3, 3]
+        cos = -np.einsum("ij,ij->i", normals, centres) / np.linalg.norm(centres, axis=1)
+        return np.asarray(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+
+    def frontal_ids(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> tuple[int, ...]:
+        """The ``ids`` seen within ``max_view_angle`` of face-on, or the most frontal one."""
+        angles = self.view_angles(T_camera_cube, ids)
+        kept = tuple(i for i, a in zip(ids, angles, strict=True) if a <= self.max_view_angle)
+        return kept or (ids[int(np.argmin(angles))],)
+
+    def _pick(self, cands: list[CubePose], prev: FloatArray | None) -> CubePose | None:
+        """The best candidate, or among those as good (corner noise), the one nearest
+        ``prev``; None when there are none."""
         if not cands:
             return None
-        pick = cands[0]
-        if prev is not None:
-            n = round(len(pick.marker_ids) * 4)
-            limit = self.corner_sigma**2 * CHI2_6DOF_99 / n
-            ok = [c for c in cands if c.rms**2 - cands[0].rms ** 2 <= limit]
-            pick = min(ok, key=lambda c: rotation_angle(c.T_camera_cube, prev))
-        return pick
+        if prev is None:
+            return cands[0]
+        n = round(len(cands[0].marker_ids) * 4)
+        limit = self.corner_sigma**2 * CHI2_6DOF_99 / n
+        ok = [c for c in cands if c.rms**2 - cands[0].rms ** 2 <= limit]
+        return min(ok, key=lambda c: rotation_angle(c.T_camera_cube, prev))
 
     def candidates(self, detections: list[Detection], camera: CameraModel) -> list[CubePose]:
         """Every local optimum found: each IPPE solution of each visible cube marker,
