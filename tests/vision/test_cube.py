@@ -168,3 +168,28 @@ def test_max_view_angle_checked() -> None:
         MarkerCube(MarkerCube.standard().markers, 0.08, max_view_angle=0.0)
     with pytest.raises(ParameterError, match="max_view_angle"):
         MarkerCube(MarkerCube.standard().markers, 0.08, max_view_angle=95.0)
+
+
+def test_marker_with_wrong_corners_left_out(camera: CameraModel) -> None:
+    # Two markers in view, ~35° and ~55° from face-on: exact corners agree with one pose
+    # and both are kept. One corner of a marker moved by 1.5 px (a leaf over it) is no
+    # pose of a square: that marker is left out and the pose stays on the other's exact
+    # corners; when every marker is bent, the least bent one is kept.
+    cube = MarkerCube.standard()
+    truth = _turned_cube(1.0, 35.0)
+    angles = cube.view_angles(truth, (0, 1, 3))
+    second = (1, 3)[int(np.argmin(angles[1:]))]
+    exact = {i: camera.project(transform_points(truth, cube.object_points(i))) for i in (0, second)}
+    good = [Detection(i, c) for i, c in exact.items()]
+    assert [d.marker_id for d in cube.consistent(good, camera)] == [0, second]
+    bent = exact[second].copy()
+    bent[2] += [1.5, -1.0]
+    mixed = [Detection(0, exact[0]), Detection(second, bent)]
+    assert [d.marker_id for d in cube.consistent(mixed, camera)] == [0]
+    est = cube.estimate(mixed, camera, truth)
+    assert est is not None and est.marker_ids == (0,)
+    assert np.linalg.norm(est.T_camera_cube[:3, 3] - truth[:3, 3]) < 1e-5
+    worse = exact[0].copy()
+    worse[1] += [3.0, 2.0]
+    both_bent = [Detection(0, worse), Detection(second, bent)]
+    assert [d.marker_id for d in cube.consistent(both_bent, camera)] == [second]

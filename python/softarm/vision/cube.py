@@ -41,6 +41,10 @@ from softarm.vision.poses import (
 # ``corner_sigma`` explains: N (rms² − best²) ≤ σ² χ²(6 dof, 99 %), N the matched corners
 # (rms is per corner). 16.81 is the 99 % quantile of χ² with 6 degrees of freedom (a pose).
 CHI2_6DOF_99 = 16.81
+#: One marker's four corners fix its pose with 2 degrees of freedom to spare; corners a
+#: leaf cuts or the view bends leave a residual that corner noise cannot explain: a
+#: marker is consistent when 4 rms² ≤ σ² χ²(2 dof, 99 %), 9.21 that quantile.
+CHI2_2DOF_99 = 9.21
 DEFAULT_CORNER_SIGMA_PX = 0.05
 #: A marker seen more than this far (degrees) from face-on is left out of the pose when a
 #: more frontal one is seen: foreshortened by cos θ, its corners' error grows as 1 / cos θ
@@ -150,17 +154,32 @@ class MarkerCube:
         previous: npt.ArrayLike | None = None,
     ) -> CubePose | None:
         """Like :meth:`estimate_pose` from existing detections, with fit details: the
-        pose from all the cube's markers, then, if some are seen too obliquely, again
-        from the frontal ones alone (the first pose breaking their planar ambiguity)."""
+        pose from the cube's markers whose corners are consistent on their own
+        (:meth:`consistent`), then, if some are seen too obliquely, again from the frontal
+        ones alone (the first pose breaking their planar ambiguity)."""
         prev = None if previous is None else as_pose(previous, "previous", tol=1e-4)
-        pick = self._pick(self.candidates(detections, camera), prev)
+        mine = self.consistent(detections, camera)
+        pick = self._pick(self.candidates(mine, camera), prev)
         if pick is None or len(pick.marker_ids) < 2:
             return pick
         frontal = self.frontal_ids(pick.T_camera_cube, pick.marker_ids)
         if len(frontal) == len(pick.marker_ids):
             return pick
-        kept = [d for d in detections if d.marker_id in frontal]
+        kept = [d for d in mine if d.marker_id in frontal]
         return self._pick(self.candidates(kept, camera), pick.T_camera_cube) or pick
+
+    def consistent(self, detections: list[Detection], camera: CameraModel) -> list[Detection]:
+        """The cube's markers among ``detections`` whose four corners fit a pose of their
+        own within the corner noise (see :data:`CHI2_2DOF_99`); when none does, the one
+        that fits best. A marker with wrong corners would pull the joint pose by
+        centimetres while its code still reads."""
+        mine = [d for d in detections if d.marker_id in self.markers]
+        if len(mine) < 2:
+            return mine
+        limit = self.corner_sigma * float(np.sqrt(CHI2_2DOF_99 / 4.0))
+        rms = [min((c.rms for c in self.candidates([d], camera)), default=np.inf) for d in mine]
+        kept = [d for d, r in zip(mine, rms, strict=True) if r <= limit]
+        return kept or [mine[int(np.argmin(rms))]]
 
     def view_angles(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> FloatArray:
         """Degrees between each marker ``ids``'s normal and the line of sight to its centre
