@@ -135,11 +135,11 @@ def test_view_angles_closed_form(cube: MarkerCube) -> None:
     np.testing.assert_allclose(angles[1] + angles[3], 180.0, atol=6.0)
     assert min(angles[1], angles[3]) == pytest.approx(60.0, abs=3.0)
     assert cube.frontal_ids(_turned_cube(1.0, 30.0), (0, 1, 2, 3)) == (0,)
-    # Every marker too oblique: the most frontal is kept.
+    # Every marker too oblique: all are kept (the joint fit is then the better).
     edge_on = _turned_cube(1.0, 45.0)
     narrow = MarkerCube.standard()
     narrow.max_view_angle = 10.0
-    assert len(narrow.frontal_ids(edge_on, (0, 1, 2, 3))) == 1
+    assert narrow.frontal_ids(edge_on, (0, 1)) == (0, 1)
 
 
 def test_grazing_marker_left_out_of_the_pose(camera: CameraModel) -> None:
@@ -174,7 +174,7 @@ def test_marker_with_wrong_corners_left_out(camera: CameraModel) -> None:
     # Two markers in view, ~35° and ~55° from face-on: exact corners agree with one pose
     # and both are kept. One corner of a marker moved by 1.5 px (a leaf over it) is no
     # pose of a square: that marker is left out and the pose stays on the other's exact
-    # corners; when every marker is bent, the least bent one is kept.
+    # corners; when every marker is bent, the pose is the least bent one's, flagged.
     cube = MarkerCube.standard()
     truth = _turned_cube(1.0, 35.0)
     angles = cube.view_angles(truth, (0, 1, 3))
@@ -192,4 +192,7 @@ def test_marker_with_wrong_corners_left_out(camera: CameraModel) -> None:
     worse = exact[0].copy()
     worse[1] += [3.0, 2.0]
     both_bent = [Detection(0, worse), Detection(second, bent)]
-    assert [d.marker_id for d in cube.consistent(both_bent, camera)] == [second]
+    assert cube.consistent(both_bent, camera) == []
+    flagged = cube.estimate(both_bent, camera, truth)
+    assert flagged is not None and flagged.marker_ids == (second,)
+    assert not flagged.consistent and est.consistent

@@ -10,7 +10,9 @@ window the harvest tracks the cube in (:meth:`RenderedBush.cube_window`), the cu
 pose is estimated from it as the harvest does (:class:`~softarm.vision.MarkerCube`, no
 previous pose) and scored against the true one, over all poses and apart where the
 cube's tags are in full view (at least 99 % of their pixels: leaves, fruit or the arm
-hide some in the others; the tag world's figure is of a cube in full view). ``--side N``
+hide some in the others; the tag world's figure is of a cube in full view), and apart
+where every marker used is consistent on its own (``CubePose.consistent``: the poses
+the harvest's tracker uses at once; it drops the others unless they persist). ``--side N``
 renders fixed N-pixel
 windows instead (the harvest's window before it was fitted to the cube), for
 comparison on the same poses.
@@ -54,6 +56,7 @@ def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -
     errors, sides, tried, seconds = [], [], 0, 0.0
     unhidden: list[float] = []  # the cube's tags in full view
     hidden: list[float] = []  # some of them hidden (leaves, fruit, the arm)
+    trusted: list[float] = []  # from markers consistent on their own (the tracker's)
     for seed in seeds:
         bush = Bush.generate(arm, 8, seed, view_point=cams.T_base_c1[:3, 3])
         world = world_for(bush, cams, BASE_TAG_ID)
@@ -78,12 +81,17 @@ def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -
                 error = 1e3 * float(np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3]))
                 errors.append(error)
                 (unhidden if share >= UNHIDDEN else hidden).append(error)
+                if est.consistent:
+                    trusted.append(error)
         world.close()
     return {
         "poses": tried,
         "found": len(errors),
         "median_mm": _median(errors),
         "p95_mm": float(np.percentile(errors, 95)) if errors else float("nan"),
+        "consistent": len(trusted),
+        "median_consistent_mm": _median(trusted),
+        "p95_consistent_mm": float(np.percentile(trusted, 95)) if trusted else float("nan"),
         "in_full_view": len(unhidden),
         "median_in_full_view_mm": _median(unhidden),
         "median_partly_hidden_mm": _median(hidden),

@@ -11,7 +11,7 @@ is kept (section II-C: a cube with four tags tracks the end effector).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import cv2
@@ -46,8 +46,8 @@ CHI2_6DOF_99 = 16.81
 #: marker is consistent when 4 rms² ≤ σ² χ²(2 dof, 99 %), 9.21 that quantile.
 CHI2_2DOF_99 = 9.21
 DEFAULT_CORNER_SIGMA_PX = 0.05
-#: A marker seen more than this far (degrees) from face-on is left out of the pose when a
-#: more frontal one is seen: foreshortened by cos θ, its corners' error grows as 1 / cos θ
+#: A marker seen more than this far (degrees) from face-on is left out of the pose when one
+#: within it is seen: foreshortened by cos θ, its corners' error grows as 1 / cos θ
 #: along the compressed axis (twice the face-on error at 60°), and in the joint fit it
 #: pulls the pose along the line of sight, the axis a marker's size measures worst.
 DEFAULT_MAX_VIEW_ANGLE_DEG = 60.0
@@ -59,11 +59,14 @@ _LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
 
 @dataclass(frozen=True)
 class CubePose:
-    """A cube pose estimate: ``T_camera_cube``, RMS reprojection error (px), markers used."""
+    """A cube pose estimate: ``T_camera_cube``, RMS reprojection error (px), markers used,
+    and whether they are :meth:`MarkerCube.consistent` (False: no marker's corners were,
+    and the pose is the least bent marker's, possibly centimetres off)."""
 
     T_camera_cube: FloatArray
     rms: float
     marker_ids: tuple[int, ...]
+    consistent: bool = True
 
 
 class MarkerCube:
@@ -72,7 +75,7 @@ class MarkerCube:
     (m) and ``dictionary``. ``corner_sigma`` (px) is the expected corner noise, which sets
     how close in reprojection error two solutions must be to count as ambiguous;
     markers seen more than ``max_view_angle`` (degrees) from face-on are left out of the
-    pose while a more frontal one is seen (:data:`DEFAULT_MAX_VIEW_ANGLE_DEG`)."""
+    pose while one within it is seen (:data:`DEFAULT_MAX_VIEW_ANGLE_DEG`)."""
 
     def __init__(
         self,
@@ -155,31 +158,43 @@ class MarkerCube:
     ) -> CubePose | None:
         """Like :meth:`estimate_pose` from existing detections, with fit details: the
         pose from the cube's markers whose corners are consistent on their own
-        (:meth:`consistent`), then, if some are seen too obliquely, again from the frontal
-        ones alone (the first pose breaking their planar ambiguity)."""
+        (:meth:`consistent`; when none is, the least bent one's, flagged), then, if some
+        are seen too obliquely, again from the frontal ones alone (the first pose
+        breaking their planar ambiguity)."""
         prev = None if previous is None else as_pose(previous, "previous", tol=1e-4)
         mine = self.consistent(detections, camera)
+        trusted = bool(mine)
+        mine = mine or self._least_bent(detections, camera)
         pick = self._pick(self.candidates(mine, camera), prev)
-        if pick is None or len(pick.marker_ids) < 2:
-            return pick
-        frontal = self.frontal_ids(pick.T_camera_cube, pick.marker_ids)
-        if len(frontal) == len(pick.marker_ids):
-            return pick
-        kept = [d for d in mine if d.marker_id in frontal]
-        return self._pick(self.candidates(kept, camera), pick.T_camera_cube) or pick
+        if pick is not None and len(pick.marker_ids) > 1:
+            frontal = self.frontal_ids(pick.T_camera_cube, pick.marker_ids)
+            if len(frontal) < len(pick.marker_ids):
+                kept = [d for d in mine if d.marker_id in frontal]
+                pick = self._pick(self.candidates(kept, camera), pick.T_camera_cube) or pick
+        return None if pick is None else replace(pick, consistent=trusted)
 
     def consistent(self, detections: list[Detection], camera: CameraModel) -> list[Detection]:
         """The cube's markers among ``detections`` whose four corners fit a pose of their
-        own within the corner noise (see :data:`CHI2_2DOF_99`); when none does, the one
-        that fits best. A marker with wrong corners would pull the joint pose by
-        centimetres while its code still reads."""
-        mine = [d for d in detections if d.marker_id in self.markers]
-        if len(mine) < 2:
-            return mine
+        own within the corner noise (see :data:`CHI2_2DOF_99`). A marker whose code
+        still reads but whose corners are wrong (a leaf over one, an edge the
+        refinement could not measure) would move the pose by centimetres."""
         limit = self.corner_sigma * float(np.sqrt(CHI2_2DOF_99 / 4.0))
-        rms = [min((c.rms for c in self.candidates([d], camera)), default=np.inf) for d in mine]
-        kept = [d for d, r in zip(mine, rms, strict=True) if r <= limit]
-        return kept or [mine[int(np.argmin(rms))]]
+        return [d for d, rms in self._own_fits(detections, camera) if rms <= limit]
+
+    def _least_bent(self, detections: list[Detection], camera: CameraModel) -> list[Detection]:
+        """The cube's marker among ``detections`` whose corners come nearest a pose of
+        their own ([] when none is seen): one marker's error, not the mix of several."""
+        fits = self._own_fits(detections, camera)
+        return [min(fits, key=lambda f: f[1])[0]] if fits else []
+
+    def _own_fits(
+        self, detections: list[Detection], camera: CameraModel
+    ) -> list[tuple[Detection, float]]:
+        """Each of the cube's markers among ``detections`` with the RMS (px) of the best
+        pose its four corners give alone."""
+        mine = [d for d in detections if d.marker_id in self.markers]
+        return [(d, min((c.rms for c in self.candidates([d], camera)), default=np.inf))
+                for d in mine]  # fmt: skip
 
     def view_angles(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> FloatArray:
         """Degrees between each marker ``ids``'s normal and the line of sight to its centre
@@ -190,10 +205,11 @@ class MarkerCube:
         return np.asarray(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
 
     def frontal_ids(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> tuple[int, ...]:
-        """The ``ids`` seen within ``max_view_angle`` of face-on, or the most frontal one."""
+        """The ``ids`` seen within ``max_view_angle`` of face-on, or all of them when none
+        is (the cube seen from near its open end: then the joint fit is the better)."""
         angles = self.view_angles(T_camera_cube, ids)
         kept = tuple(i for i, a in zip(ids, angles, strict=True) if a <= self.max_view_angle)
-        return kept or (ids[int(np.argmin(angles))],)
+        return kept or ids
 
     def _pick(self, cands: list[CubePose], prev: FloatArray | None) -> CubePose | None:
         """The best candidate, or among those as good (corner noise), the one nearest
