@@ -11,8 +11,8 @@ pose is estimated from it as the harvest does (:class:`~softarm.vision.MarkerCub
 previous pose) and scored against the true one, over all poses and apart where the
 cube's tags are in full view (at least 99 % of their pixels: leaves, fruit or the arm
 hide some in the others; the tag world's figure is of a cube in full view), and apart
-where every marker used is consistent on its own (``CubePose.consistent``: the poses
-the harvest's tracker uses at once; it drops the others unless they persist). ``--side N``
+where every marker used is consistent on its own (``CubePose.consistent``; the others
+are the least bent marker's pose). ``--side N``
 renders fixed N-pixel
 windows instead (the harvest's window before it was fitted to the cube), for
 comparison on the same poses.

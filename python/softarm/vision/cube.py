@@ -162,10 +162,15 @@ class MarkerCube:
         are seen too obliquely, again from the frontal ones alone (the first pose
         breaking their planar ambiguity)."""
         prev = None if previous is None else as_pose(previous, "previous", tol=1e-4)
-        mine = self.consistent(detections, camera)
+        own = self._own_fits(detections, camera)
+        mine = self._consistent_of(own)
         trusted = bool(mine)
-        mine = mine or self._least_bent(detections, camera)
-        pick = self._pick(self.candidates(mine, camera), prev)
+        if not trusted and own:  # the least bent: one marker's error, not a mix of several
+            mine = [min(own, key=lambda fit: fit[1][0].rms if fit[1] else np.inf)[0]]
+        # A lone marker's candidates are its own fit's.
+        alone = [cands for d, cands in own if len(mine) == 1 and d is mine[0]]
+        cands = alone[0] if alone else self.candidates(mine, camera)
+        pick = self._pick(cands, prev)
         if pick is not None and len(pick.marker_ids) > 1:
             frontal = self.frontal_ids(pick.T_camera_cube, pick.marker_ids)
             if len(frontal) < len(pick.marker_ids):
@@ -178,23 +183,19 @@ class MarkerCube:
         own within the corner noise (see :data:`CHI2_2DOF_99`). A marker whose code
         still reads but whose corners are wrong (a leaf over one, an edge the
         refinement could not measure) would move the pose by centimetres."""
-        limit = self.corner_sigma * float(np.sqrt(CHI2_2DOF_99 / 4.0))
-        return [d for d, rms in self._own_fits(detections, camera) if rms <= limit]
+        return self._consistent_of(self._own_fits(detections, camera))
 
-    def _least_bent(self, detections: list[Detection], camera: CameraModel) -> list[Detection]:
-        """The cube's marker among ``detections`` whose corners come nearest a pose of
-        their own ([] when none is seen): one marker's error, not the mix of several."""
-        fits = self._own_fits(detections, camera)
-        return [min(fits, key=lambda f: f[1])[0]] if fits else []
+    def _consistent_of(self, own: list[tuple[Detection, list[CubePose]]]) -> list[Detection]:
+        limit = self.corner_sigma * float(np.sqrt(CHI2_2DOF_99 / 4.0))
+        return [d for d, cands in own if cands and cands[0].rms <= limit]
 
     def _own_fits(
         self, detections: list[Detection], camera: CameraModel
-    ) -> list[tuple[Detection, float]]:
-        """Each of the cube's markers among ``detections`` with the RMS (px) of the best
-        pose its four corners give alone."""
+    ) -> list[tuple[Detection, list[CubePose]]]:
+        """Each of the cube's markers among ``detections`` with the candidates of its
+        four corners alone, best first."""
         mine = [d for d in detections if d.marker_id in self.markers]
-        return [(d, min((c.rms for c in self.candidates([d], camera)), default=np.inf))
-                for d in mine]  # fmt: skip
+        return [(d, self.candidates([d], camera)) for d in mine]
 
     def view_angles(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> FloatArray:
         """Degrees between each marker ``ids``'s normal and the line of sight to its centre
