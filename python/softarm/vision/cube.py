@@ -167,10 +167,7 @@ class MarkerCube:
         trusted = bool(mine)
         if not trusted and own:  # the least bent: one marker's error, not a mix of several
             mine = [min(own, key=lambda fit: fit[1][0].rms if fit[1] else np.inf)[0]]
-        # A lone marker's candidates are its own fit's.
-        alone = [cands for d, cands in own if len(mine) == 1 and d is mine[0]]
-        cands = alone[0] if alone else self.candidates(mine, camera)
-        pick = self._pick(cands, prev)
+        pick = self._pick(self._candidates_of(mine, own, camera), prev)
         if pick is not None and len(pick.marker_ids) > 1:
             frontal = self.frontal_ids(pick.T_camera_cube, pick.marker_ids)
             if len(frontal) < len(pick.marker_ids):
@@ -188,6 +185,17 @@ class MarkerCube:
     def _consistent_of(self, own: list[tuple[Detection, list[CubePose]]]) -> list[Detection]:
         limit = self.corner_sigma * float(np.sqrt(CHI2_2DOF_99 / 4.0))
         return [d for d, cands in own if cands and cands[0].rms <= limit]
+
+    def _candidates_of(
+        self,
+        mine: list[Detection],
+        own: list[tuple[Detection, list[CubePose]]],
+        camera: CameraModel,
+    ) -> list[CubePose]:
+        """The candidates of the markers ``mine``: a lone marker's are its own fit's."""
+        if len(mine) == 1:
+            return next(cands for d, cands in own if d is mine[0])
+        return self.candidates(mine, camera)
 
     def _own_fits(
         self, detections: list[Detection], camera: CameraModel
