@@ -196,3 +196,15 @@ def test_marker_with_wrong_corners_left_out(camera: CameraModel) -> None:
     flagged = cube.estimate(both_bent, camera, truth)
     assert flagged is not None and flagged.marker_ids == (second,)
     assert not flagged.consistent and est.consistent
+
+
+def test_view_angles_of_no_markers_and_bad_inputs(cube: MarkerCube) -> None:
+    from softarm.errors import PoseError
+
+    pose = _turned_cube(1.0, 30.0)
+    assert cube.view_angles(pose, ()).shape == (0,)
+    assert cube.frontal_ids(pose, ()) == ()
+    with pytest.raises(ParameterError, match="ids"):
+        cube.view_angles(pose, (0, 7))
+    with pytest.raises(PoseError, match="T_camera_cube"):
+        cube.view_angles(np.full((4, 4), np.nan), (0,))

@@ -207,8 +207,21 @@ class MarkerCube:
 
     def view_angles(self, T_camera_cube: FloatArray, ids: tuple[int, ...]) -> FloatArray:
         """Degrees between each marker ``ids``'s normal and the line of sight to its centre
-        when the cube is at ``T_camera_cube`` (0 face-on, 90 edge-on)."""
-        poses = np.stack([T_camera_cube @ self.markers[i] for i in ids])
+        when the cube is at ``T_camera_cube`` (0 face-on, 90 edge-on); empty for no ids.
+
+        Raises:
+            PoseError: ``T_camera_cube`` is no pose.
+            ParameterError: ``ids`` names no marker of this cube.
+        """
+        T = as_pose(T_camera_cube, "T_camera_cube", tol=1e-4)
+        unknown = [i for i in ids if i not in self.markers]
+        if unknown:
+            raise ParameterError(
+                f"ids: {unknown} are no markers of this cube (it has {sorted(self.markers)})"
+            )
+        if not ids:
+            return np.zeros(0)
+        poses = np.stack([T @ self.markers[i] for i in ids])
         normals, centres = poses[:, :3, 2], poses[:, :3, 3]
         cos = -np.einsum("ij,ij->i", normals, centres) / np.linalg.norm(centres, axis=1)
         return np.asarray(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
