@@ -117,6 +117,49 @@ def test_the_disparity_of_a_thin_cane_is_its_own_not_the_backdrops(stereo: Stere
     assert np.mean(np.abs(disparity[mask] - d_bar) <= 1.0) > 0.85
 
 
+def _shaded_tube(left: np.ndarray, right: np.ndarray, x: int, disparity: int) -> np.ndarray:
+    """A 5-pixel vertical tube at column ``x`` of ``left`` and ``x - disparity`` of
+    ``right`` (rows 100-399) on a textured backdrop; its mask in ``left``."""
+    tube = (np.array([0.6, 0.9, 1.0, 0.8, 0.5])[:, None] * [40, 120, 110]).astype(np.uint8)
+    mask = np.zeros(left.shape[:2], bool)
+    left[100:400, x : x + 5] = tube
+    right[100:400, x - disparity : x - disparity + 5] = tube
+    mask[100:400, x : x + 5] = True
+    return mask
+
+
+def _textured_pair(width: int, shift: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(6)
+    noise = rng.integers(0, 255, (480, width + shift)).astype(np.uint8)
+    texture = cv2.GaussianBlur(noise, (0, 0), 1.0)
+    backdrop = np.repeat(texture[:, :, None], 3, axis=2).astype(np.uint8)
+    return backdrop[:, shift:].copy(), backdrop[:, :width].copy()
+
+
+def test_a_cane_at_the_images_left_edge_is_matched(stereo: StereoCamera) -> None:
+    # SGBM matches nothing in the first 184 columns of its input (the disparity span
+    # here): the crop is padded past the image's edge instead of failing inside OpenCV
+    # or leaving the cane unmatched.
+    rect = stereo.rectification
+    d_bar = round(rect.focal * rect.baseline / 1.4)
+    left, right = _textured_pair(640, round(rect.focal * rect.baseline / 1.5))
+    mask = _shaded_tube(left, right, 100, d_bar)
+    disparity = stereo_disparity(left, right, rect, mask, (0.6, 1.5))
+    assert np.mean(np.abs(disparity[mask] - d_bar) <= 1.0) > 0.85
+
+
+def test_an_image_narrower_than_the_disparity_span_still_matches() -> None:
+    K = np.array([[900.0, 0, 80], [0, 900.0, 240], [0, 0, 1]])
+    camera = CameraModel(K, np.zeros(5), image_size=(160, 480))
+    T_left_right = np.eye(4)
+    T_left_right[0, 3] = 0.12
+    narrow = StereoCamera(camera, camera, np.eye(4), T_left_right)
+    left, right = _textured_pair(160, 80)
+    mask = _shaded_tube(left, right, 100, 80)
+    disparity = stereo_disparity(left, right, narrow.rectification, mask, (0.6, 1.5))
+    assert np.mean(np.abs(disparity[mask] - 80) <= 1.0) > 0.85
+
+
 def test_the_map_error_of_no_fit_is_no_coverage() -> None:
     scores = cane_map_error([], [_Cane(KNOWN[0])], workspace=5.0)
     assert scores["coverage"] == 0.0 and np.isnan(scores["median_mm"])

@@ -101,7 +101,22 @@ def stereo_disparity(
     pad = 4
     y0, y1 = max(rows.min() - pad, 0), min(rows.max() + pad + 1, mask.shape[0])
     x1 = min(cols.max() + pad + 1, mask.shape[1])
-    x0 = max(cols.min() - pad - d_min - n_disp, 0)
+    # SGBM leaves the first minDisparity + numDisparities columns of its input
+    # unmatched, so the crop reaches that far left of the mask; past the image's edge
+    # it is padded with black, where a pixel whose match lies inside the right image
+    # still finds it (a cane near the left edge).
+    x0 = cols.min() - pad - d_min - n_disp
+    p1, p2 = smoothness
+    sgbm = cv2.StereoSGBM.create(
+        minDisparity=d_min, numDisparities=n_disp, blockSize=3, P1=p1, P2=p2,
+        uniquenessRatio=10, speckleWindowSize=100, speckleRange=2,
+    )  # fmt: skip
+    edge = max(-x0, 0)
+    grey = [_padded_grey(img[y0:y1, x0 + edge : x1], edge) for img in (left, right)]
+    raw = sgbm.compute(grey[0], grey[1]).astype(np.float32)[:, edge:] / 16.0
+    raw[raw < d_min] = np.nan
+    disparity[y0:y1, x0 + edge : x1] = raw
+    return disparity
     p1, p2 = smoothness
     sgbm = cv2.StereoSGBM.create(
         minDisparity=d_min, numDisparities=n_disp, blockSize=3, P1=p1, P2=p2,
@@ -112,3 +127,12 @@ def stereo_disparity(
     raw[raw < d_min] = np.nan
     disparity[y0:y1, x0:x1] = raw
     return disparity
+
+
+def _padded_grey(bgr: npt.NDArray[np.uint8], left_pad: int) -> npt.NDArray[np.uint8]:
+    """``bgr`` in grey with ``left_pad`` black columns before it."""
+    grey = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    return cast(
+        npt.NDArray[np.uint8],
+        cv2.copyMakeBorder(grey, 0, 0, left_pad, 0, cv2.BORDER_CONSTANT, value=0),
+    )
