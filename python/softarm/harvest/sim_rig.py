@@ -46,7 +46,6 @@ from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_map import BushMap
 from softarm.perception.bush_vision import BushVision
-from softarm.perception.stereo_registration import register_c1_stereo
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.plant import ArmPlant
@@ -54,7 +53,7 @@ from softarm.sim.render.world import world_for
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.vision import MarkerCube
 from softarm.vision.poses import invert
-from softarm.vision.two_cameras import CameraVision
+from softarm.vision.two_cameras import CameraVision, register_c1
 
 __all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "control_inputs", "default_cameras"]
 
@@ -370,14 +369,14 @@ def _bush_world(
 def _bush_scene(
     bush: Bush, plant: ArmPlant, cams: SimCameras, clock: SimClock, recorder: FrameRecorder | None
 ) -> BushScene:
-    """The rendered bush, C1 registered on its base tag with both eyes, the first C1
-    look merged into its map."""
+    """The rendered bush, C1 registered on its base tag, the first C1 look merged
+    into its map."""
     world = world_for(bush, cams, BASE_TAG_ID, c2_scale=C2_SCALE)
     scene = BushScene(world, BushMap(), bush, plant)
     if recorder is not None:
         scene.read_pair = recorder.wrap_pair(scene.pair, clock.now)
-    T_base_c1 = register_c1_stereo(
-        scene.pair, world.stereo, BASE_TAG_ID, cams.base_tag, cams.T_base_tag
+    T_base_c1 = register_c1(
+        scene.c1_whole, cams.model(1), BASE_TAG_ID, cams.base_tag, cams.T_base_tag
     )
     scene.registered(invert(T_base_c1))
     scene.look()

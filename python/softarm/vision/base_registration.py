@@ -68,14 +68,7 @@ class BaseRegistration:
         """Add this frame's observation (if any); return the averaged ``T_base_camera``."""
         obs = self.observe(image)
         if obs is not None:
-            self.add(obs)
-        return self.T_base_camera
-
-    def add(self, T_base_camera: npt.ArrayLike) -> FloatArray | None:
-        """Add a pose found otherwise (both eyes of a stereo pair:
-        :func:`softarm.perception.stereo_registration.register_c1_stereo`); return the
-        averaged ``T_base_camera``."""
-        self._history.append(as_pose(T_base_camera, "T_base_camera"))
+            self._history.append(obs)
         return self.T_base_camera
 
     @property
