@@ -22,6 +22,7 @@ from softarm.errors import ParameterError
 from softarm.vision._checks import FloatArray, as_pose, positive
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.detector import (
+    LM_CRITERIA,
     Detection,
     MarkerDetector,
     marker_object_points,
@@ -54,7 +55,6 @@ DEFAULT_MAX_VIEW_ANGLE_DEG = 60.0
 #: A printed tag's square (its quiet zone around the marker) is this many times the
 #: marker's side: the paper's 80 mm tags on the cube's 100 mm faces.
 FACE_PER_MARKER = 1.25
-_LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
 
 
 @dataclass(frozen=True)
@@ -277,7 +277,7 @@ class MarkerCube:
         """Levenberg–Marquardt over all matched corners from ``start``; (pose, RMS px)."""
         rvec0, tvec0 = rvec_tvec_from_pose(start)
         rvec, tvec = cv2.solvePnPRefineLM(
-            obj, img, camera.matrix, camera.distortion, rvec0, tvec0, _LM_CRITERIA
+            obj, img, camera.matrix, camera.distortion, rvec0, tvec0, LM_CRITERIA
         )
         proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
         rms = float(np.sqrt(np.mean(np.sum((proj.reshape(-1, 2) - img) ** 2, axis=1))))

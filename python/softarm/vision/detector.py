@@ -2,7 +2,8 @@
 
 OpenCV 5 has no ``estimatePoseSingleMarkers``: the pose of one square marker is solved
 here with ``solvePnPGeneric`` and ``SOLVEPNP_IPPE_SQUARE``, which returns both solutions of
-the planar ambiguity with their reprojection errors, so callers can disambiguate.
+the planar ambiguity, each refined by Levenberg–Marquardt and returned with its
+reprojection error, so callers can disambiguate.
 
 Marker frame (OpenCV ArUco convention): origin at the marker centre, x to the right, y up,
 z out of the printed face; corners in detection order are top-left (-L/2, L/2, 0),
@@ -32,6 +33,8 @@ from softarm.vision.refine import READ_MARGIN, refine_marker_corners
 
 # A best IPPE solution worse than this (px RMS) triggers the SQPNP fallback.
 FALLBACK_RMS_PX = 1.0
+#: Levenberg–Marquardt's stop for the pose refinements (iterations, step).
+LM_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-10)
 
 
 def marker_object_points(marker_length: float) -> FloatArray:
@@ -249,13 +252,26 @@ def square_marker_poses(
 
 
 def _ippe(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[MarkerPose]:
-    n, rvecs, tvecs, errs = cv2.solvePnPGeneric(
+    """Both IPPE-square solutions, each refined to the least reprojection error. IPPE
+    is exact for exact corners in a pinhole camera but is no least-squares fit: on a
+    rendered base tag 0.77 m away its corners 0.004 px from the truth, IPPE gave 0.022 px
+    RMS and a tilt 0.74° off, the refined pose 0.002 px and 0.075°."""
+    n, rvecs, tvecs, _ = cv2.solvePnPGeneric(
         obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_IPPE_SQUARE
     )
-    return [
-        MarkerPose(pose_from_rvec_tvec(rvecs[k], tvecs[k]), float(np.ravel(errs)[k]))
-        for k in range(int(n))
-    ]
+    return [_refined(obj, img, camera, rvecs[k], tvecs[k]) for k in range(int(n))]
+
+
+def _refined(
+    obj: FloatArray, img: FloatArray, camera: CameraModel, rvec: Any, tvec: Any
+) -> MarkerPose:
+    """Levenberg–Marquardt from (``rvec``, ``tvec``); the pose and its RMS (px)."""
+    rvec, tvec = cv2.solvePnPRefineLM(
+        obj, img, camera.matrix, camera.distortion, rvec, tvec, LM_CRITERIA
+    )
+    proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
+    rms = float(np.sqrt(np.mean(np.sum((proj - img).reshape(-1, 2) ** 2, axis=1))))
+    return MarkerPose(pose_from_rvec_tvec(rvec, tvec), rms)
 
 
 def _sqpnp(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[MarkerPose]:
