@@ -263,7 +263,10 @@ class MarkerCube:
         used = tuple(int(i) for i in ids)
         out = []
         for det in mine:
-            for sol in square_marker_poses(det.corners, camera, self.marker_length):
+            # IPPE's two solutions seed the joint fit unrefined (refined alone they can
+            # fall into one, and the joint fit needs both).
+            seeds = square_marker_poses(det.corners, camera, self.marker_length, refine=False)
+            for sol in seeds:
                 start = sol.T_camera_marker @ invert(self.markers[det.marker_id])
                 pose, rms = self._refine(start, obj, img, camera)
                 out.append(CubePose(pose, rms, used))

@@ -233,16 +233,19 @@ def marker_corners(corners: npt.ArrayLike, name: str = "corners") -> FloatArray:
 
 
 def square_marker_poses(
-    corners: npt.ArrayLike, camera: CameraModel, marker_length: float
+    corners: npt.ArrayLike, camera: CameraModel, marker_length: float, refine: bool = True
 ) -> list[MarkerPose]:
-    """Both IPPE-square solutions for one marker, best (lowest RMS reprojection) first.
-    Corners that are not a marker's (:func:`marker_corners`) and a camera model OpenCV
-    cannot solve with are a typed error; a non-finite solution is left out."""
+    """Both IPPE-square solutions for one marker, best (lowest RMS reprojection) first,
+    each refined to the least reprojection error unless ``refine`` is False (a caller
+    that refines over more corners itself, as :class:`~softarm.vision.cube.MarkerCube`
+    does, takes IPPE's two as its seeds: refined alone they can fall into one). Corners
+    that are not a marker's (:func:`marker_corners`) and a camera model OpenCV cannot
+    solve with are a typed error; a non-finite solution is left out."""
     length = positive(marker_length, "marker_length")
     img = marker_corners(corners).reshape(4, 1, 2)
     obj = marker_object_points(length).reshape(4, 1, 3)
     with opencv_errors("marker pose: corners or camera model"):
-        out = _ippe(obj, img, camera)
+        out = _ippe(obj, img, camera, refine)
         if not out or min(p.rms for p in out) > FALLBACK_RMS_PX:
             # IPPE degenerates for an exactly fronto-parallel square (it returns the pose
             # turned 180° about the normal); SQPNP has no such case.
@@ -251,15 +254,21 @@ def square_marker_poses(
     return sorted(finite, key=lambda p: p.rms)
 
 
-def _ippe(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[MarkerPose]:
-    """Both IPPE-square solutions, each refined to the least reprojection error. IPPE
-    is exact for exact corners in a pinhole camera but is no least-squares fit: on a
-    rendered base tag 0.77 m away its corners 0.004 px from the truth, IPPE gave 0.022 px
-    RMS and a tilt 0.74° off, the refined pose 0.002 px and 0.075°."""
-    n, rvecs, tvecs, _ = cv2.solvePnPGeneric(
+def _ippe(obj: FloatArray, img: FloatArray, camera: CameraModel, refine: bool) -> list[MarkerPose]:
+    """Both IPPE-square solutions, with ``refine`` each refined to the least
+    reprojection error. IPPE is exact for exact corners in a pinhole camera but is no
+    least-squares fit: on a rendered base tag 0.77 m away its corners 0.004 px from the
+    truth, IPPE gave 0.022 px RMS and a tilt 0.74° off, the refined pose 0.002 px and
+    0.075°."""
+    n, rvecs, tvecs, errs = cv2.solvePnPGeneric(
         obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_IPPE_SQUARE
     )
-    return [_refined(obj, img, camera, rvecs[k], tvecs[k]) for k in range(int(n))]
+    if refine:
+        return [_refined(obj, img, camera, rvecs[k], tvecs[k]) for k in range(int(n))]
+    return [
+        MarkerPose(pose_from_rvec_tvec(rvecs[k], tvecs[k]), float(np.ravel(errs)[k]))
+        for k in range(int(n))
+    ]
 
 
 def _refined(
