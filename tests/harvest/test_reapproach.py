@@ -181,6 +181,22 @@ def test_no_axis_left_to_try_is_unreachable() -> None:
     assert rig.vented()
 
 
+def test_no_other_axis_after_a_graspable_stall_comes_back_to_it() -> None:
+    # The square axis ends 4 mm short in fine positioning (inside the gripper's 1 cm) and
+    # the cone holds no other axis: the arm comes back along the square plan and grasps
+    # where it ends, as after a last stall (this berry was UNREACHABLE before; traced on
+    # bush 823 of the rendered world).
+    rig, planner = _rig([SQUARE], only_at=BERRIES[1], short=0.004)
+    planner.axes = [SQUARE]
+    result = rig.machine.run_berry(BerryTarget(1))
+    assert result.harvested and result.fault is None
+    assert np.allclose(rig.machine.axis, SQUARE) and len(planner.avoided) == 2
+    assert 2.0 < result.position_error_mm <= 5.0
+    back = next(r for r in rig.machine.log.records if r["kind"] == "no_other_axis")
+    assert 3.0 < back["back_to_mm"] <= 5.0
+    assert rig.transitions(1).count(S.INITIAL_PLACEMENT) == 2
+
+
 def test_a_last_axis_that_ends_farther_out_comes_back_to_the_nearest_attempt() -> None:
     # Square stalls 4 mm short in fine positioning, the tilted axis 8 mm: both inside the
     # gripper's 1 cm. The arm comes back along the square plan (no new plan) and grasps.

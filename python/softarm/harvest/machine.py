@@ -192,7 +192,8 @@ class HarvestMachine:
         plans again along another axis of the cone, up to ``reapproaches`` times. The
         last new axis grasps only if it ends no farther from the berry than the nearest
         earlier stall inside the gripper's reach; else the arm comes back to that one's
-        plan and grasps where it ends. A last stall, or a time-out, also backs out
+        plan and grasps where it ends, as it does when a re-approach finds no other axis
+        in the cone. A last stall, or a time-out, also backs out
         before the fault: vented in the bush, the arm would relax to its rest shape
         through the canes."""
         c = self.config
@@ -200,12 +201,7 @@ class HarvestMachine:
         nearest: _Attempt | None = None  # the fine-positioning stall nearest the berry
         back_to: _Attempt | None = None  # coming back to it
         while True:
-            waypoints: tuple[FloatArray, ...] = ()
-            self.axis = c.approach_axis
-            if back_to is not None:
-                waypoints, self.axis = back_to.waypoints, back_to.axis
-            elif self.planner is not None:
-                waypoints, self.axis = self.servo.plan(watch, self.q, self.planner, tried)
+            waypoints, self.axis, back_to = self._next_plan(watch, tried, nearest, back_to)
             more = back_to is None and self.planner is not None and len(tried) < c.reapproaches
             if more:
                 grasp_within = c.stall_progress  # the stall rule's resolution: try another
@@ -252,6 +248,33 @@ class HarvestMachine:
                     if back_to is None
                     else f"back to the axis that ended {1e3 * back_to.grasp_error:.1f} mm off",
                 )
+
+    def _next_plan(
+        self,
+        watch: BerryWatch,
+        tried: list[FloatArray],
+        nearest: _Attempt | None,
+        back_to: _Attempt | None,
+    ) -> tuple[tuple[FloatArray, ...], FloatArray, _Attempt | None]:
+        """The next attempt's waypoints and axis, and the earlier attempt it comes back
+        to (None for a new plan): ``back_to``'s plan; else a new plan along an axis not
+        ``tried``; when a re-approach finds none, the ``nearest`` earlier attempt inside
+        the gripper's reach, come back to as after a last stall (without it the berry is
+        UNREACHABLE); without a planner, the configured axis."""
+        if back_to is not None:
+            return back_to.waypoints, back_to.axis, back_to
+        if self.planner is None:
+            return (), self.config.approach_axis, None
+        try:
+            waypoints, axis = self.servo.plan(watch, self.q, self.planner, tried)
+        except Fault as fault:
+            if not tried or nearest is None or fault.reason is not FaultReason.UNREACHABLE:
+                raise
+            self.log.event(
+                "no_other_axis", t=self.clock.now(), back_to_mm=1e3 * nearest.grasp_error
+            )
+            return nearest.waypoints, nearest.axis, nearest
+        return waypoints, axis, None
 
     def _finish(self, result: BerryResult, watch: BerryWatch, start: float) -> BerryResult:
         """Record what the stages observed, the final state and the time into ``result``."""
