@@ -297,7 +297,7 @@ def _sqpnp(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[Marker
 def estimate_marker_poses(
     detections: list[Detection], camera: CameraModel, marker_length: float
 ) -> dict[int, FloatArray]:
-    """``{id: T_camera_marker}`` for each detection (the lower-error IPPE solution)."""
+    """``{id: T_camera_marker}`` for each detection (the lower-error refined IPPE solution)."""
     out: dict[int, FloatArray] = {}
     for det in detections:
         sols = square_marker_poses(det.corners, camera, marker_length)
