@@ -117,16 +117,6 @@ def stereo_disparity(
     raw[raw < d_min] = np.nan
     disparity[y0:y1, x0 + edge : x1] = raw
     return disparity
-    p1, p2 = smoothness
-    sgbm = cv2.StereoSGBM.create(
-        minDisparity=d_min, numDisparities=n_disp, blockSize=3, P1=p1, P2=p2,
-        uniquenessRatio=10, speckleWindowSize=100, speckleRange=2,
-    )  # fmt: skip
-    grey = [cv2.cvtColor(img[y0:y1, x0:x1], cv2.COLOR_BGR2GRAY) for img in (left, right)]
-    raw = sgbm.compute(grey[0], grey[1]).astype(np.float32) / 16.0
-    raw[raw < d_min] = np.nan
-    disparity[y0:y1, x0:x1] = raw
-    return disparity
 
 
 def _padded_grey(bgr: npt.NDArray[np.uint8], left_pad: int) -> npt.NDArray[np.uint8]:
