@@ -22,16 +22,15 @@ from softarm.errors import ParameterError
 from softarm.vision._checks import FloatArray, as_pose, positive
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.detector import (
-    LM_CRITERIA,
     Detection,
     MarkerDetector,
     marker_object_points,
+    refined_pose,
     square_marker_poses,
 )
 from softarm.vision.dictionaries import check_marker_id
 from softarm.vision.poses import (
     invert,
-    pose_from_rvec_tvec,
     rotation_angle,
     rvec_tvec_from_pose,
     transform_points,
@@ -278,13 +277,8 @@ class MarkerCube:
         start: FloatArray, obj: FloatArray, img: FloatArray, camera: CameraModel
     ) -> tuple[FloatArray, float]:
         """Levenberg–Marquardt over all matched corners from ``start``; (pose, RMS px)."""
-        rvec0, tvec0 = rvec_tvec_from_pose(start)
-        rvec, tvec = cv2.solvePnPRefineLM(
-            obj, img, camera.matrix, camera.distortion, rvec0, tvec0, LM_CRITERIA
-        )
-        proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
-        rms = float(np.sqrt(np.mean(np.sum((proj.reshape(-1, 2) - img) ** 2, axis=1))))
-        return pose_from_rvec_tvec(rvec, tvec), rms
+        fit = refined_pose(*rvec_tvec_from_pose(start), obj, img, camera)
+        return fit.T_camera_marker, fit.rms
 
 
 class CubeTracker:

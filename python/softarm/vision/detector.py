@@ -264,23 +264,32 @@ def _ippe(obj: FloatArray, img: FloatArray, camera: CameraModel, refine: bool) -
         obj, img, camera.matrix, camera.distortion, flags=cv2.SOLVEPNP_IPPE_SQUARE
     )
     if refine:
-        return [_refined(obj, img, camera, rvecs[k], tvecs[k]) for k in range(int(n))]
+        return [
+            refined_pose(_f64(rvecs[k]), _f64(tvecs[k]), obj, img, camera) for k in range(int(n))
+        ]
     return [
         MarkerPose(pose_from_rvec_tvec(rvecs[k], tvecs[k]), float(np.ravel(errs)[k]))
         for k in range(int(n))
     ]
 
 
-def _refined(
-    obj: FloatArray, img: FloatArray, camera: CameraModel, rvec: Any, tvec: Any
+def _f64(a: Any) -> FloatArray:
+    return np.asarray(a, dtype=np.float64)
+
+
+def refined_pose(
+    rvec: FloatArray, tvec: FloatArray, obj: FloatArray, img: FloatArray, camera: CameraModel
 ) -> MarkerPose:
-    """Levenberg–Marquardt from (``rvec``, ``tvec``); the pose and its RMS (px)."""
-    rvec, tvec = cv2.solvePnPRefineLM(
-        obj, img, camera.matrix, camera.distortion, rvec, tvec, LM_CRITERIA
+    """The pose of object points ``obj`` (N, 3) seen at ``img`` (N, 2) pixels refined by
+    Levenberg–Marquardt from (``rvec``, ``tvec``), OpenCV's, with its RMS reprojection
+    error (px)."""
+    points, pixels = obj.reshape(-1, 3), img.reshape(-1, 2)
+    r, t = cv2.solvePnPRefineLM(
+        points, pixels, camera.matrix, camera.distortion, rvec, tvec, LM_CRITERIA
     )
-    proj, _ = cv2.projectPoints(obj, rvec, tvec, camera.matrix, camera.distortion)
-    rms = float(np.sqrt(np.mean(np.sum((proj - img).reshape(-1, 2) ** 2, axis=1))))
-    return MarkerPose(pose_from_rvec_tvec(rvec, tvec), rms)
+    proj, _ = cv2.projectPoints(points, r, t, camera.matrix, camera.distortion)
+    rms = float(np.sqrt(np.mean(np.sum((proj.reshape(-1, 2) - pixels) ** 2, axis=1))))
+    return MarkerPose(pose_from_rvec_tvec(r, t), rms)
 
 
 def _sqpnp(obj: FloatArray, img: FloatArray, camera: CameraModel) -> list[MarkerPose]:
