@@ -33,10 +33,10 @@ def _stereo(path: Path) -> None:
 
 
 def test_the_template_section_uncommented_parses() -> None:
-    text = re.sub(r"(?m)^# (\[perception\]|stereo =|device =|calibration =|berries =)",
+    text = re.sub(r"(?m)^# (\[perception\]|stereo =|device =|calibration =|berries =|survey =)",
                   r"\1", _ready())  # fmt: skip
     p = parse_config(text, folder="/rig").perception
-    assert p is not None and p.stereo == "zed2" and p.devices() == (0,)
+    assert p is not None and p.stereo == "zed2" and p.devices() == (0,) and not p.survey
     assert p.calibration_path == str(Path("/rig") / "stereo.yml")
 
 
@@ -44,6 +44,13 @@ def test_a_pair_resolves_its_files_and_round_trips() -> None:
     cfg = parse_config(_ready('stereo = "pair"\nleft = "l.mp4"\nright = 2\n'), folder="/rig")
     assert cfg.perception is not None
     assert cfg.perception.devices() == (str(Path("/rig") / "l.mp4"), 2)
+    assert not cfg.perception.survey  # C1's canes alone unless asked
+    assert parse_config(dump_config(cfg), folder="/rig") == cfg
+
+
+def test_the_survey_can_be_turned_on_and_round_trips() -> None:
+    cfg = parse_config(_ready("survey = true\n"), folder="/rig")
+    assert cfg.perception is not None and cfg.perception.survey is True
     assert parse_config(dump_config(cfg), folder="/rig") == cfg
 
 
@@ -54,6 +61,7 @@ def test_a_pair_resolves_its_files_and_round_trips() -> None:
         ('stereo = "zed2"\nleft = 1', "perception.left"),
         ('stereo = "pair"\nleft = 0', "perception.right"),
         ('berries = "paint"', "perception.berries"),
+        ('survey = "yes"', "perception.survey"),
         ("device = true", "perception.device"),
         ("calibration = 3", "perception.calibration"),
         ("lens = 1", "perception.lens"),

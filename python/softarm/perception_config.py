@@ -5,7 +5,9 @@ they are calibrated, for the markerless harvest on the hardware (docs/hardware.m
 path; the ZED2 without its SDK), split into its halves; ``stereo = "pair"`` is two
 OpenCV devices (``left``, ``right``). ``calibration`` is a ``stereo.yml`` written by
 ``softarm camera calibrate`` (resolved against the config file's folder); ``berries``
-is ``"markerless"`` (found by perception, the default) or ``"tags"`` (ArUco tags).
+is ``"markerless"`` (found by perception, the default) or ``"tags"`` (ArUco tags);
+``survey`` (false by default) takes C2 to pairs of views of the bush before the first
+berry, to complete the canes C1 fits (:mod:`softarm.harvest.cane_survey`).
 """
 
 from __future__ import annotations
@@ -34,8 +36,8 @@ BERRY_MODES = ("markerless", "tags")
 
 @dataclass(frozen=True)
 class PerceptionConfig:
-    """``[perception]``: the stereo source, its calibration file and the berry mode;
-    ``folder`` is the config file's, which paths resolve against."""
+    """``[perception]``: the stereo source, its calibration file, the berry mode and
+    whether C2 surveys the canes; ``folder`` is the config file's, which paths resolve against."""
 
     stereo: str = "zed2"
     calibration: str = "stereo.yml"
@@ -43,6 +45,7 @@ class PerceptionConfig:
     left: int | str | None = None
     right: int | str | None = None
     berries: str = "markerless"
+    survey: bool = False
     folder: str | None = field(default=None, compare=False, repr=False)
 
     @property
@@ -82,7 +85,12 @@ def parse_perception(t: _Table) -> PerceptionConfig | None:
             raise t.error(name, f"is not a key of stereo = {stereo!r} (it takes {wanted})")
     sources = {name: _source(t, name, 0 if name == "device" else None) for name in wanted}
     berries = _choice(t, "berries", BERRY_MODES, "markerless")
-    config = PerceptionConfig(stereo, calibration, berries=berries, folder=t.folder, **sources)
+    survey = t.get("survey", False)
+    if not isinstance(survey, bool):
+        raise t.error("survey", "must be true or false")
+    config = PerceptionConfig(
+        stereo, calibration, berries=berries, survey=survey, folder=t.folder, **sources
+    )
     t.done()
     return config
 

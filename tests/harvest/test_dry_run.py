@@ -25,7 +25,17 @@ SEED = 902
 def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     pytest.importorskip("mujoco")
     folder = tmp_path_factory.mktemp("dry") / "rec"
-    args = ["harvest", "--sim", "--world", "bush", "--berries", "3", "--seed", str(SEED)]
+    args = [
+        "harvest",
+        "--sim",
+        "--world",
+        "bush",
+        "--survey",
+        "--berries",
+        "3",
+        "--seed",
+        str(SEED),
+    ]
     status = main([*args, "--record-frames", str(folder), "-q"])
     if not (folder / INDEX).is_file():
         pytest.skip("the rendered bush is unavailable here (EGL)")
@@ -60,6 +70,9 @@ def test_the_hardware_path_sends_the_recorded_commands(recording: Path, tmp_path
     first = maps[0]  # the map after each look: what perception found
     assert first["berries"] and {"id", "position", "radius_m", "ripe"} <= set(first["berries"][0])
     assert all(len(c["coeffs"]) == 3 for c in first["canes"])
+    # The hardware path flew the survey the simulator recorded, and refit the canes.
+    done = [r for r in records if r["kind"] == "survey_done"]
+    assert len(done) == 1 and done[0]["used"] >= 1
 
 
 def test_a_different_ripeness_reading_is_not_the_recording(recording: Path, tmp_path: Path) -> None:

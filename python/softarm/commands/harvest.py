@@ -104,6 +104,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "bush, berries and canes found by the cameras (render extra, MUJOCO_GL=egl); "
         "--berries counts ripe and unripe together, 30%% unripe",
     )  # fmt: skip
+    p.add_argument(
+        "--survey", action="store_true",
+        help="--world bush: before the first berry, take C2 to two pairs of views of the "
+        "bush and fit the canes with them (more of the canes mapped, more berries refused "
+        "near phantom canes: docs/perception.md)",
+    )  # fmt: skip
     add_plant_options(p)
     add_dry_run_options(p)
     p.add_argument(
@@ -139,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
     if args.sim:
         args.seed = 0 if args.seed is None else args.seed
         if args.world == "bush":
-            options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
+            options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION, survey=args.survey)
             options.update(record_frames=args.record_frames)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,

@@ -8,7 +8,8 @@ per berry beside the tag world's on the same seeds when its reports and times ar
 ``--run FIRST LAST BUSH_DIR TAG_DIR`` makes those folders first: for each seed, the
 bush world's harvest and then the tag world's on the same seed (so the two share the
 machine's load), each timed as a whole process, their reports and ``wall_times.txt``
-written (``--berries``, 8 by default)::
+written (``--berries``, 8 by default; ``--survey``: the bush world with C2's cane
+survey)::
 
     MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 770 779 \
         docs/data/perception/bush_harvest_770-779 docs/data/perception/tag_harvest_770-779
@@ -69,14 +70,17 @@ def _reports(folder: Path) -> list[dict[str, Any]]:
     return [json.loads(p.read_text()) for p in sorted(folder.glob("r*.json"))]
 
 
-def run_pair(seeds: range, bush_dir: Path, tag_dir: Path, berries: int = 8) -> None:
-    """Harvest each seed in the bush world, then in the tag world, timing each whole
-    process (``python -m softarm harvest --sim ...``); reports and wall times into the
-    two folders."""
+def run_pair(
+    seeds: range, bush_dir: Path, tag_dir: Path, berries: int = 8, survey: bool = False
+) -> None:
+    """Harvest each seed in the bush world (with C2's cane survey when ``survey``),
+    then in the tag world, timing each whole process (``python -m softarm
+    harvest --sim ...``); reports and wall times into the two folders."""
     for folder in (bush_dir, tag_dir):
         folder.mkdir(parents=True, exist_ok=True)
     for seed in seeds:
-        for folder, world in ((bush_dir, ["--world", "bush"]), (tag_dir, [])):
+        bush = ["--world", "bush"] + (["--survey"] if survey else [])
+        for folder, world in ((bush_dir, bush), (tag_dir, [])):
             report = folder / f"r{seed}.json"
             command = [sys.executable, "-m", "softarm", "harvest", "--sim", *world,
                        "--berries", str(berries), "--seed", str(seed),
@@ -94,7 +98,8 @@ def main(argv: list[str]) -> None:
     if argv[:1] == ["--run"]:
         berries = int(argv[argv.index("--berries") + 1]) if "--berries" in argv else 8
         first, last, bush_dir, tag_dir = argv[1:5]
-        run_pair(range(int(first), int(last) + 1), Path(bush_dir), Path(tag_dir), berries)
+        seeds = range(int(first), int(last) + 1)
+        run_pair(seeds, Path(bush_dir), Path(tag_dir), berries, "--survey" in argv)
         argv = [bush_dir, tag_dir]
     for name in argv:
         folder = Path(name)

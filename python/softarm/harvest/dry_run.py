@@ -124,6 +124,8 @@ class RigDescription:
     T_ee_cube: FloatArray
     berry_tag: float
     T_base_tag: FloatArray
+    #: Whether the rig surveyed the canes with C2 (``[perception] survey``).
+    survey: bool = False
 
     @property
     def stereo(self) -> StereoCamera:
@@ -158,7 +160,7 @@ class RigDescription:
             calibration,
             plant_model=_plant_model(self.plant),
             harvest=self.harvest,
-            perception=PerceptionConfig("pair", "stereo.yml", left=0, right=2),
+            perception=PerceptionConfig("pair", "stereo.yml", left=0, right=2, survey=self.survey),
         )
 
 

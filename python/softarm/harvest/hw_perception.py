@@ -5,17 +5,19 @@ the rig's own parts as in simulation (:mod:`softarm.harvest.rig_parts`)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from softarm._core import PolynomialCurve
 from softarm.checks import FloatArray
-from softarm.errors import ConfigError, HardwareUnavailableError
+from softarm.errors import ConfigError, HardwareUnavailableError, VisionError
 from softarm.harvest.rig_parts import a_cane
 from softarm.perception.bush_map import BushMap
-from softarm.perception.canes import fit_canes
+from softarm.perception.canes import CaneFit, cane_points, fit_cane_points
 from softarm.perception.sight_lines import sight_lines
 from softarm.perception.stereo import locate_berries
 from softarm.perception.stereo_camera import StereoCamera
@@ -90,9 +92,28 @@ class StereoC1:
 
     def fit_canes(self, parts: FloatArray, reach: float) -> list[PolynomialCurve]:
         """The canes of one stereo view, the rig's own ``parts`` and what lies beyond
-        ``reach`` left out (as in the rendered bush); the map keeps them."""
+        ``reach`` left out (as in the rendered bush); the map keeps them and the
+        view's cane points."""
         left, right = self.pair()
-        fits = fit_canes(left, right, self.stereo)
+        self.bush_map.cane_points = cane_points(left, right, self.stereo)
+        return self._keep(fit_cane_points(self.bush_map.cane_points), parts, reach)
+
+    def refit_canes(
+        self, parts: FloatArray, reach: float, more: Sequence[FloatArray]
+    ) -> list[PolynomialCurve]:
+        """The canes of the map's last view fitted again together with the cane points
+        ``more`` of other views (the survey's, :mod:`softarm.harvest.cane_survey`),
+        filtered as :meth:`fit_canes` does; the map keeps them.
+
+        Raises:
+            VisionError: the map has no C1 cane points (no :meth:`fit_canes` before).
+        """
+        if self.bush_map.cane_points is None:
+            raise VisionError("refit_canes: the map has no C1 cane points (fit_canes first)")
+        points = np.vstack([self.bush_map.cane_points, *more])
+        return self._keep(fit_cane_points(points), parts, reach)
+
+    def _keep(self, fits: list[CaneFit], parts: FloatArray, reach: float) -> list[PolynomialCurve]:
         self.bush_map.canes = [f for f in fits if a_cane(f.points[:, :3], parts, reach)]
         return [c.curve for c in self.bush_map.canes]
 

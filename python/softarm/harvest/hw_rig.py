@@ -16,6 +16,7 @@ import numpy as np
 
 from softarm._core import PolynomialCurve, Section, SoftArm
 from softarm.calibration.result import Calibration
+from softarm.checks import FloatArray
 from softarm.config import Config
 from softarm.errors import ConfigError
 from softarm.hardware.arduino_devices import ArduinoGripper, ArduinoRipenessSensor
@@ -24,6 +25,7 @@ from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.protocols import PressureBank
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.actuator import PressureMap
+from softarm.harvest.cane_survey import CaneSurvey
 from softarm.harvest.hw_devices import DeviceDrivers, Devices
 from softarm.harvest.hw_perception import StereoC1, stereo_camera
 from softarm.harvest.interfaces import BerryTarget, Clock
@@ -55,6 +57,9 @@ class HardwareRig:
     c1: StereoC1 | None = None
     #: The berries come from the map (``berries = "markerless"``), not from tags.
     markerless: bool = False
+    #: C2's survey of the canes C1 fitted, flown at the start of :meth:`run`; None
+    #: without perceived canes or with ``survey = false``.
+    survey: CaneSurvey | None = None
 
     def close(self) -> None:
         """Vent the arm and release every device."""
@@ -63,7 +68,10 @@ class HardwareRig:
     def run(self, berries: int) -> HarvestReport:
         """Harvest ``berries``: the tags 10, 11, ... stuck to them (section IV-E), or
         with markerless perception at most that many of the map's ripe berries, by the
-        loop the rendered bush runs (:func:`~softarm.harvest.map_harvest.harvest_map`)."""
+        loop the rendered bush runs (:func:`~softarm.harvest.map_harvest.harvest_map`);
+        the survey first, where there is one."""
+        if self.survey is not None:
+            self.survey.run()
         if not self.markerless or self.c1 is None:
             return self.machine.run([BerryTarget(10 + i) for i in range(berries)])
         report = HarvestReport()
@@ -115,8 +123,10 @@ def build_hardware_rig(
         bank = _pressure_bank(config, dev.pressure_outputs(config, stack), clock, stack)
         link = dev.arduino(config, stack)
         c1 = _stereo_c1(config, dev, stack)
+        parts = None
         if c1 is not None and not canes:
-            canes = _perceived_canes(c1, config, cfg, inputs.model)
+            parts = _rig_parts(config, cfg, inputs.model)
+            canes = c1.fit_canes(parts, CANE_REACH)
         vision = _vision(config, cfg, dev, stack, c1)
         control = build_control_stack(cfg, inputs, canes, bank, clock.now)
         machine = HarvestMachine(
@@ -125,7 +135,11 @@ def build_hardware_rig(
             planner=control.planner,
         )  # fmt: skip
         markerless = isinstance(vision, BushVision)
-        return HardwareRig(machine, stack.pop_all(), c1, markerless)
+        survey = None
+        if c1 is not None and parts is not None and config.perception is not None:
+            if config.perception.survey:
+                survey = CaneSurvey(machine, control, c1, vision, parts, CANE_REACH)
+        return HardwareRig(machine, stack.pop_all(), c1, markerless, survey)
     raise AssertionError("unreachable")  # pragma: no cover  (the with block returns)
 
 
@@ -175,15 +189,12 @@ def _stereo_c1(config: Config, devices: Devices, stack: ExitStack) -> StereoC1 |
     return c1
 
 
-def _perceived_canes(
-    c1: StereoC1, config: Config, cfg: HarvestConfig, model: SoftArm
-) -> list[PolynomialCurve]:
-    """The canes fitted from C1's stereo, the arm, its cube and (where the config
-    places it) the base tag left out as the rig's own."""
+def _rig_parts(config: Config, cfg: HarvestConfig, model: SoftArm) -> FloatArray:
+    """What C1 sees of the rig itself, left out of the canes it fits: the arm, its
+    cube and (where the config places it) the base tag."""
     cal = config.calibration
     tag = None if cal.T_base_tag is None else np.array(cal.T_base_tag)
-    parts = rig_parts(model, cfg, np.array(cal.T_EE_cube), tag)
-    return c1.fit_canes(parts, CANE_REACH)
+    return rig_parts(model, cfg, np.array(cal.T_EE_cube), tag)
 
 
 def _vision(

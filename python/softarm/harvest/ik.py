@@ -149,7 +149,7 @@ class ModelIK:
                 continue  # the true arm differs by a few %: grasp away from the limits
             if room > self.limit_room and self._room(q_pre) < self.limit_room:
                 continue
-            if not self._clear(q_pre, q_grasp[0], 5, self.margin):
+            if not self.clear(q_pre, q_grasp[0], 5, self.margin):
                 continue
             if via == DETOUR:
                 q_mid = self._detour(q, q_pre, ramp)
@@ -157,12 +157,12 @@ class ModelIK:
                     return [q_mid, q_pre]
                 continue
             if via is None:
-                if self._clear(q, q_pre, 12, ramp):
+                if self.clear(q, q_pre, 12, ramp):
                     return [q_pre]
                 continue
             back = approach_pose(current, berry, axis, c.grasp_offset + c.standoff + via)
             for q_via in self.solve(q_pre, back, sample=False) + self.solve(q, back):
-                if self._clear(q, q_via, 12, ramp) and self._clear(q_via, q_pre, 6, ramp):
+                if self.clear(q, q_via, 12, ramp) and self.clear(q_via, q_pre, 6, ramp):
                     return [q_via, q_pre]
         return None
 
@@ -183,7 +183,7 @@ class ModelIK:
             if self.clearance.gap(q_mid) < ramp:
                 continue
             tried += 1
-            if self._clear(q, q_mid, 12, ramp) and self._clear(q_mid, q_pre, 12, ramp):
+            if self.clear(q, q_mid, 12, ramp) and self.clear(q_mid, q_pre, 12, ramp):
                 return np.asarray(q_mid, dtype=np.float64)
             if tried >= DETOUR_CHECKS:
                 break
@@ -193,7 +193,7 @@ class ModelIK:
         """Distance (m) of ``q`` to the nearest joint limit."""
         return float(min(np.min(q - self.arm.lower), np.min(self.arm.upper - q)))
 
-    def _clear(
+    def clear(
         self, q0: FloatArray, q1: FloatArray, steps: int = 12, margin: float | None = None
     ) -> bool:
         """Whether the model arm keeps ``margin`` (default: the open-loop ``ramp_margin``)

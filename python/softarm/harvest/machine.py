@@ -25,8 +25,9 @@ not relax the arm through the canes; after a stall it re-approaches along anothe
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -50,12 +51,20 @@ from softarm.harvest.outcome import Fault
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.servo import Servo
 from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+from softarm.harvest.survey import SurveyPlan
 from softarm.harvest_config import HarvestConfig
 from softarm.perception.bush_map import BushMap
 
 __all__ = ["HarvestMachine"]
 
 S = HarvestState
+
+#: The survey's steps and transitions are logged under this target (no berry's id).
+SURVEY = BerryTarget(-1)
+#: A view of C2 (:meth:`softarm.vision.two_cameras.CameraVision.view_c2`): its image
+#: and its pose in the base frame.
+View = tuple[Any, FloatArray]
+ViewSource = Callable[[float], View | None]
 
 
 class HarvestMachine:
@@ -180,6 +189,40 @@ class HarvestMachine:
             self.log.event("crash", berry=berry.tag_id, error=repr(exc))
             raise
         return self._finish(result, watch, start)
+
+    def survey(self, plan: SurveyPlan, view: ViewSource) -> list[tuple[View, View]]:
+        """SURVEY: ramp to each pair's two configurations in turn (open loop, as
+        placement's ramps; the plan checked them), ``view(t)`` once the arm has settled
+        at each, then ramp to the ready pose; the pairs whose two views were both taken.
+        A fault ends the survey where it is, vented and logged like a berry's, with the
+        pairs taken before it; the harvest goes on from IDLE."""
+        watch = BerryWatch(self.vision, self.clock, SURVEY, self.log, self.config.marker_timeout)
+        self._transition(S.SURVEY, SURVEY, f"{len(plan.pairs)} pairs of views planned")
+        pairs: list[tuple[View, View]] = []
+        try:
+            for first, second in plan.pairs:
+                views = [self._take_view(watch, q, view) for q in (first, second)]
+                if views[0] is not None and views[1] is not None:
+                    pairs.append((views[0], views[1]))
+            deadline = self.clock.now() + self.config.idle_timeout
+            self.servo.ramp(watch, self.state, self.q, self.home, deadline)
+            self._transition(S.IDLE, SURVEY, f"survey done: {len(pairs)} pairs of views")
+        except (Fault, SafetyError, NonFiniteError, HardwareError, VisionError) as exc:
+            self._fault(SURVEY, BerryResult(SURVEY.tag_id), _reason(exc), str(exc))
+        except BaseException as exc:
+            self._vent(f"unexpected {exc!r}")
+            self.log.event("crash", berry=SURVEY.tag_id, error=repr(exc))
+            raise
+        return pairs
+
+    def _take_view(self, watch: BerryWatch, q: FloatArray, view: ViewSource) -> View | None:
+        """Ramp to ``q``, settle, and take ``view`` there (None: C1 lost the cube or C2
+        gave no frame)."""
+        deadline = self.clock.now() + self.config.idle_timeout
+        self.servo.ramp(watch, self.state, self.q, q, deadline)
+        taken = view(self.clock.now())
+        self.log.event("survey_view", t=self.clock.now(), taken=taken is not None)
+        return taken
 
     def _reach(self, watch: BerryWatch, berry: BerryTarget) -> tuple[FloatArray, ...]:
         """INITIAL_PLACEMENT then FINE_POSITIONING (the grasp point onto the berry);
@@ -341,6 +384,20 @@ class HarvestMachine:
             self.log.event("vent_failed", error=repr(exc))
             vented = False
         self.log.event("vent", t=self.clock.now(), reason=reason, ok=vented)
+
+
+def _reason(exc: BaseException) -> FaultReason:
+    """The fault reason of a stage's exception (as :meth:`HarvestMachine.run_berry`
+    maps them)."""
+    if isinstance(exc, Fault):
+        return exc.reason
+    if isinstance(exc, SafetyError):
+        return FaultReason.SAFETY_STOP
+    if isinstance(exc, NonFiniteError):
+        return FaultReason.NAN_MEASUREMENT
+    if isinstance(exc, HardwareError):
+        return FaultReason.HARDWARE_ERROR
+    return FaultReason.VISION_ERROR
 
 
 @dataclass(frozen=True)

@@ -97,6 +97,13 @@ class ControlStack:
     planner: ModelIK
     clearance: Clearance
 
+    def know_canes(self, canes: Sequence[PolynomialCurve]) -> None:
+        """From now on avoid ``canes`` (a refined map) instead: the planner's and the way
+        check's clearance, and the controller's obstacles unless it avoids none."""
+        self.clearance.canes = list(canes)
+        if self.controller.clearance is not None:
+            self.controller.obstacles = list(canes)
+
 
 def gains_over(base: Gains, values: Mapping[str, Any]) -> Gains:
     """``base`` with the gain keywords ``values`` over it.

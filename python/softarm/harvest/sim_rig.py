@@ -16,12 +16,14 @@ import numpy as np
 
 import softarm
 from softarm.calibration.result import Calibration
+from softarm.checks import FloatArray
 from softarm.config import ChannelsConfig
 from softarm.errors import ParameterError
 from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.hardware.pressure_map import ElongationMap
 from softarm.harvest.actuator import PressureMap
 from softarm.harvest.bush_world import BushGripper, BushScene, harvest_bush
+from softarm.harvest.cane_survey import CaneSurvey
 from softarm.harvest.clearance import Clearance
 from softarm.harvest.dry_run import (
     BERRY_STATES,
@@ -95,6 +97,10 @@ class SimRigOptions:
     #: controller sweeps); "bush": the rendered bush, berries and canes found by
     #: perception (softarm.perception), the markerless harvest.
     world: str = "tags"
+    #: In the rendered bush, C2 surveys the canes C1 fitted before the first berry
+    #: (:mod:`softarm.harvest.cane_survey`; ``--survey``), as the hardware does with
+    #: ``[perception] survey = true``. Off by default: docs/perception.md, Limits.
+    survey: bool = False
     #: Resolver gain keywords (``--gains``) over every controller resolver's own.
     gains: Mapping[str, Any] = field(default_factory=dict)
     #: A folder to record the rendered bush's frames, the ripeness readings and the
@@ -146,6 +152,8 @@ class SimRig:
     scene: BushScene | None = None
     #: What ``record_frames`` records into, None without it.
     recorder: FrameRecorder | None = None
+    #: C2's survey of the canes (``world = "bush"`` with ``survey``), flown first.
+    survey: CaneSurvey | None = None
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
         """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
@@ -156,6 +164,8 @@ class SimRig:
         """
         if self.scene is not None:
             scene = self.scene
+            if self.survey is not None:
+                self.survey.run()
             report = harvest_bush(
                 scene, self.machine.run_berry, self.gripper.delivered, on_berry,
                 on_look=lambda: self.machine.log_map(scene.bush_map),
@@ -216,7 +226,10 @@ def build_sim_rig(
     vision: CameraVision
     gripper: SimGripper
     if o.world == "bush":
-        scene, vision, gripper, canes = _bush_world(o, bush, plant, model, cams, clock, recorder)
+        parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
+        scene, vision, gripper, canes = _bush_world(
+            o, bush, plant, model, cams, parts, clock, recorder
+        )
     else:
         scene = None
         vision = sim_vision(
@@ -230,7 +243,12 @@ def build_sim_rig(
         n_actuators=model.n_actuators, config=cfg, log=HarvestLog(o.log_path),
         ground_truth=gripper, planner=stack.planner,
     )  # fmt: skip
-    return SimRig(bush, model, plant, clock, bank, vision, gripper, watch, machine, scene, recorder)
+    survey = None
+    if scene is not None and o.survey:
+        survey = CaneSurvey(machine, stack, scene.stereo_c1(), vision, parts, CANE_REACH)
+    return SimRig(
+        bush, model, plant, clock, bank, vision, gripper, watch, machine, scene, recorder, survey
+    )
 
 
 def control_inputs(o: SimRigOptions, model: softarm.SoftArm) -> ControlInputs:
@@ -342,16 +360,17 @@ def _bush_world(
     plant: ArmPlant,
     model: softarm.SoftArm,
     cams: SimCameras,
+    parts: FloatArray,
     clock: SimClock,
     recorder: FrameRecorder | None,
 ) -> tuple[BushScene, BushVision, BushGripper, list[softarm.PolynomialCurve]]:
     """The rendered bush and its map, the markerless vision, the gripper that closes on
     the true berry a map entry stands for, and the canes the planner, the resolver and
-    the clearance avoid: fitted from C1 without the rig's own parts. With ``recorder``
+    the clearance avoid: fitted from C1 without the rig's own ``parts``. With ``recorder``
     every frame is recorded, and the rig's hardware configuration written beside."""
     cfg = o.config
     scene = _bush_scene(bush, plant, cams, clock, recorder)
-    canes = scene.fit_canes(rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag), CANE_REACH)
+    canes = scene.fit_canes(parts, CANE_REACH)
     vision = _bush_vision(scene, cams, cfg.grasp_offset, recorder)
     gripper = BushGripper(
         scene, plant, vision, list(bush.berries), cfg.grasp_offset, cfg.grasp_workspace
@@ -360,7 +379,7 @@ def _bush_world(
         identified = o.identified or declared_plant(o.plant, model.n_actuators, cfg.period)
         rig = RigDescription(
             model, cfg, dict(o.gains), identified, scene, scene.world.c2,
-            cams.T_ee_c2, cams.T_ee_cube, cams.berry_tag, cams.T_base_tag,
+            cams.T_ee_c2, cams.T_ee_cube, cams.berry_tag, cams.T_base_tag, o.survey,
         )  # fmt: skip
         write_rig_files(recorder.folder, rig)
     return scene, vision, gripper, canes

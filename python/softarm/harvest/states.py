@@ -15,6 +15,9 @@ class HarvestState(StrEnum):
     """One state of :class:`~softarm.harvest.machine.HarvestMachine`."""
 
     IDLE = "idle"
+    #: Before the first berry, C2 is taken to pairs of views of the bush that fill in
+    #: the canes C1 cannot place (:mod:`softarm.harvest.survey`).
+    SURVEY = "survey"
     #: Eye-to-hand feedback drives the gripper to the pre-grasp pose (fig. 4, first stage).
     INITIAL_PLACEMENT = "initial_placement"
     #: Eye-in-hand feedback (eq. 21) drives the gripper onto the berry (fig. 4, second stage).

@@ -52,6 +52,9 @@ class BushMap:
     merge_distance: float = 0.02
     berries: list[MappedBerry] = field(default_factory=list)
     canes: list[CaneFit] = field(default_factory=list)
+    #: C1's cane points (:func:`~softarm.perception.canes.cane_points`, (n, 4)) the
+    #: canes were last fitted from, for a refit with other views' (None before).
+    cane_points: FloatArray | None = None
     #: The ripe fruit C1 found without a position, each with C2's crossings so far.
     unplaced: list[Placing] = field(default_factory=list)
 

@@ -18,6 +18,7 @@ The pipeline (:func:`fit_canes`):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import cv2
@@ -31,7 +32,14 @@ from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_
 from softarm.perception.cane_pixels import CaneLook, cane_mask, half_width_px, stereo_disparity
 from softarm.perception.stereo_camera import StereoCamera
 
-__all__ = ["CaneFit", "CaneSettings", "fit_canes"]
+__all__ = [
+    "CaneFit",
+    "CaneSettings",
+    "cane_points",
+    "centre_line_points",
+    "fit_cane_points",
+    "fit_canes",
+]
 
 
 @dataclass(frozen=True)
@@ -68,6 +76,7 @@ def fit_canes(
     stereo: StereoCamera,
     depth: FloatArray | None = None,
     settings: CaneSettings | None = None,
+    more: Sequence[FloatArray] = (),
 ) -> list[CaneFit]:
     """The canes C1 sees, largest support first; [] when there is none.
 
@@ -80,10 +89,28 @@ def fit_canes(
             camera; when given, stereo matching is skipped.
         settings: thresholds; the defaults were tuned on rendered bushes 0–4 and
             900–919.
+        more: cane points from other views, each (n, 4) as :func:`cane_points` gives
+            them (:func:`softarm.perception.cane_views.view_pair_points`: C2's survey),
+            fitted together with C1's.
 
     Raises:
         VisionError: an empty image, a wrong dtype or shape, or sizes that disagree.
     """
+    settings = settings or CaneSettings()
+    points = cane_points(left, right, stereo, depth, settings)
+    return fit_cane_points(np.vstack([points, *more]), settings)
+
+
+def cane_points(
+    left: npt.NDArray[np.uint8],
+    right: npt.NDArray[np.uint8] | None,
+    stereo: StereoCamera,
+    depth: FloatArray | None = None,
+    settings: CaneSettings | None = None,
+) -> FloatArray:
+    """(n, 4) rows, at most ``settings.max_points``: a point on a cane's centre line C1
+    sees (base frame, m) and the cane's radius there (m); arguments and errors as
+    :func:`fit_canes`."""
     settings = settings or CaneSettings()
     _check_inputs(left, right, stereo, depth)
     if depth is None:
@@ -91,11 +118,17 @@ def fit_canes(
         camera_points = _stereo_points(left, right, stereo, settings)
     else:
         camera_points = _depth_points(left, depth, stereo, settings)
-    if len(camera_points) < settings.search.min_support:
-        return []
     T = np.asarray(stereo.T_base_left, dtype=np.float64)
-    points = camera_points[:, :3] @ T[:3, :3].T + T[:3, 3]
-    return _fit_all(points, camera_points[:, 3], settings)
+    return np.column_stack([camera_points[:, :3] @ T[:3, :3].T + T[:3, 3], camera_points[:, 3]])
+
+
+def fit_cane_points(points: FloatArray, settings: CaneSettings | None = None) -> list[CaneFit]:
+    """The canes among ``points`` (n, 4), as :func:`cane_points` gives them, largest
+    support first; [] when there are too few."""
+    settings = settings or CaneSettings()
+    if len(points) < settings.search.min_support:
+        return []
+    return _fit_all(points[:, :3], points[:, 3], settings)
 
 
 def _check_inputs(left: object, right: object, stereo: StereoCamera, depth: object) -> None:
@@ -185,6 +218,22 @@ def _to_centre_line(
     rays = surface / np.linalg.norm(surface, axis=1, keepdims=True)
     centre = surface + rays * (np.pi / 4.0 * radius)[:, None]
     return np.column_stack([centre, radius])
+
+
+def centre_line_points(
+    surface: FloatArray,
+    radius: FloatArray,
+    T_base_camera: FloatArray,
+    depth_range: tuple[float, float],
+    max_points: int,
+) -> FloatArray:
+    """(n, 4) rows as :func:`cane_points`: the ``surface`` points (camera frame, m) of
+    canes of ``radius`` (m) moved to their centre lines, those within ``depth_range``
+    kept, evenly subsampled to at most ``max_points`` and placed by ``T_base_camera``."""
+    centre = _to_centre_line(surface, radius, depth_range)
+    centre = centre[:: max(1, int(np.ceil(len(centre) / max_points)))]
+    T = np.asarray(T_base_camera, dtype=np.float64)
+    return np.column_stack([centre[:, :3] @ T[:3, :3].T + T[:3, 3], centre[:, 3]])
 
 
 def _fit_all(points: FloatArray, radius: FloatArray, settings: CaneSettings) -> list[CaneFit]:

@@ -128,6 +128,22 @@ class CameraVision:
         T_c1_ee, _ = self._view_c1(time)
         return None if T_c1_ee is None else self.T_base_c1 @ T_c1_ee
 
+    def view_c2(self, time: float) -> tuple[Any, FloatArray] | None:
+        """C2's frame at ``time`` and C2's pose in the base frame, from the cube in C1's
+        frame and the hand-eye calibration (eq. 21, 22); None without either, or when
+        no marker of the cube is consistent on its own (:meth:`MarkerCube.estimate`):
+        two views' depth is only as good as their poses. The tracking loop's state
+        (its last pose, the jump rule) is left as it was."""
+        dets = self.detector.detect(_frame(self.frame1, time), self.model1)
+        est = self.cube.estimate(dets, self.model1)
+        if est is None or not est.consistent:
+            return None
+        image = self.frame2(time)
+        if image is None:
+            return None
+        T_c1_ee = est.T_camera_cube @ invert(self.T_ee_cube)
+        return image, self.T_base_c1 @ T_c1_ee @ self.fusion.T_ee_c2
+
     def _view_c1(self, time: float) -> tuple[FloatArray | None, FloatArray | None]:
         """C1's frame at ``time``: ``T_c1_ee`` (None when the cube is not seen or the pose
         is an outlier) and the selected berry's tag position in C1 (None if not seen)."""
