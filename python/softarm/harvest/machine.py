@@ -65,6 +65,9 @@ SURVEY = BerryTarget(-1)
 #: and its pose in the base frame.
 View = tuple[Any, FloatArray]
 ViewSource = Callable[[float], View | None]
+#: What ends a berry (or the survey) in FAULT, vented, the harvest going on: a stage's
+#: own Fault and the device, measurement and vision errors (:func:`_reason`).
+STAGE_ERRORS = (Fault, SafetyError, NonFiniteError, HardwareError, VisionError)
 
 
 class HarvestMachine:
@@ -173,16 +176,8 @@ class HarvestMachine:
             if result.harvested:
                 self.gripper.open()  # drop the berry at the rest pose
             self._transition(S.DONE, berry, "harvested" if result.harvested else "skipped")
-        except Fault as fault:
-            self._fault(berry, result, fault.reason, str(fault))
-        except SafetyError as exc:
-            self._fault(berry, result, FaultReason.SAFETY_STOP, repr(exc))
-        except NonFiniteError as exc:
-            self._fault(berry, result, FaultReason.NAN_MEASUREMENT, repr(exc))
-        except HardwareError as exc:
-            self._fault(berry, result, FaultReason.HARDWARE_ERROR, repr(exc))
-        except VisionError as exc:
-            self._fault(berry, result, FaultReason.VISION_ERROR, repr(exc))
+        except STAGE_ERRORS as exc:
+            self._fault(berry, result, _reason(exc), _detail(exc))
         except BaseException as exc:
             # A bug or Ctrl-C: still leave the arm vented and the log synced, then re-raise.
             self._vent(f"unexpected {exc!r}")
@@ -207,8 +202,8 @@ class HarvestMachine:
             deadline = self.clock.now() + self.config.idle_timeout
             self.servo.ramp(watch, self.state, self.q, self.home, deadline)
             self._transition(S.IDLE, SURVEY, f"survey done: {len(pairs)} pairs of views")
-        except (Fault, SafetyError, NonFiniteError, HardwareError, VisionError) as exc:
-            self._fault(SURVEY, BerryResult(SURVEY.tag_id), _reason(exc), str(exc))
+        except STAGE_ERRORS as exc:
+            self._fault(SURVEY, BerryResult(SURVEY.tag_id), _reason(exc), _detail(exc))
         except BaseException as exc:
             self._vent(f"unexpected {exc!r}")
             self.log.event("crash", berry=SURVEY.tag_id, error=repr(exc))
@@ -387,8 +382,7 @@ class HarvestMachine:
 
 
 def _reason(exc: BaseException) -> FaultReason:
-    """The fault reason of a stage's exception (as :meth:`HarvestMachine.run_berry`
-    maps them)."""
+    """The fault reason of an exception of :data:`STAGE_ERRORS`."""
     if isinstance(exc, Fault):
         return exc.reason
     if isinstance(exc, SafetyError):
@@ -398,6 +392,11 @@ def _reason(exc: BaseException) -> FaultReason:
     if isinstance(exc, HardwareError):
         return FaultReason.HARDWARE_ERROR
     return FaultReason.VISION_ERROR
+
+
+def _detail(exc: BaseException) -> str:
+    """What the fault log says of ``exc``: a stage's own message, else the error."""
+    return str(exc) if isinstance(exc, Fault) else repr(exc)
 
 
 @dataclass(frozen=True)
