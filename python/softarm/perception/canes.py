@@ -18,7 +18,6 @@ The pipeline (:func:`fit_canes`):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import cv2
@@ -76,7 +75,6 @@ def fit_canes(
     stereo: StereoCamera,
     depth: FloatArray | None = None,
     settings: CaneSettings | None = None,
-    more: Sequence[FloatArray] = (),
 ) -> list[CaneFit]:
     """The canes C1 sees, largest support first; [] when there is none.
 
@@ -89,16 +87,12 @@ def fit_canes(
             camera; when given, stereo matching is skipped.
         settings: thresholds; the defaults were tuned on rendered bushes 0–4 and
             900–919.
-        more: cane points from other views, each (n, 4) as :func:`cane_points` gives
-            them (:func:`softarm.perception.cane_views.view_pair_points`: C2's survey),
-            fitted together with C1's.
 
     Raises:
         VisionError: an empty image, a wrong dtype or shape, or sizes that disagree.
     """
     settings = settings or CaneSettings()
-    points = cane_points(left, right, stereo, depth, settings)
-    return fit_cane_points(np.vstack([points, *more]), settings)
+    return fit_cane_points(cane_points(left, right, stereo, depth, settings), settings)
 
 
 def cane_points(
@@ -123,7 +117,8 @@ def cane_points(
 
 
 def fit_cane_points(points: FloatArray, settings: CaneSettings | None = None) -> list[CaneFit]:
-    """The canes among ``points`` (n, 4), as :func:`cane_points` gives them, largest
+    """The canes among ``points`` (n, 4), as :func:`cane_points` gives them (and
+    :func:`softarm.perception.cane_views.view_pair_points` for other views), largest
     support first; [] when there are too few."""
     settings = settings or CaneSettings()
     if len(points) < settings.search.min_support:
