@@ -103,3 +103,17 @@ def test_bad_images_are_named(first, second, named: str) -> None:
 def test_black_views_give_no_points() -> None:
     black = np.zeros((480, 640, 3), np.uint8)
     assert view_pair_points(black, black, CAMERA, _pose(0.0), _pose(0.05)).shape == (0, 4)
+
+
+def test_pixel_size_is_distance_over_focal_length() -> None:
+    from softarm.perception.cane_views import pixel_size
+    from softarm.perception.stereo_camera import StereoCamera
+
+    eye = CameraModel(CAMERA.matrix, np.zeros(5), (640, 480))
+    T_left_right = np.eye(4)
+    T_left_right[0, 3] = 0.12
+    T_base_left = np.eye(4)
+    T_base_left[:3, 3] = [0.1, -0.2, 0.3]
+    stereo = StereoCamera(eye, eye, T_base_left, T_left_right)
+    point = T_base_left[:3, 3] + np.array([0.3, 0.4, 1.2])  # 1.3 m from the left eye
+    assert pixel_size(stereo, point) == pytest.approx(1.3 / stereo.rectification.focal)
