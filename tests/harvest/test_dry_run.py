@@ -104,9 +104,11 @@ def test_a_missing_frame_is_a_one_line_error(
         (["--config", "hw.toml", "--dry-run"], "--frames"),
         (["--config", "hw.toml", "--frames", "x"], "--dry-run"),
         (["--sim", "--record-frames", "x"], "--world bush"),
+        (["--sim", "--survey"], "--survey"),
+        (["--config", "hw.toml", "--survey"], "[perception] survey"),
     ],
 )
-def test_the_dry_run_options_outside_their_mode_are_refused(
+def test_options_outside_their_mode_are_refused(
     args: list[str], named: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (tmp_path / "hw.toml").write_text("")

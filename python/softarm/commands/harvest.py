@@ -43,7 +43,7 @@ from softarm.commands._run_info import (
     write_run_bag,
 )
 from softarm.commands._signals import drives_arm, vents_on_stop
-from softarm.errors import ConfigError, HardwareUnavailableError
+from softarm.errors import ConfigError, HardwareUnavailableError, ParameterError
 from softarm.harvest_config import HarvestConfig
 
 if TYPE_CHECKING:
@@ -137,6 +137,11 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     check_dry_run(args)
+    if args.survey and not (args.sim and args.world == "bush"):
+        raise ParameterError(
+            "--survey: surveys the rendered bush (--sim --world bush); "
+            "on the arm, [perception] survey = true"
+        )
     check_bag(args.bag)
     check_view(args.view, args.record)
     configure_logging(args.quiet)
