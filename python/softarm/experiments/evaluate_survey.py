@@ -92,29 +92,29 @@ def _berries_centre(left: Any, right: Any, stereo: Any) -> FloatArray | None:
 
 
 def _views(world: Any, arm: Any, cams: Any, pair: Any) -> Any:
-    """The pair's two C2 frames with C2's pose from the cube tracked in C1; None when C1
-    loses the cube at either view, or sees no marker of it consistent on its own."""
+    """The pair's two C2 frames with C2's pose from the cube tracked in C1, as the
+    harvest takes them (:meth:`CameraVision.view_c2`); None when C1 loses the cube at
+    either view, or sees no marker of it consistent on its own."""
+    from softarm.harvest_config import HarvestConfig
     from softarm.sim.render.world import arm_sections
     from softarm.vision import MarkerCube
-    from softarm.vision.detector import MarkerDetector
-    from softarm.vision.poses import invert
+    from softarm.vision.two_cameras import CameraVision
 
-    cube = MarkerCube.standard(cams.cube_marker)
-    detector = MarkerDetector(cube.dictionary)
-    c1 = world.stereo.left
+    here: dict[str, FloatArray] = {}
+    vision = CameraVision(
+        lambda t: world.cube_window(here["ee"] @ cams.T_ee_cube),
+        lambda t: world.c2_frame().colour,
+        world.stereo.left, world.c2, world.stereo.T_base_left, cams.T_ee_c2,
+        cams.T_ee_cube, MarkerCube.standard(cams.cube_marker), cams.berry_tag,
+        HarvestConfig().grasp_offset,
+    )  # fmt: skip
     views = []
     for q in pair:
-        T_base_ee = np.asarray(arm.forward(q))
-        world.set_arm(arm_sections(arm, q), T_base_ee)
-        window = world.cube_window(T_base_ee @ cams.T_ee_cube)
-        est = cube.estimate(detector.detect(window, c1), c1)
-        if est is None or not est.consistent:  # as CameraVision.view_c2
-            world.hide_arm()
-            return None
-        tracked = world.stereo.T_base_left @ est.T_camera_cube @ invert(cams.T_ee_cube)
-        views.append((world.c2_frame().colour, tracked @ cams.T_ee_c2))
+        here["ee"] = np.asarray(arm.forward(q))
+        world.set_arm(arm_sections(arm, q), here["ee"])
+        views.append(vision.view_c2(0.0))
     world.hide_arm()
-    return views
+    return None if None in views else views
 
 
 def summarise(rows: list[dict[str, Any]]) -> dict[str, float]:

@@ -56,12 +56,13 @@ class CaneSurvey:
             self.vision.fusion.T_ee_c2, centre, self.settings,
         )  # fmt: skip
         views = self.machine.survey(plan, self.vision.view_c2)
+        footprint = pixel_size(self.c1.stereo, centre)
         points = []
         for (first, T_first), (second, T_second) in views:
             try:
                 points.append(view_pair_points(
                     first, second, self.vision.model2, T_first, T_second,
-                    footprint=pixel_size(self.c1.stereo, centre),
+                    footprint=footprint,
                 ))  # fmt: skip
             except VisionError as exc:  # the true arm moved C2 other than planned
                 log.event("survey_pair_dropped", why=str(exc))
