@@ -1,7 +1,8 @@
 """Canes as cubic curves from 3D points: the planning paper's curve obstacle (eq. 10),
 p(u) = Σ_k c_k u^k for u in [0, 1], fitted by least squares with u the normalised arc
 length, and the points split into canes by sequential RANSAC (a line proposes a cane,
-the cubic through its inliers grows it along the cane, past gaps where leaves hide it);
+the cubic through its inliers grows it along the cane, past gaps where leaves hide it,
+but not out to specks, stray points too sparse to be a glimpse of a cane);
 then the pieces of one cane that a leaf cuts apart further than the growth reaches are
 joined when their ends face each other and one cubic passes through both.
 """
@@ -39,6 +40,11 @@ class CurveSearch:
         it removed the two phantoms that made the planner refuse two berries);
         min_length: its shortest extent.
     max_gap: the longest hole (a leaf in front) a cane is followed across.
+    speck_radius, speck_points: a point with fewer than ``speck_points`` points of its
+        cane (itself included) within ``speck_radius`` is a speck, a stray match, and no
+        cane is grown across a hole to it: a cubic bent out to a few specks 5–12 cm
+        away runs through open air where the planner then sees a cane (on diagnosis
+        harvests 854, 856, 859 and 861 such bridges made it refuse a berry each).
     proposals: random lines tried for each cane; seed: their generator's seed.
     join_gap, join_angle: two canes whose ends face each other across at most
         ``join_gap`` (m), each end's outward direction within ``join_angle`` (degrees)
@@ -51,6 +57,8 @@ class CurveSearch:
     min_support: int = 70
     min_length: float = 0.04
     max_gap: float = 0.10
+    speck_radius: float = 0.010
+    speck_points: int = 5
     proposals: int = 150
     seed: int = 0
     join_gap: float = 0.15
@@ -177,12 +185,12 @@ def _grow(points: FloatArray, line: IndexArray, search: CurveSearch) -> IndexArr
     """The cane grown from the inliers ``line`` of a proposed line: alternately fit the
     cubic and take the points near it, in one run without long holes; None when it is
     too short or has too few points."""
-    members = _longest_run(points, line, search.max_gap)
+    members = _longest_run(points, _without_specks(points, line, search), search.max_gap)
     for _ in range(3):
         if len(members) < search.min_support:
             return None
         coeffs = arc_length_cubic(points[members])
-        members = _near_curve(points, coeffs, search)
+        members = _without_specks(points, _near_curve(points, coeffs, search), search)
         members = _longest_run(points, members, search.max_gap)
     if len(members) < search.min_support or _extent(points[members]) < search.min_length:
         return None
@@ -230,9 +238,20 @@ def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> 
     return np.flatnonzero(distance < search.curve_tolerance)
 
 
+def _without_specks(points: FloatArray, members: IndexArray, search: CurveSearch) -> IndexArray:
+    """The ``members`` that are not specks (see ``CurveSearch.speck_points``)."""
+    if len(members) == 0:
+        return members
+    chosen = points[members]
+    neighbours = cKDTree(chosen).query_ball_point(chosen, search.speck_radius, return_length=True)
+    return members[np.asarray(neighbours) >= search.speck_points]
+
+
 def _longest_run(points: FloatArray, members: IndexArray, max_gap: float) -> IndexArray:
     """The members along the principal axis, cut at holes longer than ``max_gap``;
     the run with most points."""
+    if len(members) < 2:
+        return members
     chosen = points[members]
     axis = np.linalg.svd(chosen - chosen.mean(axis=0), full_matrices=False)[2][0]
     order = np.argsort(chosen @ axis)
