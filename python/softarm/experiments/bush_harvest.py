@@ -9,7 +9,7 @@ per berry beside the tag world's on the same seeds when its reports and times ar
 bush world's harvest and then the tag world's on the same seed (so the two share the
 machine's load), each timed as a whole process, their reports and ``wall_times.txt``
 written (``--berries``, 8 by default; ``--survey``: the bush world with C2's cane
-survey)::
+survey; ``--jobs N``: N seeds at once, on a machine with the cores for it)::
 
     MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 770 779 \
         docs/data/perception/bush_harvest_770-779 docs/data/perception/tag_harvest_770-779
@@ -21,7 +21,9 @@ import json
 import statistics
 import subprocess
 import sys
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -71,15 +73,23 @@ def _reports(folder: Path) -> list[dict[str, Any]]:
 
 
 def run_pair(
-    seeds: range, bush_dir: Path, tag_dir: Path, berries: int = 8, survey: bool = False
+    seeds: range,
+    bush_dir: Path,
+    tag_dir: Path,
+    berries: int = 8,
+    survey: bool = False,
+    jobs: int = 1,
 ) -> None:
     """Harvest each seed in the bush world (with C2's cane survey when ``survey``),
     then in the tag world, timing each whole process (``python -m softarm
-    harvest --sim ...``); reports and wall times into the two folders."""
+    harvest --sim ...``); reports and wall times into the two folders. ``jobs`` seeds
+    run at once (each seed's two worlds one after the other, so they share the load)."""
     for folder in (bush_dir, tag_dir):
         folder.mkdir(parents=True, exist_ok=True)
-    for seed in seeds:
-        bush = ["--world", "bush"] + (["--survey"] if survey else [])
+    lock = threading.Lock()
+    bush = ["--world", "bush"] + (["--survey"] if survey else [])
+
+    def one_seed(seed: int) -> None:
         for folder, world in ((bush_dir, bush), (tag_dir, [])):
             report = folder / f"r{seed}.json"
             command = [sys.executable, "-m", "softarm", "harvest", "--sim", *world,
@@ -88,8 +98,11 @@ def run_pair(
             start = time.monotonic()
             subprocess.run(command, check=False, stdout=subprocess.DEVNULL)
             wall = time.monotonic() - start
-            with (folder / "wall_times.txt").open("a") as f:
+            with lock, (folder / "wall_times.txt").open("a") as f:
                 f.write(f"{seed} wall {wall:.2f}\n")
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        list(pool.map(one_seed, seeds))
 
 
 def main(argv: list[str]) -> None:
@@ -97,9 +110,10 @@ def main(argv: list[str]) -> None:
     making them, with ``--run``)."""
     if argv[:1] == ["--run"]:
         berries = int(argv[argv.index("--berries") + 1]) if "--berries" in argv else 8
+        jobs = int(argv[argv.index("--jobs") + 1]) if "--jobs" in argv else 1
         first, last, bush_dir, tag_dir = argv[1:5]
         seeds = range(int(first), int(last) + 1)
-        run_pair(seeds, Path(bush_dir), Path(tag_dir), berries, "--survey" in argv)
+        run_pair(seeds, Path(bush_dir), Path(tag_dir), berries, "--survey" in argv, jobs)
         argv = [bush_dir, tag_dir]
     for name in argv:
         folder = Path(name)
