@@ -25,7 +25,12 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
+
+import numpy as np
+
+from softarm.perception.cane_metrics import cane_map_error
 
 __all__ = ["summarise"]
 
@@ -50,10 +55,31 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
         "contact_steps": sum(r["branch_contact_steps"] for r in reports),
         "cane_median_mm": statistics.median(medians) if medians else float("nan"),
         "cane_p95_mm": statistics.median(p95s) if p95s else float("nan"),
-        "cane_coverage": statistics.fmean(m["coverage"] for m in maps),
+        "cane_coverage": _length_weighted_coverage(reports),
+        "cane_coverage_per_bush": statistics.fmean(m["coverage"] for m in maps),
         "sim_s_per_berry": sum(r["sim_time_s"] for r in reports)
         / max(sum(len(r["berries"]) for r in reports), 1),
     }
+
+
+def _length_weighted_coverage(reports: list[dict[str, Any]]) -> float:
+    """The share of all the bushes' true cane length in the workspace that the maps
+    cover (the goal's measure: each bush weighs by its length there, so a bush with a
+    few centimetres of cane in reach counts for a few centimetres)."""
+    lengths = [_cane_length(r) for r in reports]
+    covered = sum(
+        float(r["cane_map"]["coverage"]) * n for r, n in zip(reports, lengths, strict=True)
+    )
+    return covered / max(sum(lengths), 1e-12)
+
+
+def _cane_length(report: dict[str, Any]) -> float:
+    """The true cane length (m) in the workspace: the report's, else from the canes
+    its header records."""
+    if "length_m" in report["cane_map"]:
+        return float(report["cane_map"]["length_m"])
+    canes = [SimpleNamespace(coeffs=np.asarray(c)) for c in report["header"]["world"]["canes"]]
+    return float(cane_map_error([], canes)["length_m"])
 
 
 def wall_per_berry(folder: Path) -> float:
