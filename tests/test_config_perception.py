@@ -36,7 +36,7 @@ def test_the_template_section_uncommented_parses() -> None:
     text = re.sub(r"(?m)^# (\[perception\]|stereo =|device =|calibration =|berries =|survey =)",
                   r"\1", _ready())  # fmt: skip
     p = parse_config(text, folder="/rig").perception
-    assert p is not None and p.stereo == "zed2" and p.devices() == (0,) and not p.survey
+    assert p is not None and p.stereo == "zed2" and p.devices() == (0,) and p.survey
     assert p.calibration_path == str(Path("/rig") / "stereo.yml")
 
 
@@ -44,13 +44,13 @@ def test_a_pair_resolves_its_files_and_round_trips() -> None:
     cfg = parse_config(_ready('stereo = "pair"\nleft = "l.mp4"\nright = 2\n'), folder="/rig")
     assert cfg.perception is not None
     assert cfg.perception.devices() == (str(Path("/rig") / "l.mp4"), 2)
-    assert not cfg.perception.survey  # C1's canes alone unless asked
+    assert cfg.perception.survey  # C2 surveys the canes unless told not to
     assert parse_config(dump_config(cfg), folder="/rig") == cfg
 
 
-def test_the_survey_can_be_turned_on_and_round_trips() -> None:
-    cfg = parse_config(_ready("survey = true\n"), folder="/rig")
-    assert cfg.perception is not None and cfg.perception.survey is True
+def test_the_survey_can_be_turned_off_and_round_trips() -> None:
+    cfg = parse_config(_ready("survey = false\n"), folder="/rig")
+    assert cfg.perception is not None and cfg.perception.survey is False
     assert parse_config(dump_config(cfg), folder="/rig") == cfg
 
 

@@ -6,7 +6,7 @@ path; the ZED2 without its SDK), split into its halves; ``stereo = "pair"`` is t
 OpenCV devices (``left``, ``right``). ``calibration`` is a ``stereo.yml`` written by
 ``softarm camera calibrate`` (resolved against the config file's folder); ``berries``
 is ``"markerless"`` (found by perception, the default) or ``"tags"`` (ArUco tags);
-``survey`` (false by default) takes C2 to pairs of views of the bush before the first
+``survey`` (true by default) takes C2 to pairs of views of the bush before the first
 berry, to complete the canes C1 fits (:mod:`softarm.harvest.cane_survey`).
 """
 
@@ -45,7 +45,7 @@ class PerceptionConfig:
     left: int | str | None = None
     right: int | str | None = None
     berries: str = "markerless"
-    survey: bool = False
+    survey: bool = True
     folder: str | None = field(default=None, compare=False, repr=False)
 
     @property
@@ -85,7 +85,7 @@ def parse_perception(t: _Table) -> PerceptionConfig | None:
             raise t.error(name, f"is not a key of stereo = {stereo!r} (it takes {wanted})")
     sources = {name: _source(t, name, 0 if name == "device" else None) for name in wanted}
     berries = _choice(t, "berries", BERRY_MODES, "markerless")
-    survey = t.get("survey", False)
+    survey = t.get("survey", True)
     if not isinstance(survey, bool):
         raise t.error("survey", "must be true or false")
     config = PerceptionConfig(

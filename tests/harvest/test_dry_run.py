@@ -30,7 +30,6 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "--sim",
         "--world",
         "bush",
-        "--survey",
         "--berries",
         "3",
         "--seed",
@@ -70,7 +69,8 @@ def test_the_hardware_path_sends_the_recorded_commands(recording: Path, tmp_path
     first = maps[0]  # the map after each look: what perception found
     assert first["berries"] and {"id", "position", "radius_m", "ripe"} <= set(first["berries"][0])
     assert all(len(c["coeffs"]) == 3 for c in first["canes"])
-    # The hardware path flew the survey the simulator recorded, and refit the canes.
+    # The hardware path flew the survey (on by default in both) the simulator
+    # recorded, and refit the canes.
     done = [r for r in records if r["kind"] == "survey_done"]
     assert len(done) == 1 and done[0]["used"] >= 1
 
@@ -105,6 +105,7 @@ def test_a_missing_frame_is_a_one_line_error(
         (["--config", "hw.toml", "--frames", "x"], "--dry-run"),
         (["--sim", "--record-frames", "x"], "--world bush"),
         (["--sim", "--survey"], "--survey"),
+        (["--sim", "--no-survey"], "--survey"),
         (["--config", "hw.toml", "--survey"], "[perception] survey"),
     ],
 )

@@ -64,7 +64,7 @@ PERCEPTION = """\
 # device = 0  # the ZED2's OpenCV device index or a path; a "pair" takes left and right
 # calibration = "stereo.yml"  # from `softarm camera calibrate`, next to this file
 # berries = "markerless"  # or "tags"
-# survey = false  # true: C2 views the bush in pairs before the first berry (more canes)
+# survey = true  # false: no C2 views of the bush before the first berry (C1's canes only)
 """
 
 HEADER = """\

@@ -105,10 +105,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--berries counts ripe and unripe together, 30%% unripe",
     )  # fmt: skip
     p.add_argument(
-        "--survey", action="store_true",
+        "--survey", action=argparse.BooleanOptionalAction, default=None,
         help="--world bush: before the first berry, take C2 to two pairs of views of the "
-        "bush and fit the canes with them (more of the canes mapped, more berries refused "
-        "near phantom canes: docs/perception.md)",
+        "bush and fit the canes with them (on by default: more of the canes mapped, "
+        "docs/perception.md); --no-survey: C1's canes only",
     )  # fmt: skip
     add_plant_options(p)
     add_dry_run_options(p)
@@ -137,10 +137,10 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     check_dry_run(args)
-    if args.survey and not (args.sim and args.world == "bush"):
+    if args.survey is not None and not (args.sim and args.world == "bush"):
         raise ParameterError(
-            "--survey: surveys the rendered bush (--sim --world bush); "
-            "on the arm, [perception] survey = true"
+            "--survey/--no-survey: for the rendered bush (--sim --world bush); "
+            "on the arm, [perception] survey"
         )
     check_bag(args.bag)
     check_view(args.view, args.record)
@@ -150,8 +150,8 @@ def run(args: argparse.Namespace) -> int:
     if args.sim:
         args.seed = 0 if args.seed is None else args.seed
         if args.world == "bush":
-            options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION, survey=args.survey)
-            options.update(record_frames=args.record_frames)
+            options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
+            options.update(survey=args.survey is not False, record_frames=args.record_frames)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
             gains=gains, view=args.view, record=args.record, bag=args.bag, args=args, **options,

@@ -8,8 +8,9 @@ per berry beside the tag world's on the same seeds when its reports and times ar
 ``--run FIRST LAST BUSH_DIR TAG_DIR`` makes those folders first: for each seed, the
 bush world's harvest and then the tag world's on the same seed (so the two share the
 machine's load), each timed as a whole process, their reports and ``wall_times.txt``
-written (``--berries``, 8 by default; ``--survey``: the bush world with C2's cane
-survey; ``--jobs N``: N seeds at once, on a machine with the cores for it)::
+written (``--berries``, 8 by default; ``--no-survey``: the bush world without C2's
+cane survey, C1's canes only; ``--jobs N``: N seeds at once, on a machine with the
+cores for it)::
 
     MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 770 779 \
         docs/data/perception/bush_harvest_770-779 docs/data/perception/tag_harvest_770-779
@@ -103,17 +104,17 @@ def run_pair(
     bush_dir: Path,
     tag_dir: Path,
     berries: int = 8,
-    survey: bool = False,
+    survey: bool = True,
     jobs: int = 1,
 ) -> None:
-    """Harvest each seed in the bush world (with C2's cane survey when ``survey``),
+    """Harvest each seed in the bush world (without C2's cane survey unless ``survey``),
     then in the tag world, timing each whole process (``python -m softarm
     harvest --sim ...``); reports and wall times into the two folders. ``jobs`` seeds
     run at once (each seed's two worlds one after the other, so they share the load)."""
     for folder in (bush_dir, tag_dir):
         folder.mkdir(parents=True, exist_ok=True)
     lock = threading.Lock()
-    bush = ["--world", "bush"] + (["--survey"] if survey else [])
+    bush = ["--world", "bush"] + ([] if survey else ["--no-survey"])
 
     def one_seed(seed: int) -> None:
         for folder, world in ((bush_dir, bush), (tag_dir, [])):
@@ -139,7 +140,7 @@ def main(argv: list[str]) -> None:
         jobs = int(argv[argv.index("--jobs") + 1]) if "--jobs" in argv else 1
         first, last, bush_dir, tag_dir = argv[1:5]
         seeds = range(int(first), int(last) + 1)
-        run_pair(seeds, Path(bush_dir), Path(tag_dir), berries, "--survey" in argv, jobs)
+        run_pair(seeds, Path(bush_dir), Path(tag_dir), berries, "--no-survey" not in argv, jobs)
         argv = [bush_dir, tag_dir]
     for name in argv:
         folder = Path(name)

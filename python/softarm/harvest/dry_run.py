@@ -125,7 +125,7 @@ class RigDescription:
     berry_tag: float
     T_base_tag: FloatArray
     #: Whether the rig surveyed the canes with C2 (``[perception] survey``).
-    survey: bool = False
+    survey: bool = True
 
     @property
     def stereo(self) -> StereoCamera:

@@ -98,9 +98,9 @@ class SimRigOptions:
     #: perception (softarm.perception), the markerless harvest.
     world: str = "tags"
     #: In the rendered bush, C2 surveys the canes C1 fitted before the first berry
-    #: (:mod:`softarm.harvest.cane_survey`; ``--survey``), as the hardware does with
-    #: ``[perception] survey = true``. Off by default: docs/perception.md, Limits.
-    survey: bool = False
+    #: (:mod:`softarm.harvest.cane_survey`; ``--no-survey`` turns it off), as the
+    #: hardware does unless ``[perception] survey = false``.
+    survey: bool = True
     #: Resolver gain keywords (``--gains``) over every controller resolver's own.
     gains: Mapping[str, Any] = field(default_factory=dict)
     #: A folder to record the rendered bush's frames, the ripeness readings and the
