@@ -27,7 +27,7 @@ def report() -> dict:
 def test_the_report_says_what_the_markerless_harvest_did(report: dict) -> None:
     assert report["world"] == "bush"
     assert {"ripe_in_reach", "ripe_harvested", "unripe_picked", "cane_map"} <= set(report)
-    assert set(report["cane_map"]) == {"median_mm", "p95_mm", "coverage"}
+    assert set(report["cane_map"]) == {"median_mm", "p95_mm", "coverage", "length_m"}
     for berry in report["berries"]:
         assert berry["ripe"] is not None and berry["localisation_error_mm"] < 15.0
 
