@@ -97,3 +97,30 @@ def test_a_detour_goes_round_a_cane_the_straight_ramps_pass_too_near() -> None:
         assert planner._path(q, berry, current, axis, via, 0.0, planner.ramp_margin) is None
     assert planner._path(q, berry, current, axis, DETOUR, 0.001, planner.ramp_margin)
     assert any(np.allclose(a, axis) for a in cone_axes(c.approach_axis, c.approach_cone_deg))
+
+
+def test_a_berry_only_the_survey_canes_block_is_planned_around_the_fallback_canes() -> None:
+    # A wall of canes 4 cm in front of the berry (phantoms, say) blocks every approach;
+    # with C1's canes as the fallback the berry is planned around those, and the
+    # planner says so and keeps its full clearance afterwards.
+    import softarm
+
+    planner, q, current, bush = _scene(limit_room=0.001)
+    berry = bush.berries[0].position
+    c1 = planner.clearance
+    assert c1 is not None
+    wall = [
+        softarm.PolynomialCurve(
+            np.array([[berry[0] - 0.3, 0.6, 0, 0], [berry[1] - 0.04, 0, 0, 0], [z, 0, 0, 0]]),
+            (0.0, 1.0),
+        )
+        for z in berry[2] + np.linspace(-0.3, 0.3, 25)
+    ]
+    every = Clearance(c1.arm, [*c1.canes, *wall], c1.offset)
+    planner.clearance = every
+    assert planner.plan(q, berry, current) is None and not planner.fell_back
+    planner.fallback = c1
+    plan = planner.plan(q, berry, current)
+    assert plan is not None and planner.fell_back and planner.clearance is every
+    planner.clearance = c1
+    _assert_ramps_clear(planner, q, plan[0])

@@ -107,6 +107,9 @@ def test_the_stack_avoids_the_canes_it_is_told_of(
     sim_rig.build_sim_rig(sim_rig.SimRigOptions(n_berries=1, seed=1, avoid_canes=avoid))
     stack = built[0]
     cane = softarm.PolynomialCurve(np.zeros((3, 4)), (0.0, 1.0))
+    before = list(stack.clearance.canes)
     stack.know_canes([cane])
     assert stack.clearance.canes == [cane] and stack.planner.clearance is stack.clearance
+    # The canes known before stay the planner's fallback (ModelIK.plan).
+    assert stack.planner.fallback is not None and stack.planner.fallback.canes == before
     assert stack.controller.obstacles == ([cane] if avoid else [])

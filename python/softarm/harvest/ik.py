@@ -85,6 +85,11 @@ class ModelIK:
         self.clearance, self.margin, self.via = clearance, margin, via
         self.ramp_margin = ramp_margin
         self.limit_room = limit_room
+        #: The canes to plan around where no plan clears ``clearance``'s: the ones C1
+        #: saw itself, once C2's survey has added its own (ControlStack.know_canes).
+        self.fallback: Clearance | None = None
+        #: Whether the last plan cleared only the fallback's canes.
+        self.fell_back = False
 
     def plan(
         self,
@@ -101,7 +106,31 @@ class ModelIK:
         limits; then a via half as far back; then grasps on the limits. Every pass keeps
         the same cane margins. A berry with no such plan is UNREACHABLE: brushing a cane
         open loop is not worth one berry. The axes in ``avoid`` (within 1°) are skipped:
-        the true arm could not reach the berry along them."""
+        the true arm could not reach the berry along them.
+
+        With a ``fallback``, a berry that no plan clear of every cane reaches is planned
+        clear of the fallback's canes, C1's own, as it is without C2's survey
+        (``fell_back``): a phantom among the survey's canes would otherwise cost the
+        berry (traced on diagnosis harvests 1019, 934 and 1037). The closed loop still
+        keeps the arm from every cane, the survey's too."""
+        self.fell_back = False
+        found = self._plan(q, berry, current, avoid)
+        if found is None and self.fallback is not None and self.clearance is not None:
+            every, self.clearance = self.clearance, self.fallback
+            try:
+                found = self._plan(q, berry, current, avoid)
+            finally:
+                self.clearance = every
+            self.fell_back = found is not None
+        return found
+
+    def _plan(
+        self,
+        q: FloatArray,
+        berry: FloatArray,
+        current: FloatArray,
+        avoid: Sequence[FloatArray],
+    ) -> tuple[list[FloatArray], FloatArray] | None:
         tried = np.asarray(avoid, dtype=np.float64).reshape(-1, 3)
         axes = [
             a

@@ -99,8 +99,11 @@ class ControlStack:
 
     def know_canes(self, canes: Sequence[PolynomialCurve]) -> None:
         """From now on avoid ``canes`` (a refined map) instead: the planner's and the way
-        check's clearance, and the controller's obstacles unless it avoids none."""
-        self.clearance.canes = list(canes)
+        check's clearance, and the controller's obstacles unless it avoids none. The
+        canes known before stay the planner's fallback (:meth:`ModelIK.plan`)."""
+        c = self.clearance
+        self.planner.fallback = Clearance(c.arm, c.canes, c.offset)
+        c.canes = list(canes)
         if self.controller.clearance is not None:
             self.controller.obstacles = list(canes)
 

@@ -104,7 +104,10 @@ class Servo:
         if plan is None:
             raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
         planned, axis = plan
-        self.log.event("plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position)
+        self.log.event(
+            "plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position,
+            fell_back=bool(getattr(planner, "fell_back", False)),
+        )  # fmt: skip
         return tuple(planned), axis
 
     def place(
