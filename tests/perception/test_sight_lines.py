@@ -146,6 +146,19 @@ def test_the_map_keeps_ripe_unplaced_fruit_once_and_places_it() -> None:
     assert bush_map.unplaced == []
 
 
+def test_the_second_of_two_waiting_fruit_can_be_placed_first() -> None:
+    # Placing the second waiting fruit compares it with the first on the way (seed
+    # 1081's harvest ended in a ValueError here: two placings compared by their arrays).
+    line = _line()
+    other = SightLine(line.origin, -line.direction, line.half_angle, 0.9)
+    bush_map = BushMap()
+    bush_map.note_unplaced([line, other])
+    assert len(bush_map.unplaced) == 2
+    first, second = bush_map.unplaced
+    bush_map.place(second, FRUIT)
+    assert bush_map.unplaced == [first] and bush_map.unplaced[0] is first
+
+
 def test_a_line_through_a_mapped_berry_is_that_berry() -> None:
     bush_map = BushMap(berries=[MappedBerry(0, FRUIT + 0.01, 0.01, 1.0)])
     bush_map.note_unplaced([_line()])

@@ -108,10 +108,12 @@ def crossing(
     return result
 
 
-@dataclass
+@dataclass(eq=False)
 class Placing:
     """The crossings of one sight line seen so far (their points and the C2 positions
-    they were seen from); :meth:`position` once enough agree."""
+    they were seen from); :meth:`position` once enough agree. Each is its own fruit:
+    two are equal only when they are the same object (their arrays have no truth
+    value to compare by)."""
 
     line: SightLine
     points: list[FloatArray] = field(default_factory=list)
