@@ -147,8 +147,8 @@ def test_the_map_keeps_ripe_unplaced_fruit_once_and_places_it() -> None:
 
 
 def test_the_second_of_two_waiting_fruit_can_be_placed_first() -> None:
-    # Placing the second waiting fruit compares it with the first on the way (seed
-    # 1081's harvest ended in a ValueError here: two placings compared by their arrays).
+    # Placing the second waiting fruit compares it with the first on the way: compared
+    # by their arrays, two placings ended a harvest in a ValueError here.
     line = _line()
     other = SightLine(line.origin, -line.direction, line.half_angle, 0.9)
     bush_map = BushMap()

@@ -111,8 +111,7 @@ class ModelIK:
         With a ``fallback``, a berry that no plan clear of every cane reaches is planned
         clear of the fallback's canes, C1's own, as it is without C2's survey
         (``fell_back``): a phantom among the survey's canes would otherwise cost the
-        berry (traced on diagnosis harvests 1019, 934 and 1037). The closed loop still
-        keeps the arm from every cane, the survey's too."""
+        berry. The closed loop still keeps the arm from every cane, the survey's too."""
         self.fell_back = False
         found = self._plan(q, berry, current, avoid)
         if found is None and self.fallback is not None and self.clearance is not None:

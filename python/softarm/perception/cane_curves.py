@@ -43,8 +43,8 @@ class CurveSearch:
     speck_radius, speck_points: a point with fewer than ``speck_points`` points of its
         cane (itself included) within ``speck_radius`` is a speck, a stray match, and no
         cane is grown across a hole to it: a cubic bent out to a few specks 5–12 cm
-        away runs through open air where the planner then sees a cane (on diagnosis
-        harvests 854, 856, 859 and 861 such bridges made it refuse a berry each).
+        away runs through open air, where the planner then sees a cane and may refuse
+        a berry.
     proposals: random lines tried for each cane; seed: their generator's seed.
     join_gap, join_angle: two canes whose ends face each other across at most
         ``join_gap`` (m), each end's outward direction within ``join_angle`` (degrees)
