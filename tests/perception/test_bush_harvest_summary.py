@@ -1,0 +1,36 @@
+"""The markerless harvest's pooled figures (softarm.experiments.bush_harvest): the cane
+coverage is pooled by each bush's cane length, the goal's measure."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from softarm.experiments.bush_harvest import summarise
+
+
+def _report(coverage: float, length_m: float | None, canes: list[Any] | None = None) -> dict:
+    cane_map: dict[str, Any] = {"median_mm": 1.0, "p95_mm": 3.0, "coverage": coverage}
+    if length_m is not None:
+        cane_map["length_m"] = length_m
+    return {
+        "ripe_in_reach": 2, "ripe_harvested": 2, "ripe_never_mapped": 0, "unripe_picked": 0,
+        "branch_contact_steps": 0, "sim_time_s": 4.0, "cane_map": cane_map,
+        "berries": [{"harvested": True, "true_position_error_mm": 0.5}] * 2,
+        "header": {"world": {"canes": canes or []}},
+    }  # fmt: skip
+
+
+def test_a_bush_weighs_by_its_cane_length() -> None:
+    figures = summarise([_report(1.0, 1.0), _report(0.0, 3.0)])
+    assert figures["cane_coverage"] == pytest.approx(0.25)
+    assert figures["cane_coverage_per_bush"] == pytest.approx(0.5)
+
+
+def test_an_older_report_takes_its_length_from_the_canes_its_header_records() -> None:
+    # A straight cane 0.2 m long, inside the workspace: 0.2 m against 0.6 m given.
+    cane = np.array([[0.0, 0.2, 0, 0], [0.3, 0, 0, 0], [0.2, 0, 0, 0]]).tolist()
+    figures = summarise([_report(1.0, None, [cane]), _report(0.0, 0.6)])
+    assert figures["cane_coverage"] == pytest.approx(0.25, abs=0.01)
