@@ -11,7 +11,12 @@ import pytest
 from softarm.experiments.bush_harvest import summarise
 
 
-def _report(coverage: float, length_m: float | None, canes: list[Any] | None = None) -> dict:
+def _report(
+    coverage: float,
+    length_m: float | None,
+    canes: list[Any] | None = None,
+    unmapped_shares: list[float] | None = None,
+) -> dict:
     cane_map: dict[str, Any] = {"median_mm": 1.0, "p95_mm": 3.0, "coverage": coverage}
     if length_m is not None:
         cane_map["length_m"] = length_m
@@ -20,6 +25,7 @@ def _report(coverage: float, length_m: float | None, canes: list[Any] | None = N
         "branch_contact_steps": 0, "sim_time_s": 4.0, "cane_map": cane_map,
         "berries": [{"harvested": True, "true_position_error_mm": 0.5}] * 2,
         "header": {"world": {"canes": canes or []}},
+        **({} if unmapped_shares is None else {"ripe_never_mapped_c1_share": unmapped_shares}),
     }  # fmt: skip
 
 
@@ -34,3 +40,11 @@ def test_an_older_report_takes_its_length_from_the_canes_its_header_records() ->
     cane = np.array([[0.0, 0.2, 0, 0], [0.3, 0, 0, 0], [0.2, 0, 0, 0]]).tolist()
     figures = summarise([_report(1.0, None, [cane]), _report(0.0, 0.6)])
     assert figures["cane_coverage"] == pytest.approx(0.25, abs=0.01)
+
+
+def test_never_mapped_berries_under_a_tenth_in_view_count_as_hidden() -> None:
+    figures = summarise([_report(1.0, 1.0, unmapped_shares=[0.0, 0.05, 0.6]),
+                         _report(1.0, 1.0, unmapped_shares=[])])  # fmt: skip
+    assert figures["never_mapped_hidden_from_c1"] == 2
+    # A report that does not record the shares makes the count unknown, not 0.
+    assert np.isnan(summarise([_report(1.0, 1.0)])["never_mapped_hidden_from_c1"])

@@ -4,6 +4,7 @@ equals the full one pixel for pixel."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from perception_world import rendered_world
 
 import softarm
@@ -105,3 +106,17 @@ def test_the_visible_share_of_an_object() -> None:
     segments = [g for g in range(renderer.model.ngeom) if renderer.labels.kind[g] == 5][1:4]
     assert renderer.visible_share("c1_left", segments) == 0.0
     assert (renderer.model.geom_group != 5).all()  # restored
+
+
+def test_each_berrys_visible_share_is_the_renderers_measure_of_it() -> None:
+    # The world's per-berry shares (C1's lens applied) against the renderer's visible
+    # share of each berry's geoms (pinhole, drawn alone against drawn with the scene).
+    world = rendered_world(902, 8)  # a bush whose leaves hide two fruit in part
+    renderer, labels = world.renderer, world.renderer.labels
+    shares = world.berry_shares()
+    assert set(shares) == {b.tag_id for b in world.bush.berries}
+    for tag, share in shares.items():
+        geoms = [g for g in range(renderer.model.ngeom) if labels.kind[g] == 1
+                 and labels.instance[g] == tag]  # fmt: skip
+        assert share == pytest.approx(renderer.visible_share("c1_left", geoms), abs=0.05)
+    assert any(0.0 < s < 0.9 for s in shares.values())

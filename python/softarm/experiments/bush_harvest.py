@@ -35,6 +35,9 @@ from softarm.perception.cane_metrics import cane_map_error
 
 __all__ = ["summarise"]
 
+#: A berry with less than this share of it in view of C1 counts as hidden from C1.
+HIDDEN_SHARE = 0.1
+
 
 def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
     """Pooled figures over ``reports`` (one per bush)."""
@@ -51,6 +54,7 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
         "ripe_harvested": sum(r["ripe_harvested"] for r in reports),
         "harvested_share": sum(r["ripe_harvested"] for r in reports) / max(ripe, 1),
         "ripe_never_mapped": sum(r["ripe_never_mapped"] for r in reports),
+        "never_mapped_hidden_from_c1": _hidden_from_c1(reports),
         "unripe_picked": sum(r["unripe_picked"] for r in reports),
         "mean_true_fine_error_mm": statistics.fmean(errors) if errors else float("nan"),
         "contact_steps": sum(r["branch_contact_steps"] for r in reports),
@@ -61,6 +65,17 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
         "sim_s_per_berry": sum(r["sim_time_s"] for r in reports)
         / max(sum(len(r["berries"]) for r in reports), 1),
     }
+
+
+def _hidden_from_c1(reports: list[dict[str, Any]]) -> float:
+    """How many ripe berries the map never held were under ``HIDDEN_SHARE`` in view of
+    C1 from where it looks (hidden from C1; C2 places only fruit C1 glimpsed, so these
+    were hidden from both cameras as the harvest uses them); NaN when older reports do
+    not record the shares."""
+    if any("ripe_never_mapped_c1_share" not in r for r in reports):
+        return float("nan")
+    shares = [s for r in reports for s in r["ripe_never_mapped_c1_share"]]
+    return float(sum(s < HIDDEN_SHARE for s in shares))
 
 
 def _length_weighted_coverage(reports: list[dict[str, Any]]) -> float:

@@ -134,6 +134,16 @@ class BushScene:
         """C1's left image now, with the map's berries and fitted canes drawn on it."""
         return draw_bush_map(self.c1_whole(0.0), self.bush_map, self.c1())
 
+    def c1_shares(self, tags: list[int]) -> list[float]:
+        """The visible share in C1's left eye (ground truth) of each true berry of
+        ``tags``, with the arm as it is: at the end of a harvest home, where C1 looks
+        from (what C1 had to find a berry by; C2 places only fruit C1 glimpsed)."""
+        if not tags:
+            return []
+        self._draw()
+        shares = self.world.berry_shares()
+        return [round(shares[t], 3) for t in tags]
+
     def truth_of(self, berry_id: int) -> Berry | None:
         """The true berry (still on the bush or not) a map entry stands for, or None."""
         entry = self.bush_map.get(berry_id)
@@ -199,12 +209,14 @@ def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
     ripe = [b for b in scene.bush.berries if b.ripeness >= 0.5]
     picked = {b.tag_id: b for b in scene.bush.berries if b.tag_id in delivered}
     mapped = {t.tag_id for e in scene.bush_map.berries if (t := scene.truth_of(e.id)) is not None}
+    unmapped = [b.tag_id for b in ripe if b.tag_id not in mapped]
     return {
         "world": "bush",
         "ripe_in_reach": len(ripe),
         "ripe_harvested": sum(b.ripeness >= 0.5 for b in picked.values()),
         "unripe_picked": sum(b.ripeness < 0.5 for b in picked.values()),
-        "ripe_never_mapped": sum(b.tag_id not in mapped for b in ripe),
+        "ripe_never_mapped": len(unmapped),
+        "ripe_never_mapped_c1_share": scene.c1_shares(unmapped),
         "cane_map": {
             k: v
             for k, v in cane_map_error(scene.bush_map.canes, scene.bush.branches).items()

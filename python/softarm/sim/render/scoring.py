@@ -59,15 +59,14 @@ def score_berries(world: RenderedBush, detections: list[BerryDetection]) -> Berr
     """Score ``detections`` (from :func:`locate_berries` on the world's C1 pair, in the
     rectified left image) against the world's truth as the arm is drawn now."""
     left, _ = world.c1(truth=True)
-    outline = world.berry_outlines()
+    shares = world.berry_shares(left)
     rect = world.stereo.rectification
-    assert left.geoms is not None and outline.geoms is not None
+    assert left.geoms is not None
     score = BerryScore()
     claimed: set[int] = set()
     for berry in world.bush.berries:
         visible = world.labels.mask(left.geoms, "berry", berry.tag_id)
-        whole = world.labels.mask(outline.geoms, "berry", berry.tag_id)
-        share = visible.sum() / max(whole.sum(), 1)
+        share = shares[berry.tag_id]
         region = _rectified(visible, rect.maps[0])
         hits = [i for i, d in enumerate(detections) if _inside(d, region) and i not in claimed]
         ripe = berry.ripeness >= 0.5

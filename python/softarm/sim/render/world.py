@@ -212,6 +212,20 @@ class RenderedBush:
         d = self._distort["c1"]
         return RenderedFrame(f.colour, None, None if f.geoms is None else d.nearest(f.geoms))
 
+    def berry_shares(self, seen: RenderedFrame | None = None) -> dict[int, float]:
+        """Each berry's visible share in C1's left eye as the arm is drawn now (tag id
+        -> its pixels in the whole scene over those of its outline alone, 0 when out of
+        the picture); ``seen``: that eye's truth frame when already rendered."""
+        seen = seen or self.c1_left(truth=True)
+        outline = self.berry_outlines()
+        assert seen.geoms is not None and outline.geoms is not None  # asked for
+        shares = {}
+        for berry in self.bush.berries:
+            whole = self.labels.mask(outline.geoms, "berry", berry.tag_id).sum()
+            visible = self.labels.mask(seen.geoms, "berry", berry.tag_id).sum()
+            shares[berry.tag_id] = float(visible / whole) if whole else 0.0
+        return shares
+
     def close(self) -> None:
         """Free the renderer."""
         self.renderer.close()
