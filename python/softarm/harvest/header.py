@@ -84,6 +84,7 @@ UNITS: dict[str, dict[str, str]] = {
     "transport_held": {"t": "s", "error": "m"},
     "fine_budget": {"t": "s", "error": "m"},
     "limit_grasp": {"t": "s", "error": "m"},
+    "lost_grasp": {"t": "s", "error": "m"},
     "placement_limit": {"t": "s", "error": "m", "pointing": "rad"},
     "ripeness": {"value": "0..1", "threshold": "0..1"},
     "berry_result": {"target": "m", "duration_s": "s", "*_mm": "mm", "*_deg": "deg"},

@@ -44,6 +44,9 @@ class Ending(StrEnum):
     LIMIT_GRASP = "limit_grasp"
     #: Placed within the position tolerance; a joint limit holds the pointing.
     PLACEMENT_LIMIT = "placement_limit"
+    #: Fine positioning lost the cube or the berry with the grasp point last measured
+    #: inside the grasp workspace: the arm held still meanwhile.
+    LOST_GRASP = "lost_grasp"
 
 
 @dataclass(frozen=True)

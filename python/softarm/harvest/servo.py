@@ -402,15 +402,19 @@ class Servo:
         start = self.clock.now()
         watch.excuse_berry(start)  # the open-loop ramp needed no berry
         progress = Progress(start)
+        last: Aim | None = None  # this stage's last measured aim
         while True:
-            seen = self._look(watch, q, need_fix=goal.frozen is None)
+            try:
+                seen = self._look(watch, q, need_fix=goal.frozen is None)
+            except Fault as fault:
+                return self._lost_near(fault, q, axis, last, goal)
             if goal.frozen is not None:
                 seen = replace(seen, fix=BerryFix(goal.frozen, "held", seen.t - start))
             if seen.pose is None or seen.fix is None:
                 watch.log_step(stage, seen, q, None, None, False)
                 q = self._hold(q)
                 continue
-            aim = self._aim(seen, axis, goal.distance)
+            aim = last = self._aim(seen, axis, goal.distance)
             if goal.record_errors:  # the errors at the grasp
                 watch.record_grasp_errors(self._grasp_error(seen), aim.pointing)
             ended = self._settled_or_out_of_time(watch, stage, seen, q, axis, aim, goal, progress)
@@ -509,6 +513,22 @@ class Servo:
             retreat_from=q,
             grasp_error=err if goal.budget is not None else None,
         )
+
+    def _lost_near(
+        self, fault: Fault, q: FloatArray, axis: FloatArray, last: Aim | None, goal: ServoGoal
+    ) -> StageOutcome:
+        """Fine positioning that lost the cube or the berry (MARKER_LOST) with the grasp
+        point last measured inside the gripper's ±1 cm (``grasp_workspace``) grasps
+        where the arm is, as past the budget on the last axis (III-D): the loop held the
+        arm still while the marker was lost, a re-approach would need the marker it
+        lost, and the ripeness check at the grasp keeps the last word. Any other fault
+        is raised again."""
+        near = last is not None and last.error <= self.cfg.grasp_workspace
+        if fault.reason is not FaultReason.MARKER_LOST or goal.budget is None or not near:
+            raise fault
+        assert last is not None  # near
+        self.log.event("lost_grasp", t=self.clock.now(), error=last.error, detail=str(fault))
+        return StageOutcome(q, Ending.LOST_GRASP, axis)
 
     def _hold(self, q: FloatArray) -> FloatArray:
         """Keep commanding ``q`` (it also feeds the safety layer's watchdog) and wait;

@@ -60,6 +60,7 @@ _LEVELS = {
     "fine_budget": "WARN",
     "placement_limit": "WARN",
     "limit_grasp": "WARN",
+    "lost_grasp": "WARN",
 }
 
 
