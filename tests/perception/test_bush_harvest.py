@@ -9,19 +9,33 @@ import os
 
 import pytest
 
-from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+from softarm.harvest.sim_rig import SimRig, SimRigOptions, build_sim_rig
 from softarm.sim.render import RenderUnavailableError
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 
 @pytest.fixture(scope="module")
-def report() -> dict:
+def harvested() -> tuple[SimRig, dict]:
     try:
         rig = build_sim_rig(SimRigOptions(n_berries=4, seed=330, world="bush", unripe_fraction=0.3))
     except RenderUnavailableError as exc:
         pytest.skip(str(exc))
-    return rig.run().to_dict()
+    return rig, rig.run().to_dict()
+
+
+@pytest.fixture(scope="module")
+def report(harvested: tuple[SimRig, dict]) -> dict:
+    return harvested[1]
+
+
+def test_the_berries_picked_are_gone_from_the_pictures(harvested: tuple[SimRig, dict]) -> None:
+    rig, _ = harvested
+    assert rig.scene is not None and rig.gripper.delivered
+    world = rig.scene.world
+    left = world.c1_left(truth=True)
+    for tag in rig.gripper.delivered:
+        assert not world.labels.mask(left.geoms, "berry", tag).any()
 
 
 def test_the_report_says_what_the_markerless_harvest_did(report: dict) -> None:

@@ -120,3 +120,18 @@ def test_each_berrys_visible_share_is_the_renderers_measure_of_it() -> None:
                  and labels.instance[g] == tag]  # fmt: skip
         assert share == pytest.approx(renderer.visible_share("c1_left", geoms), abs=0.05)
     assert any(0.0 < s < 0.9 for s in shares.values())
+
+
+def test_a_picked_berry_leaves_the_picture_and_hides_nothing_any_more() -> None:
+    world = rendered_world(902, 8)
+    shares = world.berry_shares()
+    tag = max(shares, key=lambda t: shares[t])
+    world.remove_berry(tag)
+    left = world.c1_left(truth=True)
+    assert left.geoms is not None
+    assert not world.labels.mask(left.geoms, "berry", tag).any()
+    after = world.berry_shares(left)
+    assert after[tag] == 0.0
+    assert all(after[t] >= shares[t] - 1e-9 for t in shares if t != tag)
+    world.hide_arm()  # the arm's moves and a render's culling leave it removed
+    assert not world.labels.mask(world.c1_left(truth=True).geoms, "berry", tag).any()

@@ -167,6 +167,14 @@ class BushGripper(SimGripper):
         truth = self.scene.truth_of(tag_id)
         return truth if truth is not None and truth in self.on_bush else None
 
+    def open(self) -> None:
+        """Open (:meth:`SimGripper.open`); a berry delivered leaves the rendered bush
+        too, and with it what it hid from the cameras."""
+        delivered = len(self.delivered)
+        super().open()
+        for tag in self.delivered[delivered:]:
+            self.scene.world.remove_berry(tag)
+
 
 def harvest_bush(
     scene: BushScene,

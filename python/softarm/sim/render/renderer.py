@@ -124,6 +124,13 @@ class BushRenderer:
         self.model.geom_pos[self._leaves] = self._leaf_home
         self.model.geom_pos[self._leaves[inside]] = FAR_AWAY
 
+    def remove_berry(self, tag_id: int) -> None:
+        """Take berry ``tag_id`` off the bush for good (picked): its geoms join the
+        group no render draws."""
+        berry = (self.labels.kind == KINDS.index("berry")) & (self.labels.instance == tag_id)
+        self._groups[berry] = CULLED_GROUP
+        self.model.geom_group[berry] = CULLED_GROUP
+
     def set_arm(self, sections: Sequence[FloatArray], T_base_ee: FloatArray) -> None:
         """Draw the arm: ``sections`` are (ARM_SEGMENTS_PER_SECTION + 1, 3) points along
         each section's centre line (base frame), ``T_base_ee`` the end effector; the

@@ -153,6 +153,10 @@ class RenderedBush:
         """An empty view of the bush (no arm)."""
         self.renderer.hide_arm()
 
+    def remove_berry(self, tag_id: int) -> None:
+        """Take berry ``tag_id`` off the bush for good (picked): no frame draws it."""
+        self.renderer.remove_berry(tag_id)
+
     def c1(self, truth: bool = False) -> tuple[RenderedFrame, RenderedFrame]:
         """C1's (left, right) images; with ``truth`` also depth and geom ids."""
         return self._frame("c1_left", "c1", truth), self._frame("c1_right", "c1", truth)
