@@ -41,7 +41,7 @@ def test_the_berries_picked_are_gone_from_the_pictures(harvested: tuple[SimRig, 
 def test_the_report_says_what_the_markerless_harvest_did(report: dict) -> None:
     assert report["world"] == "bush"
     assert {"ripe_in_reach", "ripe_harvested", "unripe_picked", "cane_map"} <= set(report)
-    assert set(report["cane_map"]) == {"median_mm", "p95_mm", "coverage", "length_m"}
+    assert set(report["cane_map"]) == {"median_mm", "p95_mm", "coverage", "precision", "length_m"}
     shares = report["ripe_never_mapped_c1_share"]  # how much of each C1 had to find it by
     assert len(shares) == report["ripe_never_mapped"] and all(0 <= s <= 1 for s in shares)
     for berry in report["berries"]:

@@ -16,10 +16,13 @@ def _report(
     length_m: float | None,
     canes: list[Any] | None = None,
     unmapped_shares: list[float] | None = None,
+    precision: float | None = None,
 ) -> dict:
     cane_map: dict[str, Any] = {"median_mm": 1.0, "p95_mm": 3.0, "coverage": coverage}
     if length_m is not None:
         cane_map["length_m"] = length_m
+    if precision is not None:
+        cane_map["precision"] = precision
     return {
         "ripe_in_reach": 2, "ripe_harvested": 2, "ripe_never_mapped": 0, "unripe_picked": 0,
         "branch_contact_steps": 0, "sim_time_s": 4.0, "cane_map": cane_map,
@@ -48,3 +51,9 @@ def test_never_mapped_berries_under_a_tenth_in_view_count_as_hidden() -> None:
     assert figures["never_mapped_hidden_from_c1"] == 2
     # A report that does not record the shares makes the count unknown, not 0.
     assert np.isnan(summarise([_report(1.0, 1.0)])["never_mapped_hidden_from_c1"])
+
+
+def test_the_maps_precision_is_their_mean_and_unknown_when_a_report_lacks_it() -> None:
+    both = [_report(1.0, 1.0, precision=0.8), _report(1.0, 1.0, precision=1.0)]
+    assert summarise(both)["cane_precision"] == pytest.approx(0.9)
+    assert np.isnan(summarise([*both, _report(1.0, 1.0)])["cane_precision"])

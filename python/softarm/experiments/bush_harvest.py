@@ -62,6 +62,7 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
         "cane_p95_mm": statistics.median(p95s) if p95s else float("nan"),
         "cane_coverage": _length_weighted_coverage(reports),
         "cane_coverage_per_bush": statistics.fmean(m["coverage"] for m in maps),
+        "cane_precision": _mean_precision(maps),
         "sim_s_per_berry": sum(r["sim_time_s"] for r in reports)
         / max(sum(len(r["berries"]) for r in reports), 1),
     }
@@ -76,6 +77,14 @@ def _hidden_from_c1(reports: list[dict[str, Any]]) -> float:
         return float("nan")
     shares = [s for r in reports for s in r["ripe_never_mapped_c1_share"]]
     return float(sum(s < HIDDEN_SHARE for s in shares))
+
+
+def _mean_precision(maps: list[dict[str, Any]]) -> float:
+    """The maps' mean precision (the share of fitted length near a true cane); NaN when
+    older reports do not record it."""
+    if any("precision" not in m for m in maps):
+        return float("nan")
+    return statistics.fmean(float(m["precision"]) for m in maps)
 
 
 def _length_weighted_coverage(reports: list[dict[str, Any]]) -> float:

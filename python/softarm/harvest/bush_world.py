@@ -228,6 +228,6 @@ def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
         "cane_map": {
             k: v
             for k, v in cane_map_error(scene.bush_map.canes, scene.bush.branches).items()
-            if k in ("median_mm", "p95_mm", "coverage", "length_m")
+            if k in ("median_mm", "p95_mm", "coverage", "precision", "length_m")
         },
     }

@@ -37,8 +37,8 @@ class SurveySettings:
     views of two pairs; ``margin``: least gap (m) of the model arm to the known canes
     at each view; ``samples``, ``seed``: the random configurations drawn."""
 
-    pairs: int = 2
-    baseline: float = 0.06
+    pairs: int = 3
+    baseline: float = 0.04
     distance: tuple[float, float] = (0.12, 0.5)
     max_angle: float = 40.0
     spread: float = 0.06
