@@ -118,9 +118,12 @@ def test_a_berry_only_the_survey_canes_block_is_planned_around_the_fallback_cane
     ]
     every = Clearance(c1.arm, [*c1.canes, *wall], c1.offset)
     planner.clearance = every
+    told: list[bool] = []
+    planner.on_plan = told.append
     assert planner.plan(q, berry, current) is None and not planner.fell_back
     planner.fallback = c1
     plan = planner.plan(q, berry, current)
     assert plan is not None and planner.fell_back and planner.clearance is every
+    assert told == [False, True]  # each plan says whether it fell back
     planner.clearance = c1
     _assert_ramps_clear(planner, q, plan[0])

@@ -113,3 +113,13 @@ def test_the_stack_avoids_the_canes_it_is_told_of(
     # The canes known before stay the planner's fallback (ModelIK.plan).
     assert stack.planner.fallback is not None and stack.planner.fallback.canes == before
     assert stack.controller.obstacles == ([cane] if avoid else [])
+    # A plan around the fallback's canes alone is followed avoiding those alone (the
+    # refined map's canes it goes through would hold the arm); the next plan, all again.
+    assert stack.planner.on_plan is not None
+    stack.planner.on_plan(True)
+    if avoid:
+        assert stack.controller.obstacles == before
+        assert stack.controller.clearance is stack.planner.fallback
+    stack.planner.on_plan(False)
+    assert stack.controller.obstacles == ([cane] if avoid else [])
+    assert stack.controller.clearance is (stack.clearance if avoid else None)

@@ -15,7 +15,7 @@ along the final approach to the berry and at the grasp.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -90,6 +90,9 @@ class ModelIK:
         self.fallback: Clearance | None = None
         #: Whether the last plan cleared only the fallback's canes.
         self.fell_back = False
+        #: Told after each plan whether it fell back (ControlStack.know_canes: the loop
+        #: then follows it with the canes it cleared).
+        self.on_plan: Callable[[bool], None] | None = None
 
     def plan(
         self,
@@ -111,7 +114,7 @@ class ModelIK:
         With a ``fallback``, a berry that no plan clear of every cane reaches is planned
         clear of the fallback's canes, C1's own, as it is without C2's survey
         (``fell_back``): a phantom among the survey's canes would otherwise cost the
-        berry. The closed loop still keeps the arm from every cane, the survey's too."""
+        berry. ``on_plan`` is told whether it fell back."""
         self.fell_back = False
         found = self._plan(q, berry, current, avoid)
         if found is None and self.fallback is not None and self.clearance is not None:
@@ -121,6 +124,8 @@ class ModelIK:
             finally:
                 self.clearance = every
             self.fell_back = found is not None
+        if self.on_plan is not None:
+            self.on_plan(self.fell_back)
         return found
 
     def _plan(

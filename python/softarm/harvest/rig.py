@@ -100,12 +100,25 @@ class ControlStack:
     def know_canes(self, canes: Sequence[PolynomialCurve]) -> None:
         """From now on avoid ``canes`` (a refined map) instead: the planner's and the way
         check's clearance, and the controller's obstacles unless it avoids none. The
-        canes known before stay the planner's fallback (:meth:`ModelIK.plan`)."""
+        canes known before stay the planner's fallback (:meth:`ModelIK.plan`), and a
+        plan that falls back on them is followed avoiding them alone (:meth:`_follow`)."""
         c = self.clearance
         self.planner.fallback = Clearance(c.arm, c.canes, c.offset)
+        self.planner.on_plan = self._follow
         c.canes = list(canes)
+        self._follow(False)
+
+    def _follow(self, fell_back: bool) -> None:
+        """After each plan, the canes the loop keeps the arm from until the next one
+        (the resolver's obstacles and the way check, unless the controller avoids
+        none): those the plan cleared. A plan around the fallback's canes alone goes
+        through a cane of the refined map, on the model; the way check would hold the
+        arm on its planned way before that cane until the placement timed out."""
+        fallback = self.planner.fallback
+        use = fallback if fell_back and fallback is not None else self.clearance
         if self.controller.clearance is not None:
-            self.controller.obstacles = list(canes)
+            self.controller.clearance = use
+            self.controller.obstacles = list(use.canes)
 
 
 def gains_over(base: Gains, values: Mapping[str, Any]) -> Gains:
