@@ -204,3 +204,29 @@ def test_unripe_detections_place_nothing() -> None:
         T = _c2(np.array([0.015 * k, 0.15, 0.32]))
         vision._place_unplaced([_det(_seen(T, C2, FRUIT), 12.0, ripe=False)], T)
     assert bush_map.berries == [] and bush_map.unplaced[0].points == []
+
+
+def test_a_survey_view_places_a_waiting_fruit_and_costs_nothing_without_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import softarm.perception.bush_vision as bush_vision
+
+    frames: list[np.ndarray] = []  # what the detector was given, and where C2 stood
+    poses = [_c2(np.array([0.015 * k, 0.15, 0.32])) for k in range(CROSSINGS)]
+
+    def detect(image: np.ndarray, camera: CameraModel, **_: object) -> list[BerryDetection]:
+        frames.append(image)
+        return [_det(_seen(poses[len(frames) - 1], C2, FRUIT), 12.0)]
+
+    monkeypatch.setattr(bush_vision, "detect_berries", detect)
+    image = np.zeros((8, 8, 3), np.uint8)
+    bush_map = BushMap()
+    vision = _vision(bush_map)
+    vision.place_from_view(image, poses[0])
+    assert frames == []  # nothing waits to be placed: no detection run
+    bush_map.note_unplaced([_line()])
+    for T in poses:
+        vision.place_from_view(image, T)
+    (berry,) = bush_map.berries
+    np.testing.assert_allclose(berry.position, FRUIT, atol=1e-6)
+    assert len(frames) == CROSSINGS and bush_map.unplaced == []

@@ -4,7 +4,9 @@
 turned into cane points (:func:`~softarm.perception.cane_views.view_pair_points`) and
 fitted with those of C1's view (:meth:`~softarm.harvest.hw_perception.StereoC1.
 refit_canes`); the planner, the resolver and the way check avoid the canes of that map
-from then on (:meth:`~softarm.harvest.rig.ControlStack.know_canes`).
+from then on (:meth:`~softarm.harvest.rig.ControlStack.know_canes`). The views also place
+the ripe fruit C1 saw but could not (:meth:`~softarm.perception.bush_vision.BushVision.
+place_from_view`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from softarm.harvest.hw_perception import StereoC1
 from softarm.harvest.machine import HarvestMachine
 from softarm.harvest.rig import ControlStack
 from softarm.harvest.survey import SurveySettings, plan_survey
+from softarm.perception.bush_vision import BushVision
 from softarm.perception.cane_metrics import DEFAULT_REACH
 from softarm.perception.cane_views import pixel_size, view_pair_points
 from softarm.vision.two_cameras import CameraVision
@@ -57,6 +60,10 @@ class CaneSurvey:
         )  # fmt: skip
         views = self.machine.survey(plan, self.vision.view_c2)
         footprint = pixel_size(self.c1.stereo, centre)
+        if isinstance(self.vision, BushVision):  # the views also place what C1 could not
+            for pair in views:
+                for image, T_base_c2 in pair:
+                    self.vision.place_from_view(image, T_base_c2)
         points = []
         for (first, T_first), (second, T_second) in views:
             try:

@@ -95,6 +95,14 @@ class BushVision(CameraVision):
             return None
         return track.fix(found[0], T_base_c2, self.model2)
 
+    def place_from_view(self, image: Any, T_base_c2: FloatArray) -> None:
+        """Place what of the map's unplaced fruit C2 sees in ``image``, taken at
+        ``T_base_c2`` (the cane survey's views: they face the bush from where the
+        berries' approaches seldom take C2)."""
+        if self.bush_map.unplaced:
+            dets = detect_berries(image, self.model2, settings=self.settings)
+            self._place_unplaced(dets, T_base_c2)
+
     def _place_unplaced(self, dets: list[BerryDetection], T_base_c2: FloatArray) -> None:
         """Add the crossings of C2's ripe detections that are no mapped berry with the
         map's sight lines; place each line whose crossings agree."""
