@@ -52,3 +52,43 @@ def test_a_berry_lost_from_view_is_tried_once_more_after_the_others() -> None:
 def test_other_faults_are_not_retried_and_a_stopping_fault_ends_the_run() -> None:
     assert _run({0: [FaultReason.UNREACHABLE]}) == [1, 0, 2]
     assert _run({0: [FaultReason.SAFETY_STOP]}, stop_on=(FaultReason.SAFETY_STOP,)) == [1, 0]
+
+
+def test_with_nothing_left_place_more_may_add_fruit_and_is_asked_until_it_has_none() -> None:
+    # Two waiting fruit: the first view places one (tried next), the second places
+    # nothing; then there is none left to look for, and the loop ends.
+    bush_map = _Map([0.1])
+    placed = [True, False]
+    asked: list[int] = []
+    order: list[int] = []
+
+    def place_more() -> bool:
+        asked.append(len(order))
+        if not placed:
+            return False
+        if placed.pop(0):
+            bush_map.entries.append(_Entry(len(bush_map.entries), np.array([0.5, 0.3, 0.3])))
+        return True
+
+    def run_berry(target: BerryTarget) -> BerryResult:
+        order.append(target.tag_id)
+        return BerryResult(target.tag_id, harvested=True)
+
+    harvest_map(lambda: None, bush_map, run_berry, 10, place_more=place_more)  # type: ignore[arg-type]
+    assert order == [0, 1]
+    assert asked == [1, 2, 2]  # after each berry with none left, until it says no
+
+
+def test_place_more_takes_a_look_of_the_rounds() -> None:
+    # One round: the berry; the views that follow have no look left to be used by.
+    calls: list[int] = []
+    order: list[int] = []
+
+    def run_berry(target: BerryTarget) -> BerryResult:
+        order.append(target.tag_id)
+        return BerryResult(target.tag_id, harvested=True)
+
+    harvest_map(
+        lambda: None, _Map([0.1]), run_berry, 1, place_more=lambda: bool(calls.append(1)) or True
+    )  # type: ignore[arg-type]
+    assert order == [0] and calls == []
