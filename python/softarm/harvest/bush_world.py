@@ -182,12 +182,10 @@ def harvest_bush(
     delivered: list[int],
     on_berry: Callable[[int, BerryResult], None] | None = None,
     on_look: Callable[[], None] | None = None,
-    place_more: Callable[[], bool] | None = None,
 ) -> HarvestReport:
     """Pick the map's ripe berries one by one (:func:`~softarm.harvest.map_harvest.
     harvest_map`, the loop the arm runs), each result judged against the true bush;
-    ``on_look()`` after each C1 look (the rig logs the map); ``place_more`` as
-    :func:`~softarm.harvest.map_harvest.harvest_map` takes it."""
+    ``on_look()`` after each C1 look (the rig logs the map)."""
     report = HarvestReport()
     index: dict[int, int] = {}  # map berry -> its place in the report (a retry replaces)
 
@@ -209,7 +207,7 @@ def harvest_bush(
     rounds = len(scene.bush.berries) + 8
     harvest_map(
         scene.look, scene.bush_map, run_berry, rounds, judged, stop_on=FAULTS_THAT_STOP,
-        on_look=on_look, place_more=place_more,
+        on_look=on_look,
     )  # fmt: skip
     report.extra.update(_bush_extra(scene, delivered))
     return report

@@ -26,7 +26,6 @@ from softarm.hardware.protocols import PressureBank
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.actuator import PressureMap
 from softarm.harvest.cane_survey import CaneSurvey
-from softarm.harvest.fruit_views import FruitViews
 from softarm.harvest.hw_devices import DeviceDrivers, Devices
 from softarm.harvest.hw_perception import StereoC1, stereo_camera
 from softarm.harvest.interfaces import BerryTarget, Clock
@@ -61,9 +60,6 @@ class HardwareRig:
     #: C2's survey of the canes C1 fitted, flown at the start of :meth:`run`; None
     #: without perceived canes or with ``survey = false``.
     survey: CaneSurvey | None = None
-    #: C2's views of the fruit C1 could not place, flown once nothing else is left
-    #: (markerless only).
-    fruit_views: FruitViews | None = None
 
     def close(self) -> None:
         """Vent the arm and release every device."""
@@ -80,11 +76,9 @@ class HardwareRig:
             return self.machine.run([BerryTarget(10 + i) for i in range(berries)])
         report = HarvestReport()
         c1, machine = self.c1, self.machine
-        views = self.fruit_views
         report.berries = harvest_map(
             c1.look, c1.bush_map, machine.run_berry, berries, stop_on=FAULTS_THAT_STOP,
             on_look=lambda: machine.log_map(c1.bush_map),
-            place_more=None if views is None else views.run,
         )  # fmt: skip
         last = report.berries[-1].fault if report.berries else None
         report.stopped = last if last in FAULTS_THAT_STOP else None
@@ -145,8 +139,7 @@ def build_hardware_rig(
         if c1 is not None and parts is not None and config.perception is not None:
             if config.perception.survey:
                 survey = CaneSurvey(machine, control, c1, vision, parts, CANE_REACH)
-        views = FruitViews(machine, control, vision) if isinstance(vision, BushVision) else None
-        return HardwareRig(machine, stack.pop_all(), c1, markerless, survey, views)
+        return HardwareRig(machine, stack.pop_all(), c1, markerless, survey)
     raise AssertionError("unreachable")  # pragma: no cover  (the with block returns)
 
 

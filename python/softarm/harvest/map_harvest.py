@@ -28,14 +28,11 @@ def harvest_map(
     on_result: Callable[[MappedBerry, BerryResult], None] | None = None,
     stop_on: Collection[FaultReason] = (),
     on_look: Callable[[], None] | None = None,
-    place_more: Callable[[], bool] | None = None,
 ) -> list[BerryResult]:
     """Each berry's result, in the order tried: at most ``rounds`` looks (``look``
     merges one C1 view into ``bush_map``), each followed by the leftmost ripe berry not
     tried yet; ``on_look()`` after each look, ``on_result(entry, result)`` after each
-    berry; a fault in ``stop_on`` ends it. With none left, ``place_more()`` may place
-    fruit C1 could not (:class:`~softarm.harvest.fruit_views.FruitViews`): while it
-    says it tried, the loop looks again."""
+    berry; a fault in ``stop_on`` ends it."""
     results: list[BerryResult] = []
     tried: set[int] = set()
     lost: set[int] = set()  # lost from view once: one more try
@@ -46,8 +43,6 @@ def harvest_map(
         ripe = bush_map.ripe()
         todo = [b for b in ripe if b.id not in tried] or [b for b in ripe if b.id in lost]
         if not todo:
-            if place_more is not None and place_more():
-                continue
             break
         entry = min(todo, key=lambda b: b.position[0])  # left to right
         lost.discard(entry.id)

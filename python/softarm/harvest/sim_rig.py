@@ -35,7 +35,6 @@ from softarm.harvest.dry_run import (
     write_rig_files,
 )
 from softarm.harvest.frame_files import FrameRecorder
-from softarm.harvest.fruit_views import FruitViews
 from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
@@ -155,8 +154,6 @@ class SimRig:
     recorder: FrameRecorder | None = None
     #: C2's survey of the canes (``world = "bush"`` with ``survey``), flown first.
     survey: CaneSurvey | None = None
-    #: C2's views of the fruit C1 could not place (``world = "bush"``), flown last.
-    fruit_views: FruitViews | None = None
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
         """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
@@ -169,11 +166,9 @@ class SimRig:
             scene = self.scene
             if self.survey is not None:
                 self.survey.run()
-            views = self.fruit_views
             report = harvest_bush(
                 scene, self.machine.run_berry, self.gripper.delivered, on_berry,
                 on_look=lambda: self.machine.log_map(scene.bush_map),
-                place_more=None if views is None else views.run,
             )  # fmt: skip
             return self._finish(report)
         report = HarvestReport()
@@ -248,15 +243,12 @@ def build_sim_rig(
         n_actuators=model.n_actuators, config=cfg, log=HarvestLog(o.log_path),
         ground_truth=gripper, planner=stack.planner,
     )  # fmt: skip
-    survey = views = None
+    survey = None
     if scene is not None and o.survey:
         survey = CaneSurvey(machine, stack, scene.stereo_c1(), vision, parts, CANE_REACH)
-    if scene is not None and isinstance(vision, BushVision):
-        views = FruitViews(machine, stack, vision)
     return SimRig(
-        bush, model, plant, clock, bank, vision, gripper, watch, machine, scene, recorder,
-        survey, views,
-    )  # fmt: skip
+        bush, model, plant, clock, bank, vision, gripper, watch, machine, scene, recorder, survey
+    )
 
 
 def control_inputs(o: SimRigOptions, model: softarm.SoftArm) -> ControlInputs:
