@@ -220,7 +220,8 @@ class RenderedBush:
         """Each berry's visible share in C1's left eye as the arm is drawn now (tag id
         -> its pixels in the whole scene over those of its outline alone, 0 when out of
         the picture); ``seen``: that eye's truth frame when already rendered."""
-        seen = seen or self.c1_left(truth=True)
+        if seen is None:
+            seen = self.c1_left(truth=True)
         outline = self.berry_outlines()
         assert seen.geoms is not None and outline.geoms is not None  # asked for
         shares = {}
