@@ -523,10 +523,10 @@ class Servo:
         arm still while the marker was lost, a re-approach would need the marker it
         lost, and the ripeness check at the grasp keeps the last word. Any other fault
         is raised again."""
-        near = last is not None and last.error <= self.cfg.grasp_workspace
-        if fault.reason is not FaultReason.MARKER_LOST or goal.budget is None or not near:
+        if fault.reason is not FaultReason.MARKER_LOST or goal.budget is None or last is None:
             raise fault
-        assert last is not None  # near
+        if last.error > self.cfg.grasp_workspace:
+            raise fault
         self.log.event("lost_grasp", t=self.clock.now(), error=last.error, detail=str(fault))
         return StageOutcome(q, Ending.LOST_GRASP, axis)
 
