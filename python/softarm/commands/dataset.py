@@ -57,7 +57,9 @@ def run(args: argparse.Namespace) -> int:
     """Exit 0 once every image and annotations.json are written."""
     from softarm.commands._progress import Progress
     from softarm.sim.render.dataset import ray_workers, write_dataset
+    from softarm.sim.render.gl_check import require_offscreen_gl
 
+    require_offscreen_gl()  # one line naming the fix, before OUT is created
     rig = default_rig(args.scale)
     workers = ray_workers(args.images, args.workers)
     start = time.perf_counter()

@@ -36,9 +36,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 @drives_arm("demo")
 def run(args: argparse.Namespace) -> int:
     """Harvest, print a line per berry and the summary, save the figures."""
-    from softarm.commands.harvest import configure_logging, run_sim
+    from softarm.commands.harvest import check_render, configure_logging, run_sim
 
     options = plant_options(args)  # a bad --plant/--identified fails before any output
+    check_render(args.world == "bush")  # so does a missing renderer
     if args.world == "bush":
         from softarm.commands.harvest import BUSH_UNRIPE_FRACTION
 

@@ -137,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     check_dry_run(args)
+    check_render(args.sim and args.world == "bush")
     if args.survey is not None and not (args.sim and args.world == "bush"):
         raise ParameterError(
             "--survey/--no-survey: for the rendered bush (--sim --world bush); "
@@ -157,6 +158,16 @@ def run(args: argparse.Namespace) -> int:
             gains=gains, view=args.view, record=args.record, bag=args.bag, args=args, **options,
         )  # fmt: skip
     return _run_hardware(args)
+
+
+def check_render(bush: bool) -> None:
+    """Before the banner and any output folder: the rendered bush (``bush``) needs MuJoCo
+    and an offscreen OpenGL context (a one-line :class:`RenderUnavailableError` naming
+    the fix, exit status 2, instead of MuJoCo's traceback on the first frame)."""
+    if bush:
+        from softarm.sim.render.gl_check import require_offscreen_gl
+
+        require_offscreen_gl()
 
 
 def check_view(view: bool, record: Path | None) -> None:

@@ -54,6 +54,10 @@ def simulate(
     from softarm.harvest.header import HEADER, header_record, sim_settings
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
+    if options.get("world") == "bush":  # before the log: a typed error, not MuJoCo's
+        from softarm.sim.render.gl_check import require_offscreen_gl
+
+        require_offscreen_gl()
     rig_options = SimRigOptions(n_berries=berries, seed=seed, log_path=log, **options)
     rig = build_sim_rig(rig_options)
     header = header_record(

@@ -145,7 +145,7 @@ class CharucoScene:
         if size not in self._renderers:
             try:
                 self._renderers[size] = self._mj.Renderer(self.model, size[1], size[0])
-            except (OSError, AttributeError, RuntimeError) as exc:  # no GL context
+            except (OSError, AttributeError, RuntimeError, self._mj.FatalError) as exc:  # no GL
                 raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
         return self._renderers[size]
 

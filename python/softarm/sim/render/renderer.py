@@ -48,7 +48,7 @@ class RenderUnavailableError(SoftarmError):
 
 
 HOW_TO_ENABLE = (
-    "the rendered bush needs MuJoCo (pip install mujoco) and an offscreen OpenGL: set "
+    "the rendered bush needs MuJoCo (pip install 'softarm[render]') and an offscreen OpenGL: set "
     "MUJOCO_GL=egl with an EGL driver (Mesa's libegl1 on a machine without a GPU, the "
     "NVIDIA driver on one with it) or MUJOCO_GL=osmesa; or use --world tags"
 )
@@ -280,7 +280,7 @@ class BushRenderer:
             self.model.vis.global_.offheight = max(self.model.vis.global_.offheight, h)
             try:
                 self._renderers[(w, h)] = self._mj.Renderer(self.model, h, w)
-            except (OSError, AttributeError, RuntimeError) as exc:  # no GL context
+            except (OSError, AttributeError, RuntimeError, self._mj.FatalError) as exc:  # no GL
                 raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
         return self._renderers[(w, h)]
 
