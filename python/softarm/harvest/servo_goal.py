@@ -63,7 +63,10 @@ class Progress:
         """A step at ``t``: a new best when ``error`` beats it by ``stall_progress``."""
         if error < self.best - stall_progress:
             self.best, self.best_t = error, t
-        self.saturated_since = (self.saturated_since or t) if saturated else None
+        if not saturated:
+            self.saturated_since = None
+        elif self.saturated_since is None:  # not `or`: a saturation from t = 0.0 is one
+            self.saturated_since = t
 
     def stalled(self, t: float, stall_time: float) -> bool:
         """Saturated, and without progress, for longer than ``stall_time``."""
