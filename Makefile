@@ -9,6 +9,10 @@ export PATH := $(abspath $(VENV))/bin:$(PATH)
 export MPLBACKEND ?= Agg
 # Offscreen OpenGL for the rendered bush (MuJoCo): EGL, Mesa's software rasteriser without a GPU.
 export MUJOCO_GL ?= egl
+# maturin develop hands pip every requirement of every extra; pip says "Ignoring X: markers
+# 'extra == ...' don't match your environment" for each one not asked for (about 20
+# lines). Quiet pip prints warnings and errors only; cargo's progress still shows.
+export PIP_QUIET ?= 1
 
 .PHONY: help venv dev dev-all install docs docs-site test test-rust test-python wheel demo lint fmt bench clean
 
@@ -95,6 +99,9 @@ docs-site: venv
 
 demo: install
 	$(VENV)/bin/softarm demo
+	@echo
+	@echo "softarm is installed in $(VENV), not on your PATH: run $(VENV)/bin/softarm,"
+	@echo "or first \`source $(VENV)/bin/activate\` and then \`softarm --help\`."
 
 lint: dev
 	cargo fmt --all -- --check
