@@ -34,15 +34,28 @@ TAU_TOL, HYST_TOL, GAIN_TOL = 0.10, 0.30, 0.01
 def test_cli_identifies_a_lagging_hysteretic_plant(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    # The truth comes from what this test gives the command (the plant file and the
+    # seed), never from the file the command writes: an `identify --sim` that ignored
+    # --plant (the default plant: 0.08 s, 1.5 psi) must fail here.
+    tau, hysteresis = 0.4, 3.0
     plant = tmp_path / "plant.toml"
-    plant.write_text("[plant]\npressure_tau = 0.4\nhysteresis_psi = 3.0\n", encoding="utf-8")
+    plant.write_text(
+        f"[plant]\npressure_tau = {tau}\nhysteresis_psi = {hysteresis}\n", encoding="utf-8"
+    )
     out = tmp_path / "id.json"
     assert (
         main(["identify", "--sim", "--plant", str(plant), "--seed", "2024", "--out", str(out)]) == 0
     )
     assert "saved" in capsys.readouterr().out
     found = load_identified(out)
-    truth = found.metadata["sim_truth"]
+    # The per-actuator gains (3 % spread) are drawn from the seed: a rig of its own.
+    gains = SimIdentificationRig(PlantConfig(pressure_tau=tau, hysteresis_psi=hysteresis), 2024)
+    n = gains.arm.n
+    truth = {
+        "tau_s": [tau] * n,
+        "hysteresis_psi": [hysteresis] * n,
+        "metres_per_psi": gains.truth()["metres_per_psi"],
+    }
     assert found.metadata["arm_time_s"] <= 120.0
     assert found.metadata["max_sent_psi"] <= 70.0
     assert found.control_period_s == 0.05
