@@ -11,7 +11,7 @@ median simulated seconds per berry. Run it on seeds the controller was not tuned
 
 The table of docs/harvest.md comes from its saved per-bush reports:
 
-    python examples/harvest_plants.py --summarise docs/data/plants_eighth_boundary_fresh680.json
+    python examples/harvest_plants.py --summarise runs/plants_680.json
 """
 
 from __future__ import annotations
@@ -130,7 +130,7 @@ def main() -> None:
         "--summarise",
         type=Path,
         metavar="REPORTS",
-        help="print the table of a saved reports.json (e.g. docs/data/plants_*.json); run nothing",
+        help="print the table of a saved reports.json (the --out of a run); run nothing",
     )
     args = ap.parse_args()
     if args.summarise is not None:

@@ -3,7 +3,7 @@
 unripe picked, true fine-positioning error, contacts, the cane map; and the wall time
 per berry beside the tag world's on the same seeds when its reports and times are given.
 
-    python -m softarm.experiments.bush_harvest docs/data/perception/bush_harvest_700-709
+    python -m softarm.experiments.bush_harvest runs/bush_harvest_700-709
 
 ``--run FIRST LAST BUSH_DIR TAG_DIR`` makes those folders first: for each seed, the
 bush world's harvest and then the tag world's on the same seed (so the two share the
@@ -13,7 +13,7 @@ cane survey, C1's canes only; ``--jobs N``: N seeds at once, on a machine with t
 cores for it)::
 
     MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 770 779 \
-        docs/data/perception/bush_harvest_770-779 docs/data/perception/tag_harvest_770-779
+        runs/bush_harvest_770-779 runs/tag_harvest_770-779
 """
 
 from __future__ import annotations
