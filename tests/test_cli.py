@@ -11,10 +11,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import softarm
-from softarm import cli
+from softarm import _core, cli
 from softarm.commands._args import output_dir, output_file
 from softarm.commands._format import rounded
 
@@ -159,19 +160,71 @@ def test_every_registered_command_imports() -> None:
         importlib.import_module(module)
 
 
-def test_plan_json(capsys: pytest.CaptureFixture[str]) -> None:
+def test_plan_json(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    from softarm.planning import scenarios
+
+    planned: list[scenarios.Result] = []
+    original = scenarios.compare
+
+    def compare(name: str, repeats: int = 20) -> list[scenarios.Result]:
+        planned.extend(original(name, repeats))
+        return planned
+
+    monkeypatch.setattr(scenarios, "compare", compare)
     status, out, _ = run_cli(["plan", "--scenario", "line", "--repeats", "1", "--json"], capsys)
     doc = json.loads(out)
     assert doc["scenario"] == "line" and len(doc["results"]) == 5
-    assert doc["results"][0]["method"] == "proposed"
-    assert status == (0 if doc["results"][0]["reached"] else 1)
+    proposed = doc["results"][0]
+    assert proposed["method"] == "proposed"
+    # The proposed plan reached the goal: judged on the geometry of the path it planned,
+    # not on its own flag. The arm starts straight, its tip 2 m from the goal.
+    line, plan = scenarios.load("line"), planned[0].plan
+    tip = lambda q: line.chain.forward(q)[:3, 3]  # noqa: E731
+    assert np.linalg.norm(tip(plan.path[0]) - line.goal) > 1.0
+    assert np.linalg.norm(tip(plan.path[-1]) - line.goal) <= 0.01  # the goal tolerance
+    clearance = _core.path_clearance(line.chain, plan.path, list(line.curves), 8)
+    assert clearance >= scenarios.COLLISION_DISTANCE
+    assert proposed["reached"] and not proposed["collision"] and status == 0
+    assert proposed["iterations"] == plan.iterations == len(plan.path) - 1
+    assert proposed["min_clearance_m"] == pytest.approx(clearance, abs=1e-4)
 
 
 def test_bench_json(capsys: pytest.CaptureFixture[str]) -> None:
+    import platform
+
     status, out, _ = run_cli(["bench", "--seconds", "0.001", "--no-vision", "--json"], capsys)
     assert status == 0
-    rows = json.loads(out)["timings"]
-    assert rows and all(r["median_s"] > 0 and r["calls"] > 0 for r in rows)
+    doc = json.loads(out)
+    assert doc["python"] == platform.python_version()
+    rows = doc["timings"]
+    # Every operation timed, none of OpenCV's (--no-vision), each over at least the three
+    # batches the median is taken of.
+    assert [r["operation"] for r in rows] == [
+        "SoftArm.forward",
+        "SoftArm.jacobian",
+        "SoftArm.forward_batch (10k poses)",
+        "Resolver.step (hybrid, eq. 20)",
+        "closest(arc chain, 6 curves)",
+        "PotentialFieldPlanner.plan (sim 3)",
+    ]
+    assert all(r["median_s"] > 0 and r["calls"] >= 3 for r in rows)
+
+
+def test_bench_times_operations_that_do_their_work() -> None:
+    """What `bench` times gives the right answers: a timing of a call that fails or
+    returns nothing would say nothing of the operation."""
+    from softarm.commands.bench import _cases
+
+    results = {name: fn() for name, fn in _cases(with_vision=True)}
+    assert results["SoftArm.forward"].shape == (4, 4)
+    assert results["SoftArm.jacobian"].shape == (6, 9)
+    assert results["SoftArm.forward_batch (10k poses)"].shape == (10_000, 4, 4)
+    step = results["Resolver.step (hybrid, eq. 20)"]
+    assert step.q.shape == (9,) and np.all(np.isfinite(step.q))
+    assert step.position_error > 0.0  # the goal is 3 mm per channel away
+    assert len(results["closest(arc chain, 6 curves)"]) == 6
+    assert results["PotentialFieldPlanner.plan (sim 3)"].reached
+    assert results["MarkerCube.estimate_pose (1280x720)"] is not None
 
 
 def test_rounded() -> None:
