@@ -82,8 +82,12 @@ class BerryDetection:
 
 
 def ripe_by_votes(ripe_votes: float, sightings: int) -> bool:
-    """Ripe when most of a fruit's ``sightings`` said so (summed :attr:`BerryDetection.
-    ripe_vote`); the NIR sensor decides at the grasp."""
+    """Ripe when at least half of a fruit's ``sightings`` said so (summed
+    :attr:`BerryDetection.ripe_vote`); the NIR sensor decides at the grasp.
+
+    A tie (``ripe_votes`` exactly half of ``sightings``, compared as summed) is ripe: the
+    NIR sensor has the last word, so a tie costs at most one approach, where calling it
+    unripe would leave a fruit that may be ripe unpicked without a look."""
     return ripe_votes >= 0.5 * sightings
 
 
