@@ -10,9 +10,11 @@ its report must fail before the run, not after it (a failed check creates nothin
 from __future__ import annotations
 
 import argparse
+import difflib
 import math
 import os
 import re
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -112,8 +114,54 @@ class Parser(argparse.ArgumentParser):
             action.complete = _COMPLETE_DIR  # type: ignore[attr-defined]
         return super()._add_action(action)
 
+    def parse_known_args(  # type: ignore[override]
+        self, args: Any = None, namespace: Any = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        # What was typed, for error()'s "did you mean" (a subcommand's parser gets its own).
+        self._typed = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
+
     def error(self, message: str) -> NoReturn:
+        unknown, near = _misspelt(self, getattr(self, "_typed", []))
+        if near is not None:
+            # Before "the following arguments are required: COMMAND", which a misspelt
+            # --version gets: the typo is the error.
+            message = f"unrecognized argument {unknown}; did you mean {near}?"
+        elif (choice := _INVALID_CHOICE.search(message)) is not None:
+            options = re.findall(r"'([^']*)'", choice["options"])
+            near = next(iter(difflib.get_close_matches(choice["typed"], options, n=1)), None)
+            message += f"; did you mean {near!r}?" if near else ""
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+_INVALID_CHOICE = re.compile(r"invalid choice: '(?P<typed>[^']*)' \(choose from (?P<options>.*)\)")
+
+
+def _options_of(parser: argparse.ArgumentParser, typed: list[str]) -> list[str]:
+    """The option strings of ``parser`` and of the subcommand named in ``typed``."""
+    known = list(parser._option_string_actions)
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            command = next((t for t in typed if t in action.choices), None)
+            if command is not None:
+                known += _options_of(action.choices[command], typed)
+    return known
+
+
+def _misspelt(parser: argparse.ArgumentParser, typed: list[str]) -> tuple[str, str | None]:
+    """The first typed option that no option of ``parser`` (or of its subcommand) starts
+    with, and the nearest known one (difflib; argparse's own suggest_on_error covers
+    only choices, and only from Python 3.14), or ("", None)."""
+    known = _options_of(parser, typed)
+    for token in typed:
+        name = token.split("=", 1)[0]
+        if token == "--":
+            break
+        if not name.startswith("--") or any(k.startswith(name) for k in known):
+            continue
+        near = difflib.get_close_matches(name, [k for k in known if k.startswith("--")], n=1)
+        return name, near[0] if near else None
+    return "", None
 
 
 def _integer(text: str) -> int:

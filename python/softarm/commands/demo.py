@@ -7,6 +7,7 @@ import argparse
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._signals import drives_arm
+from softarm.commands.harvest import MAX_BERRIES
 
 #: What the demo writes into --out.
 OUTPUTS = ("harvest.png", "harvest_report.json", "harvest_log.jsonl")
@@ -21,7 +22,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         f"loop harvests a few berries. Writes {', '.join(OUTPUTS)} into --out.",
     )
     p.add_argument("--out", type=output_dir, default="out", help="output folder")
-    p.add_argument("--berries", type=int_range(1, 1000), default=5, help="berries to harvest")
+    p.add_argument(
+        "--berries", type=int_range(1, MAX_BERRIES), default=5, help="berries to harvest"
+    )
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the bush and arm")
     p.add_argument(
         "--world", choices=("tags", "bush"), default="tags",

@@ -54,8 +54,9 @@ if TYPE_CHECKING:
     from softarm.harvest.report import HarvestReport
     from softarm.harvest.sim_rig import SimRig
 
-#: Berries one command may ask for: a bush, not a field.
-MAX_BERRIES = 1000
+#: Berries one command may ask for: as many as a simulated bush holds, a bush, not a field
+#: (softarm.sim.bush.MAX_BERRIES; not imported here, it pulls in OpenCV).
+MAX_BERRIES = 40
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -66,8 +67,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         description="Run the harvesting state machine (paper fig. 4) on a simulated bush "
         "(--sim) or on the hardware described by a TOML config (--config; write one with "
         "`softarm config init hw.toml`). Exit status: 0 every berry done, 1 some berry "
-        "faulted, 2 a usage or configuration error or no hardware, 130/143 stopped by "
-        "SIGINT/SIGTERM (the arm is vented).",
+        "faulted or was harvested OUTSIDE TOLERANCE (flagged on its line), 2 a usage or "
+        "configuration error or no hardware, 130/143 stopped by SIGINT/SIGTERM (the arm "
+        "is vented).",
     )
     mode = p.add_mutually_exclusive_group(required=True)
     mode.add_argument("--sim", action="store_true", help="simulated arm, cameras and bush")
@@ -106,7 +108,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )  # fmt: skip
     p.add_argument(
         "--survey", action=argparse.BooleanOptionalAction, default=None,
-        help="--world bush: before the first berry, take C2 to two pairs of views of the "
+        help="--world bush: before the first berry, take C2 to three pairs of views of the "
         "bush and fit the canes with them (on by default: more of the canes mapped, "
         "docs/perception.md); --no-survey: C1's canes only",
     )  # fmt: skip
@@ -128,7 +130,8 @@ BUSH_UNRIPE_FRACTION = 0.3
 
 @drives_arm("harvest")
 def run(args: argparse.Namespace) -> int:
-    """Run the harvest; exit status 0 when every berry ended DONE, 1 otherwise, 2 when
+    """Run the harvest; exit status 0 when every berry ended DONE within tolerance, 1
+    otherwise, 2 when
     the hardware is absent, 128 + the signal number when stopped by SIGINT/SIGTERM."""
     if args.plot is not None and not args.sim:
         print("softarm harvest: error: argument --plot: works with --sim only", file=sys.stderr)
@@ -242,7 +245,8 @@ def run_sim(
         print(f"log: {log_path}")
     if record is not None:
         print(f"recording: {record}")
-    return 0 if all(b.final_state.value == "done" for b in report.berries) else 1
+    done = all(b.final_state.value == "done" for b in report.berries)
+    return 0 if done and not off_tolerance(report, rig.machine) else 1
 
 
 def _save_image(image: Any, path: Path) -> None:
@@ -267,7 +271,7 @@ def _harvest(rig: SimRig, n: int, quiet: bool) -> HarvestReport:
             nonlocal last
             now = time.monotonic()
             retry = i in seen
-            bar.line(line(i, n, result, now - last, retry, tol))
+            bar.line(line(i, n, result, now - last, retry, tol, tagged=rig.scene is None))
             last = now
             if not retry:
                 seen.add(i)
@@ -351,7 +355,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         log.close()
     report.header = log.records[0]
     print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
-    status = 0 if report.stopped is None else 1
+    status = 0 if report.stopped is None and not off_tolerance(report, rig.machine) else 1
     if devices is not None and sent is not None:
         status = max(status, dry_run_verdict(devices, sent, report))
     if args.report:
@@ -448,17 +452,34 @@ def outside(d: dict[str, Any], tol: Tolerance) -> list[str]:
     return why
 
 
+def off_tolerance(report: HarvestReport, machine: Any) -> bool:
+    """Whether a berry was harvested outside the tolerance of ``machine``'s ``[harvest]``
+    (such a run exits 1, as one with a fault does)."""
+    tol = Tolerance.of(getattr(machine, "config", None))
+    return any(outside(b, tol) for b in report.to_dict()["berries"] if b["harvested"])
+
+
 def line(
-    i: int, n: int, r: Any, wall: float, retry: bool = False, tol: Tolerance | None = None
+    i: int,
+    n: int,
+    r: Any,
+    wall: float,
+    retry: bool = False,
+    tol: Tolerance | None = None,
+    *,
+    tagged: bool = True,
 ) -> str:
     """One line per berry: its outcome, its position and orientation errors (flagged
-    when outside ``tol``), and its own simulated and wall time."""
+    when outside ``tol``), and its own simulated and wall time. A berry is named by its
+    tag, or (not ``tagged``: the rendered bush) by its number in the bush map, the
+    number of the C1 picture."""
     d = r.to_dict()
     pos, ang = grasp_errors(d)
     what = "harvested" if d["harvested"] else (d["fault"] or "skipped (unripe)")
     pos_s = f"{pos:.2f} mm" if pos is not None else "-"
     ang_s = f"{ang:.1f} deg" if ang is not None else "-"
-    tag = f"tag {d['tag_id']}, retry" if retry else f"tag {d['tag_id']}"
+    tag = f"tag {d['tag_id']}" if tagged else f"map #{d['tag_id']}"
+    tag += ", retry" if retry else ""
     why = outside(d, tol or Tolerance()) if d["harvested"] else []
     flag = f"  OUTSIDE TOLERANCE ({', '.join(why)})" if why else ""
     return (
@@ -487,6 +508,10 @@ def summary(d: dict[str, Any], tol: Tolerance | None = None) -> str:
         extra += f", min cane gap {gap_s}, {d['branch_contact_steps']} contact steps"
     if d.get("sim_time_s") is not None:
         extra += f", {d['sim_time_s']:.1f} s simulated"
+    if "ripe_in_reach" in d:  # the rendered bush: what the bush held, not only the map
+        extra += f"; {d['ripe_harvested']}/{d['ripe_in_reach']} ripe berries picked"
+        if d.get("unripe_left") is not None:
+            extra += f", {plural(d['unripe_left'], 'unripe berry')} left on the bush"
     return (
         f"harvested {d['harvested']}/{d['attempted']} ({100 * d['success_rate']:.0f} %), "
         f"mean fine-positioning error {mean}, {mean_ang}{extra}"

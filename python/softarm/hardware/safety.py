@@ -98,6 +98,8 @@ class SafePressureBank:
         watchdog_thread: run a daemon thread that checks the watchdog every
             ``watchdog_timeout_s / 4`` s. Without it the watchdog is checked only on
             each call and by :meth:`check_watchdog`.
+        simulated: the backend is a simulated arm: a vent's warning says "simulated arm
+            vented", not "venting all N channels".
 
     Raises:
         ParameterError: a limit is not a finite number inside its range.
@@ -116,6 +118,7 @@ class SafePressureBank:
         clock: Callable[[], float] = time.monotonic,
         *,
         watchdog_thread: bool = True,
+        simulated: bool = False,
     ) -> None:
         rate = MAX_RATE_PSI_PER_S.check(max_rate_psi_per_s)
         timeout = WATCHDOG_TIMEOUT_S.check(watchdog_timeout_s)
@@ -136,6 +139,8 @@ class SafePressureBank:
         self._clock = clock
         self._lock = threading.RLock()
         self._n = int(backend.channels)
+        # What a vent's warning names: a simulated arm's is no valve opening.
+        self._vented = "simulated arm vented" if simulated else f"venting all {self._n} channels"
         self._last = np.zeros(self._n)
         self._last_time = clock()
         self._armed = False  # a command is live: the watchdog may fire
@@ -268,7 +273,7 @@ class SafePressureBank:
                 return
             now = self._clock()
             self.vent_log.append(VentEvent(now, reason))
-            _log.log(level, "venting all %d channels: %s", self._n, reason)
+            _log.log(level, "%s: %s", self._vented, reason)
             try:
                 self._backend.vent()
             except Exception as exc:

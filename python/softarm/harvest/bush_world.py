@@ -223,6 +223,7 @@ def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
         "ripe_in_reach": len(ripe),
         "ripe_harvested": sum(b.ripeness >= 0.5 for b in picked.values()),
         "unripe_picked": sum(b.ripeness < 0.5 for b in picked.values()),
+        "unripe_left": sum(b.ripeness < 0.5 and b.tag_id not in picked for b in scene.bush.berries),
         "ripe_never_mapped": len(unmapped),
         "ripe_never_mapped_c1_share": scene.c1_shares(unmapped),
         "cane_map": {

@@ -180,8 +180,7 @@ class HarvestMachine:
             self._fault(berry, result, _reason(exc), _detail(exc))
         except BaseException as exc:
             # A bug or Ctrl-C: still leave the arm vented and the log synced, then re-raise.
-            self._vent(f"unexpected {exc!r}")
-            self.log.event("crash", berry=berry.tag_id, error=repr(exc))
+            _unexpected(self, berry.tag_id, exc)
             raise
         return self._finish(result, watch, start)
 
@@ -205,8 +204,7 @@ class HarvestMachine:
         except STAGE_ERRORS as exc:
             self._fault(SURVEY, BerryResult(SURVEY.tag_id), _reason(exc), _detail(exc))
         except BaseException as exc:
-            self._vent(f"unexpected {exc!r}")
-            self.log.event("crash", berry=SURVEY.tag_id, error=repr(exc))
+            _unexpected(self, SURVEY.tag_id, exc)
             raise
         return pairs
 
@@ -379,6 +377,19 @@ class HarvestMachine:
             self.log.event("vent_failed", error=repr(exc))
             vented = False
         self.log.event("vent", t=self.clock.now(), reason=reason, ok=vented)
+
+
+def _unexpected(machine: HarvestMachine, tag_id: int, exc: BaseException) -> None:
+    """Vent after a bug, logged as a ``crash``, or after a stop (Ctrl-C, SIGTERM, an
+    exit: not an :class:`Exception`), logged as ``interrupted``, as the command's own
+    record of the stop is."""
+    if isinstance(exc, Exception):
+        machine._vent(f"unexpected {exc!r}")
+        machine.log.event("crash", berry=tag_id, error=repr(exc))
+        return
+    why = str(exc) or type(exc).__name__
+    machine._vent(f"stopped: {why}")
+    machine.log.event("interrupted", berry=tag_id, reason=why)
 
 
 def _reason(exc: BaseException) -> FaultReason:

@@ -323,7 +323,7 @@ def _bank(plant: ArmPlant, clock: SimClock, recorder: FrameRecorder | None) -> S
     ch = ChannelsConfig()
     return SafePressureBank(
         outputs, ch.p_max, ch.max_rate_psi_per_s, ch.watchdog_timeout_s, clock.now,
-        watchdog_thread=False,
+        watchdog_thread=False, simulated=True,
     )  # fmt: skip
 
 

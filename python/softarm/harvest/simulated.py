@@ -10,6 +10,8 @@ machine and may not import it (docs/architecture.md).
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -48,12 +50,15 @@ def simulate(
             ``config`` (a ``HarvestConfig``), ``unripe_fraction``, ...
 
     Raises:
-        TypeError: an unknown option.
+        TypeError: an unknown option (named, with the nearest known one).
+        softarm.sim.render.RenderUnavailableError: ``world="bush"`` where MuJoCo or an
+            offscreen OpenGL context is missing.
         softarm.errors.SoftarmError: a bad value (as the command line reports it).
     """
     from softarm.harvest.header import HEADER, header_record, sim_settings
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
+    _check_options(options, SimRigOptions)
     if options.get("world") == "bush":  # before the log: a typed error, not MuJoCo's
         from softarm.sim.render.gl_check import require_offscreen_gl
 
@@ -71,3 +76,20 @@ def simulate(
     report.header = rig.machine.log.records[0]
     rig.machine.log.close()
     return report
+
+
+def _check_options(options: dict[str, Any], fields_of: type) -> None:
+    """An unknown keyword is a TypeError naming ``simulate_harvest`` (the function the
+    user called, not the dataclass behind it), with the nearest option's name."""
+    known = [f.name for f in dataclasses.fields(fields_of) if f.name not in _SET_HERE]
+    for name in options:
+        if name not in known:
+            near = difflib.get_close_matches(name, known, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else f"; options: {', '.join(known)}"
+            raise TypeError(
+                f"softarm.simulate_harvest() got an unexpected keyword argument {name!r}{hint}"
+            )
+
+
+#: SimRigOptions fields that simulate() sets from its own arguments.
+_SET_HERE = frozenset({"n_berries", "seed", "log_path"})

@@ -143,7 +143,7 @@ class SimIdentificationRig:
         self._time = 0.0
         self.bank = SafePressureBank(
             SimulatedPressureBank(self._sim, self.arm.n), SIM_P_MAX, SIM_RATE, SIM_WATCHDOG,
-            self.now, watchdog_thread=False,
+            self.now, watchdog_thread=False, simulated=True,
         )  # fmt: skip
 
     def now(self) -> float:

@@ -24,6 +24,8 @@ from softarm.geometry import APPROACH_CONE_DEG, cone_axes
 __all__ = ["Berry", "Branch", "Bush"]
 
 PLUS_Y = np.array([0.0, 1.0, 0.0])
+#: Most berries a bush is generated with (`softarm harvest --berries` is bounded by it).
+MAX_BERRIES = 40
 
 
 @dataclass(frozen=True)
@@ -110,8 +112,8 @@ class Bush:
         (lower, upper) overrides the arm's own elongation limits (e.g. the true actuators'
         range at 0–70 psi).
         """
-        if not 1 <= n_berries <= 40:
-            raise ParameterError(f"n_berries must be in [1, 40], got {n_berries}")
+        if not 1 <= n_berries <= MAX_BERRIES:
+            raise ParameterError(f"n_berries must be in [1, {MAX_BERRIES}], got {n_berries}")
         rng = np.random.default_rng(seed)
         lo, hi = limits or (arm.lower, arm.upper)
         lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
