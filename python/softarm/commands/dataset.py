@@ -9,6 +9,8 @@ import time
 from typing import TYPE_CHECKING
 
 from softarm.commands._args import add_quiet, float_range, int_range, output_dir, positive_int
+from softarm.commands._looks import LOOKS
+from softarm.errors import ParameterError
 
 if TYPE_CHECKING:
     from softarm.sim.render.dataset import DatasetRig
@@ -36,12 +38,23 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--scale", type=float_range(0.0, 1.0), default=1.0,
         help="image size and focal length factor (1: C1 1280x720, C2 640x480)",
     )  # fmt: skip
+    p.add_argument(
+        "--world", choices=("bush", "row"), default="bush",
+        help="'bush' (default): the rendered bush; 'row': the bush in a hedgerow in daylight, "
+        "every frame through a camera model, fruit green, red, turning and ripe "
+        "(docs/perception.md, 'The daylight row')",
+    )  # fmt: skip
+    p.add_argument(
+        "--look", choices=LOOKS, default=None,
+        help="--world row: the daylight family (default random: one of the four per image)",
+    )  # fmt: skip
     add_quiet(p)
     p.set_defaults(run=run)
 
 
-def default_rig(scale: float = 1.0) -> DatasetRig:
-    """The simulated harvest's cameras and markers, images scaled by ``scale``."""
+def default_rig(scale: float = 1.0, world: str = "bush", look: str = "random") -> DatasetRig:
+    """The simulated harvest's cameras and markers, images scaled by ``scale``; the
+    ``world`` and its ``look`` (the row's)."""
     from softarm.harvest.sim_rig import default_cameras
     from softarm.harvest.sim_vision import BASE_TAG_ID
     from softarm.sim.render.dataset import DatasetRig
@@ -49,7 +62,7 @@ def default_rig(scale: float = 1.0) -> DatasetRig:
     c = default_cameras(scale=scale)
     return DatasetRig(
         c.T_base_c1, c.model(1), c.model(2), c.T_ee_c2, c.T_ee_cube, c.T_base_tag,
-        BASE_TAG_ID, c.base_tag,
+        BASE_TAG_ID, c.base_tag, world, look,
     )  # fmt: skip
 
 
@@ -60,7 +73,9 @@ def run(args: argparse.Namespace) -> int:
     from softarm.sim.render.gl_check import require_offscreen_gl
 
     require_offscreen_gl()  # one line naming the fix, before OUT is created
-    rig = default_rig(args.scale)
+    if args.look is not None and args.world != "row":
+        raise ParameterError("--look: for the rendered row (--world row)")
+    rig = default_rig(args.scale, args.world, args.look or "random")
     workers = ray_workers(args.images, args.workers)
     start = time.perf_counter()
     with Progress(args.images, "dataset", "image", args.quiet) as progress:

@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["CATEGORIES", "category_id", "mask_bbox", "mask_polygons"]
+__all__ = ["CATEGORIES", "ROW_CATEGORIES", "category_id", "mask_bbox", "mask_polygons"]
 
 #: The categories of the labelled images, COCO style (ids from 1).
 CATEGORIES: list[dict[str, Any]] = [
@@ -24,11 +24,16 @@ CATEGORIES: list[dict[str, Any]] = [
     {"id": 2, "name": "berry_unripe", "supercategory": "berry"},
     {"id": 3, "name": "cane", "supercategory": "plant"},
 ]
+#: The row's (``--world row``): its turning fruit (part red, part black; not ripe) too.
+ROW_CATEGORIES: list[dict[str, Any]] = [
+    *CATEGORIES,
+    {"id": 4, "name": "berry_turning", "supercategory": "berry"},
+]
 
 
 def category_id(name: str) -> int:
     """The id of the category called ``name``."""
-    result: int = next(c["id"] for c in CATEGORIES if c["name"] == name)
+    result: int = next(c["id"] for c in ROW_CATEGORIES if c["name"] == name)
     return result
 
 

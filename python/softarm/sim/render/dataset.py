@@ -34,8 +34,16 @@ from softarm._core import SoftArm
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError, SoftarmError
 from softarm.sim.bush import Berry, Bush
-from softarm.sim.render.coco import CATEGORIES, category_id, mask_bbox, mask_polygons
+from softarm.sim.render.coco import (
+    CATEGORIES,
+    ROW_CATEGORIES,
+    category_id,
+    mask_bbox,
+    mask_polygons,
+)
 from softarm.sim.render.renderer import RenderedFrame
+from softarm.sim.render.row import STAGE_RIPENESS
+from softarm.sim.render.row_look import LOOKS, RowLook
 from softarm.sim.render.silhouette import silhouette_area
 from softarm.sim.render.world import RenderedBush, arm_sections
 from softarm.vision.camera_model import CameraModel
@@ -68,12 +76,25 @@ class DatasetRig:
     T_base_tag: FloatArray
     base_tag_id: int
     base_tag: float
+    #: "bush", the rendered bush; "row", the bush in a hedgerow in daylight
+    #: (:mod:`softarm.sim.render.row`) with the look family ``look``
+    #: (:data:`softarm.sim.render.row_look.LOOKS`) and its camera model.
+    world_kind: str = "bush"
+    look: str = "random"
+
+    def __post_init__(self) -> None:
+        if self.world_kind not in ("bush", "row"):
+            raise ParameterError(f"world must be 'bush' or 'row', got {self.world_kind!r}")
+        if self.look not in LOOKS:
+            raise ParameterError(f"look must be one of {', '.join(LOOKS)}, got {self.look!r}")
 
     def world(self, bush: Bush) -> RenderedBush:
-        """``bush`` rendered with these cameras."""
+        """``bush`` rendered with these cameras (in the row: a look of the family drawn
+        from the bush's seed)."""
+        look = RowLook.named(self.look, bush.seed) if self.world_kind == "row" else None
         return RenderedBush(
             bush, self.T_base_c1, self.c1, self.c2, self.T_ee_c2, self.T_ee_cube,
-            self.T_base_tag, self.base_tag_id, self.base_tag,
+            self.T_base_tag, self.base_tag_id, self.base_tag, look=look,
         )  # fmt: skip
 
 
@@ -147,8 +168,10 @@ def _berry_attributes(
     full = silhouette_area(renderer.model, renderer.data, geoms, view.T_base_camera, view.camera)
     T_camera_base = np.linalg.inv(view.T_base_camera)
     in_camera = T_camera_base[:3, :3] @ berry.position + T_camera_base[:3, 3]
+    stage = {} if world.row is None else {"stage": world.stage(berry.tag_id)}
     return {
         "berry_id": berry.tag_id,
+        **stage,
         "ripeness": float(berry.ripeness),
         "visible_fraction": None if not full else round(min(1.0, pixels / full), 4),
         "position_base_m": [float(v) for v in berry.position],
@@ -159,7 +182,7 @@ def _berry_attributes(
 def _cane_attributes(world: RenderedBush, index: int) -> dict[str, Any]:
     model = world.renderer.model
     radius = float(model.geom(f"cane{index}_0").size[0])
-    coeffs = world.bush.branches[index].coeffs
+    coeffs = world.canes()[index].coeffs
     return {"cane_id": index, "radius_m": radius, "coeffs_base_m": coeffs.tolist()}
 
 
@@ -183,19 +206,38 @@ def _annotate(
     in sight."""
     assert frame.geoms is not None
     out = []
-    for berry in world.bush.berries:
+    for berry in _fruit(world):
         mask = world.labels.mask(frame.geoms, "berry", berry.tag_id)
         pixels = int(np.count_nonzero(mask))
         if pixels >= MIN_PIXELS:
-            category = "berry_ripe" if berry.ripeness >= 0.5 else "berry_unripe"
+            category = _category(world, berry)
             out.append(
                 (mask, _annotation(mask, category, _berry_attributes(world, berry, view, pixels)))
             )
-    for index in range(len(world.bush.branches)):
+    for index in range(len(world.canes())):
         mask = world.labels.mask(frame.geoms, "cane", index)
         if mask.any():
             out.append((mask, _annotation(mask, "cane", _cane_attributes(world, index))))
     return out
+
+
+def _fruit(world: RenderedBush) -> list[Berry]:
+    """Every fruit drawn, as berries (the row's: its stage's ripeness, no approach)."""
+    if world.row is None:
+        return list(world.bush.berries)
+    bush = {b.tag_id: b for b in world.bush.berries}
+    return [
+        bush.get(f.fruit_id)
+        or Berry(f.fruit_id, f.position, np.zeros(3), np.zeros(0), STAGE_RIPENESS[f.stage])
+        for f in world.row.fruit
+    ]
+
+
+def _category(world: RenderedBush, berry: Berry) -> str:
+    if world.row is not None and world.stage(berry.tag_id) == "turning":
+        return "berry_turning"
+    ripe = world.stage(berry.tag_id) == "ripe" if world.row is not None else berry.ripeness >= 0.5
+    return "berry_ripe" if ripe else "berry_unripe"
 
 
 def _write_png(path: Path, image: npt.NDArray[Any]) -> None:
@@ -211,8 +253,9 @@ def _depth_mm(depth: npt.NDArray[np.float32]) -> npt.NDArray[np.uint16]:
 
 
 def _image_record(
-    index: int, view: _View, frame: RenderedFrame, bush: Bush, arm_shown: bool
+    index: int, view: _View, frame: RenderedFrame, world: RenderedBush, arm_shown: bool
 ) -> dict[str, Any]:
+    bush = world.bush
     name = f"{index:06d}.png"
     height, width = frame.colour.shape[:2]
     return {
@@ -225,11 +268,25 @@ def _image_record(
         "view": view.name,
         "arm_shown": arm_shown,
         "bush_seed": bush.seed,
+        **_look_record(world),
         "camera": {
             "matrix": view.camera.matrix.tolist(),
             "distortion": np.ravel(view.camera.distortion).tolist(),
             "T_base_camera": view.T_base_camera.tolist(),
         },
+    }
+
+
+def _look_record(world: RenderedBush) -> dict[str, Any]:
+    """The row's look (family, sun) for an image of the row; nothing for the bush."""
+    look = world.look
+    if not isinstance(look, RowLook):
+        return {}
+    return {
+        "world": "row",
+        "look": look.name,
+        "sun_elevation_deg": round(look.sun_elevation, 2),
+        "sun_azimuth_deg": round(look.sun_azimuth, 2),
     }
 
 
@@ -255,7 +312,7 @@ def render_sample(out_dir: str | Path, seed: int, index: int, rig: DatasetRig) -
         instances[mask] = k
         annotation["instance"] = k
     out = Path(out_dir)
-    record = _image_record(index, view, frame, bush, T_base_ee is not None)
+    record = _image_record(index, view, frame, world, T_base_ee is not None)
     _write_png(out / record["file_name"], frame.colour)
     _write_png(out / record["depth_file"], _depth_mm(frame.depth))
     _write_png(out / record["instance_file"], instances)
@@ -324,7 +381,7 @@ def _ray_result(ray: Any, ref: Any) -> dict[str, Any]:
         raise
 
 
-def _coco(samples: list[dict[str, Any]], seed: int) -> dict[str, Any]:
+def _coco(samples: list[dict[str, Any]], seed: int, rig: DatasetRig) -> dict[str, Any]:
     from softarm import __version__
 
     annotations = [a for s in samples for a in s["annotations"]]
@@ -341,7 +398,7 @@ def _coco(samples: list[dict[str, Any]], seed: int) -> dict[str, Any]:
         },
         "images": [s["image"] for s in samples],
         "annotations": annotations,
-        "categories": CATEGORIES,
+        "categories": ROW_CATEGORIES if rig.world_kind == "row" else CATEGORIES,
     }
 
 
@@ -376,7 +433,7 @@ def write_dataset(
         for i in rest:
             samples.append(render_sample(out, seed, i, rig))
             on_image()
-    coco = _coco(samples, seed)
+    coco = _coco(samples, seed, rig)
     write_text(
         out / "annotations.json", json.dumps(coco, separators=(",", ":")), "annotations.json"
     )

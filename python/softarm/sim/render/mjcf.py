@@ -22,6 +22,7 @@ from scipy.spatial.transform import Rotation
 from softarm.checks import FloatArray
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.render.look import BushLook
+from softarm.sim.render.row import Row
 from softarm.vision.cube import FACE_PER_MARKER
 from softarm.vision.dictionaries import get_dictionary
 
@@ -79,10 +80,19 @@ class SceneSpec:
     n_sections: int = 3
     dictionary: str = "DICT_4X4_50"
     keep_clear: Sequence[tuple[FloatArray, FloatArray]] = field(default_factory=tuple)
+    #: The hedgerow around the bush (``--world row``, :mod:`softarm.sim.render.row`;
+    #: ``look`` then a ``RowLook``), None for the bush alone; ``shadows``: the row's sun
+    #: casts them.
+    row: Row | None = None
+    shadows: bool = True
 
 
 def scene_xml(spec: SceneSpec) -> tuple[str, dict[str, bytes]]:
     """The MJCF text of ``spec`` and its texture assets (PNG bytes by file name)."""
+    if spec.row is not None:
+        from softarm.sim.render.row_mjcf import row_scene_xml
+
+        return row_scene_xml(spec, spec.row, spec.shadows)
     rng = np.random.default_rng([spec.look.seed, 0xB05])
     assets = _tag_assets(spec)
     berries = [_berry(b, spec.look, rng) for b in spec.bush.berries]

@@ -19,7 +19,7 @@ import numpy as np
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
 from softarm.perception.stereo_camera import StereoCamera
-from softarm.sim.bush import PLUS_Y, Bush
+from softarm.sim.bush import PLUS_Y, Branch, Bush
 from softarm.sim.render.distortion import Distorter
 from softarm.sim.render.labels import GeomLabels
 from softarm.sim.render.look import BushLook
@@ -30,6 +30,9 @@ from softarm.sim.render.mjcf import (
     SceneSpec,
 )
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
+from softarm.sim.render.row import Row
+from softarm.sim.render.row_camera import RowCameras
+from softarm.sim.render.row_look import RowLook
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 from softarm.vision.cube import FACE_PER_MARKER
@@ -84,9 +87,13 @@ class RenderedBush:
         c2: C2's intrinsics; ``T_ee_c2`` its pose on the end effector.
         T_ee_cube: the marker cube on the end effector; ``cube_marker`` its tags' side.
         T_base_tag, base_tag_id, base_tag: the base tag.
-        look: the appearance; None draws one from the bush's seed.
+        look: the appearance; None draws one from the bush's seed. A
+            :class:`~softarm.sim.render.row_look.RowLook` draws the bush inside a
+            hedgerow in daylight (:mod:`softarm.sim.render.row`), every frame through
+            the look's camera model (:mod:`softarm.sim.render.row_camera`).
         baseline: C1's stereo baseline (m).
         n_sections: sections of the arm drawn.
+        shadows: in the row, the sun casts shadows (a shadow map; off: cheaper).
     """
 
     def __init__(
@@ -104,9 +111,12 @@ class RenderedBush:
         look: BushLook | None = None,
         baseline: float = ZED2_BASELINE,
         n_sections: int = 3,
+        shadows: bool = True,
     ) -> None:
         self.bush = bush
         self.look = look or BushLook.random(bush.seed)
+        self.row = Row.generate(bush, self.look) if isinstance(self.look, RowLook) else None
+        self.effects = RowCameras(self.look) if isinstance(self.look, RowLook) else None
         T_left_right = np.eye(4)
         T_left_right[0, 3] = baseline
         self.stereo = StereoCamera(c1, c1, T_base_c1, T_left_right)
@@ -126,6 +136,8 @@ class RenderedBush:
             cube_marker=cube_marker,
             n_sections=n_sections,
             keep_clear=_approach_lines(bush),
+            row=self.row,
+            shadows=shadows,
         )
         self.renderer = BushRenderer(spec)
         self._distort = {"c1": Distorter(c1), "c2": Distorter(c2)}
@@ -203,6 +215,8 @@ class RenderedBush:
         colour = cv2.remap(
             pin, mx - px0, my - py0, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
         )
+        if self.effects is not None:
+            colour = self.effects.apply("c1_window", np.asarray(colour, np.uint8))
         return ImageCrop(colour, (x0, y0), (w, h))
 
     def c2_frame(self, truth: bool = False) -> RenderedFrame:
@@ -225,11 +239,29 @@ class RenderedBush:
         outline = self.berry_outlines()
         assert seen.geoms is not None and outline.geoms is not None  # asked for
         shares = {}
-        for berry in self.bush.berries:
-            whole = self.labels.mask(outline.geoms, "berry", berry.tag_id).sum()
-            visible = self.labels.mask(seen.geoms, "berry", berry.tag_id).sum()
-            shares[berry.tag_id] = float(visible / whole) if whole else 0.0
+        for tag in self.fruit_ids():
+            whole = self.labels.mask(outline.geoms, "berry", tag).sum()
+            visible = self.labels.mask(seen.geoms, "berry", tag).sum()
+            shares[tag] = float(visible / whole) if whole else 0.0
         return shares
+
+    def fruit_ids(self) -> list[int]:
+        """Every fruit drawn: the bush's berries (tag ids), then the row's."""
+        if self.row is None:
+            return [b.tag_id for b in self.bush.berries]
+        return [f.fruit_id for f in self.row.fruit]
+
+    def stage(self, fruit_id: int) -> str | None:
+        """A fruit's stage (softarm.sim.render.row.STAGES): in the bush, ripe or
+        unripe by its ripeness; None for no such fruit."""
+        if self.row is not None:
+            return self.row.stage(fruit_id)
+        berry = next((b for b in self.bush.berries if b.tag_id == fruit_id), None)
+        return None if berry is None else ("ripe" if berry.ripeness >= 0.5 else "unripe")
+
+    def canes(self) -> list[Branch]:
+        """Every cane drawn, by its id in the masks: the bush's, then the row's."""
+        return [*self.bush.branches, *(self.row.canes if self.row is not None else [])]
 
     def close(self) -> None:
         """Free the renderer."""
@@ -238,8 +270,11 @@ class RenderedBush:
     def _frame(self, camera: str, lens: str, truth: bool) -> RenderedFrame:
         f = self.renderer.render(camera, depth=truth, geoms=truth)
         d = self._distort[lens]
+        colour = d.colour(f.colour)
+        if self.effects is not None:
+            colour = self.effects.apply(camera, colour)
         return RenderedFrame(
-            d.colour(f.colour),
+            colour,
             None if f.depth is None else d.nearest(f.depth),
             None if f.geoms is None else d.nearest(f.geoms),
         )
