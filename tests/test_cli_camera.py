@@ -120,4 +120,4 @@ def test_marker_larger_than_square_is_refused(
     argv = ["camera", "calibrate", str(tmp_path), "--right", str(tmp_path), "--squares", "9",
             "6", "--square", "0.03", "--marker", "0.04", "--out", str(tmp_path / "o")]  # fmt: skip
     assert cli.main(argv) == 2
-    assert "marker_length" in capsys.readouterr().err
+    assert "--marker 0.04 must be smaller than --square 0.03" in capsys.readouterr().err

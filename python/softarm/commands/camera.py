@@ -9,20 +9,33 @@ Mono writes ``OUT/camera.yml`` (OpenCV) and ``OUT/camera.yaml`` (ROS). Stereo (`
 side-by-side frames, the ZED2 over USB video; ``--right``: a second camera's images, paired
 with the first's in name order) writes ``left.yml``, ``right.yml`` (OpenCV),
 ``left.yaml``, ``right.yaml`` (ROS, rectified) and ``stereo.yml`` (both eyes and
-``T_left_right``). Exit status 0, or 2 with one line naming the bad argument or file.
+``T_left_right``). Exit status 0; 1 when the calibration is not converged (its data
+fails a check of :mod:`softarm.vision.calibration_checks`: too few distinct or tilted
+views, an RMS above 2 px, an implausible baseline, swapped eyes), each problem told and
+no file written; 2 with one line naming the bad argument or file.
+
+Each image is read when it is used and not kept (only its corners are), through
+:func:`softarm.files.images.read_image`: an image of more than 20 M pixels is refused
+before it is decoded.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 from softarm.commands._args import RawDefaultsFormatter, float_range, int_range, output_dir
+from softarm.commands.camera_board import add_board_parser
 from softarm.errors import InputError
 
 #: The image files a folder contributes, by extension.
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+#: Most pixels a calibration image may have: 20 M (a 4K pair side by side is 16.6 M).
+#: The ChArUco detector needs about 25 bytes a pixel on a busy image.
+MAX_PIXELS = 20_000_000
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -52,40 +65,97 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     cal.add_argument("--dictionary", default="DICT_4X4_50", help="ArUco dictionary")
     cal.add_argument("--out", type=output_dir, required=True, help="folder for the files")
     cal.set_defaults(run=run)
+    add_board_parser(actions)  # camera board: the board to print
 
 
 def run(args: argparse.Namespace) -> int:
-    """Calibrate and write the files; 0 on success (errors are one line, exit 2)."""
+    """Calibrate and write the files; 0 on success, 1 when not converged (errors are
+    one line, exit 2)."""
+    if args.marker >= args.square:
+        raise InputError(f"--marker {args.marker:g} must be smaller than --square {args.square:g}")
+    from softarm.vision.calibration_checks import CalibrationNotConverged
+
     board = (tuple(args.squares), args.square, args.marker, args.dictionary)
     left = read_images(args.images, "images")
-    if args.stereo or args.right is not None:
-        right = read_images(args.right, "--right") if args.right is not None else None
-        return _stereo(left, right, board, args.out)
-    return _mono(left, board, args.out)
+    try:
+        if args.stereo or args.right is not None:
+            right = read_images(args.right, "--right") if args.right is not None else None
+            return _stereo(left, right, board, args.out)
+        return _mono(left, board, args.out)
+    except CalibrationNotConverged as exc:
+        for problem in exc.problems:
+            print(f"softarm camera: not converged: {problem}", file=sys.stderr)
+        print(f"calibration NOT converged (rms {exc.rms:.3f} px): no files written to {args.out}")
+        return 1
 
 
-def read_images(paths: list[Path], what: str) -> list[Any]:
-    """The images of ``paths`` (files, or folders of image files in name order)."""
-    import cv2
+class ImageFiles(Sequence[Any]):
+    """Image files read on demand (the last one kept, for the two halves of a
+    side-by-side frame): a calibration holds one image at a time, not all of them."""
 
+    def __init__(self, files: list[Path], what: str) -> None:
+        self.files, self.what = files, what
+        self._last: tuple[int, Any] | None = None
+
+    def __len__(self) -> int:
+        return len(self.files)
+
+    @overload
+    def __getitem__(self, k: int) -> Any: ...
+    @overload
+    def __getitem__(self, k: slice) -> list[Any]: ...
+    def __getitem__(self, k: int | slice) -> Any:
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        from softarm.files.images import read_image
+
+        k = range(len(self))[k]  # negative indices; IndexError past the end
+        if self._last is None or self._last[0] != k:
+            self._last = (
+                k,
+                read_image(self.files[k], f"{self.what}: image", 1, max_pixels=MAX_PIXELS),
+            )
+        return self._last[1]
+
+
+class Halves(Sequence[Any]):
+    """One half (0: left, 1: right) of each side-by-side frame of ``frames``."""
+
+    def __init__(self, frames: Sequence[Any], side: int) -> None:
+        self.frames, self.side = frames, side
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    @overload
+    def __getitem__(self, k: int) -> Any: ...
+    @overload
+    def __getitem__(self, k: slice) -> list[Any]: ...
+    def __getitem__(self, k: int | slice) -> Any:
+        from softarm.vision.stereo_calibration import split_side_by_side
+
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        return split_side_by_side(self.frames[k], f"images[{k}]")[self.side]
+
+
+def read_images(paths: list[Path], what: str) -> ImageFiles:
+    """The images of ``paths`` (files, or folders of image files in name order), each
+    read when it is used."""
     files: list[Path] = []
     for path in paths:
         if path.is_dir():
             files += sorted(f for f in path.iterdir() if f.suffix.lower() in IMAGE_SUFFIXES)
+        elif not path.exists():  # a typo'd folder is named as missing, not as an image
+            raise InputError(f"{what}: {str(path)!r}: no such file or folder")
         else:
             files.append(path)
     if not files:
         raise InputError(f"{what}: no image files in {', '.join(map(str, paths))}")
-    images = []
-    for f in files:
-        image = cv2.imread(str(f), cv2.IMREAD_COLOR) if f.is_file() else None
-        if image is None:
-            raise InputError(f"{what}: cannot read {str(f)!r} as an image")
-        images.append(image)
-    return images
+    return ImageFiles(files, what)
 
 
-def _mono(images: list[Any], board: tuple[Any, ...], out: Path) -> int:
+def _mono(images: Sequence[Any], board: tuple[Any, ...], out: Path) -> int:
     from softarm.vision import calibrate_charuco
 
     model, rms = calibrate_charuco(images, *board)
@@ -99,13 +169,14 @@ def _mono(images: list[Any], board: tuple[Any, ...], out: Path) -> int:
     return 0
 
 
-def _stereo(left: list[Any], right: list[Any] | None, board: tuple[Any, ...], out: Path) -> int:
-    from softarm.vision.stereo_calibration import calibrate_stereo_charuco, split_side_by_side
+def _stereo(
+    left: Sequence[Any], right: Sequence[Any] | None, board: tuple[Any, ...], out: Path
+) -> int:
+    from softarm.vision.stereo_calibration import calibrate_stereo_charuco
     from softarm.vision.stereo_files import write_ros_stereo, write_stereo
 
     if right is None:
-        halves = [split_side_by_side(f, f"images[{k}]") for k, f in enumerate(left)]
-        left, right = [h[0] for h in halves], [h[1] for h in halves]
+        left, right = Halves(left, 0), Halves(left, 1)
     model, rms = calibrate_stereo_charuco(left, right, *board)
     out.mkdir(parents=True, exist_ok=True)
     model.left.save(out / "left.yml")

@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from softarm.errors import ConfigError
-from softarm.files import atomic_path, parse_json, write_text
+from softarm.files import parse_json, write_text
 
 if TYPE_CHECKING:
     from softarm.vision.camera_model import CameraModel
@@ -102,22 +102,26 @@ def _read_fields(fs: Any, path: str | Path) -> tuple[str, dict[str, Any]]:
 def write_opencv(model: CameraModel, path: str | Path) -> None:
     """Write ``model`` as OpenCV's calibration sample does (YAML for .yml/.yaml, XML for
     .xml, JSON for .json: FileStorage picks by extension)."""
-    with atomic_path(path, "camera file") as tmp:  # the temporary name keeps the suffix
-        try:
-            fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE)
-        except cv2.error as exc:
-            raise ConfigError(f"cannot write camera file {str(path)!r}: {exc}") from exc
-        if not fs.isOpened():
-            raise ConfigError(f"cannot write camera file {str(path)!r}")
-        try:
-            if model.image_size is not None:
-                fs.write("image_width", int(model.image_size[0]))
-                fs.write("image_height", int(model.image_size[1]))
-            fs.write("camera_matrix", np.asarray(model.matrix, dtype=np.float64))
-            dist = model.distortion.reshape(-1, 1).astype(np.float64)
-            fs.write("distortion_coefficients", dist)
-        finally:
-            fs.release()
+    fs = memory_storage(path, "camera file")
+    if model.image_size is not None:
+        fs.write("image_width", int(model.image_size[0]))
+        fs.write("image_height", int(model.image_size[1]))
+    fs.write("camera_matrix", np.asarray(model.matrix, dtype=np.float64))
+    fs.write("distortion_coefficients", model.distortion.reshape(-1, 1).astype(np.float64))
+    write_text(path, fs.releaseAndGetString(), "camera file")
+
+
+def memory_storage(path: str | Path, what: str) -> Any:
+    """A ``cv2.FileStorage`` writing into memory in the format of ``path``'s suffix: the
+    text is then written by :func:`~softarm.files.write_text`, so OpenCV never sees the
+    path (a name that is not UTF-8 crashes it)."""
+    try:
+        fs = cv2.FileStorage(Path(path).suffix, cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_MEMORY)
+    except cv2.error as exc:
+        raise ConfigError(f"cannot write {what} {str(path)!r}: {_cv_reason(exc)}") from None
+    if not fs.isOpened():
+        raise ConfigError(f"cannot write {what} {str(path)!r}")
+    return fs
 
 
 def write_ros(model: CameraModel, path: str | Path, camera_name: str = "camera") -> None:
@@ -158,15 +162,17 @@ def _ros_matrix(name: str, mat: np.ndarray) -> list[str]:
     return [f"{name}:", f"  rows: {rows}", f"  cols: {cols}", f"  data: [{data}]"]
 
 
-def _open(path: str | Path, body: str) -> Any:
+def _open(path: str | Path, body: str, what: str = "camera file") -> Any:
+    if not body.strip():  # OpenCV's own error for it is an opaque SystemError
+        raise ConfigError(f"{what} {str(path)!r} is empty")
     flags = cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY
     try:
         fs = cv2.FileStorage(body, flags)
     except (cv2.error, SystemError) as exc:  # some parse errors surface as SystemError
         msg = str(exc).strip().splitlines()[-1] if str(exc).strip() else type(exc).__name__
-        raise ConfigError(f"cannot parse camera file {str(path)!r}: {msg}") from exc
+        raise ConfigError(f"cannot parse {what} {str(path)!r}: {msg}") from None
     if not fs.isOpened():
-        raise ConfigError(f"cannot parse camera file {str(path)!r}")
+        raise ConfigError(f"cannot parse {what} {str(path)!r}")
     return fs
 
 

@@ -3,7 +3,12 @@ and the right eye's pose in the left eye's frame.
 
 Each eye is first calibrated on its own views (as :func:`calibrate_charuco`); the pair is
 then refined together on the views where both eyes see at least 6 common corners, each
-eye's intrinsics kept as the start. ``T_left_right`` follows
+eye's intrinsics kept as the start. The data is judged as a mono calibration's is
+(:mod:`softarm.vision.calibration_checks`), and the pair besides: a pair of images that
+show the board at the same place (one image given for both eyes) is refused, and a pair
+whose RMS is too large (images that do not pair up), whose baseline is implausible or
+whose right eye is not on the left eye's +x raises :class:`CalibrationNotConverged`
+with every problem found. ``T_left_right`` follows
 :class:`softarm.perception.stereo_camera.StereoCamera`: ``x_left = T_left_right @ x_right``,
 metres.
 """
@@ -18,12 +23,19 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.errors import InputError, ParameterError, VisionError
-from softarm.vision._checks import FloatArray, as_gray, as_pose, positive
+from softarm.errors import InputError, VisionError
+from softarm.vision._checks import FloatArray, as_gray, as_pose
 from softarm.vision._opencv import opencv_errors
-from softarm.vision.calibration import DEFAULT_FLAGS, grid_size
+from softarm.vision.calibration import DEFAULT_FLAGS, charuco_board, fit_views
+from softarm.vision.calibration_checks import (
+    CalibrationNotConverged,
+    Corners,
+    pair_problems,
+    rms_problem,
+    same_view,
+    tolerance,
+)
 from softarm.vision.camera_model import CameraModel
-from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.poses import invert
 
 if TYPE_CHECKING:
@@ -36,7 +48,8 @@ MIN_CORNERS = 6
 MIN_VIEWS = 3
 _TERM = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-9)
 
-Corners = tuple[npt.NDArray[np.int32], npt.NDArray[np.float32]]  # ids (N,), pixels (N, 2)
+#: Each view's corners (None: fewer than 6), and the images' common (w, h).
+Detected = tuple[list[Corners | None], tuple[int, int]]
 
 
 @dataclass(frozen=True)
@@ -94,55 +107,53 @@ def calibrate_stereo_charuco(
 
     Raises:
         InputError: the two lists differ in length, or a board argument is invalid.
-        VisionError: an image is unusable, or fewer than 3 views show the board to both
-            eyes with at least 6 common corners.
+        VisionError: an image is unusable, fewer than 3 distinct views show the board to
+            both eyes with at least 6 common corners, or a pair shows it at the same
+            place to both eyes.
+        CalibrationNotConverged: the fit is not to be trusted (every problem named).
     """
     if len(left_images) != len(right_images):
         raise InputError(
             f"left_images and right_images must pair up, got {len(left_images)} and "
             f"{len(right_images)} images"
         )
-    board = _board(squares, square_length, marker_length, dictionary)
-    left = _detect_all(board, left_images, "left_images")
-    right = _detect_all(board, right_images, "right_images")
-    model_l = _mono(board, left, "left_images", flags)
-    model_r = _mono(board, right, "right_images", flags)
-    return _stereo(board, left, right, model_l, model_r, flags)
+    board = charuco_board(squares, square_length, marker_length, dictionary)
+    left, right = _detect_pairs(board, left_images, right_images)
+    problems: list[str] = []
+    model_l = _mono(board, left, "left_images", flags, problems)
+    model_r = _mono(board, right, "right_images", flags, problems)
+    model, rms = _stereo(board, left, right, model_l, model_r, flags)
+    problems += rms_problem("stereo", rms) + pair_problems(model.T_left_right)
+    if problems:
+        raise CalibrationNotConverged(model, rms, problems)
+    return model, rms
 
 
-def _board(squares: Any, square_length: float, marker_length: float, dictionary: str) -> Any:
-    square, marker = (
-        positive(square_length, "square_length"),
-        positive(marker_length, "marker_length"),
-    )
-    if marker >= square:
-        raise ParameterError(
-            f"marker_length = {marker!r} must be smaller than square_length = {square!r}"
-        )
-    with opencv_errors("ChArUco board"):
-        return cv2.aruco.CharucoBoard(
-            grid_size(squares, "squares", least=2), square, marker, get_dictionary(dictionary)
-        )
-
-
-def _detect_all(
-    board: Any, images: Sequence[npt.NDArray[Any]], name: str
-) -> tuple[list[Corners | None], tuple[int, int]]:
-    """Each image's ChArUco corners (None: fewer than 6) and the common (w, h)."""
+def _detect_pairs(
+    board: Any, left_images: Sequence[npt.NDArray[Any]], right_images: Sequence[npt.NDArray[Any]]
+) -> tuple[Detected, Detected]:
+    """Both eyes' ChArUco corners, a pair at a time (so that images read on demand are
+    read once and not kept)."""
     detector = cv2.aruco.CharucoDetector(board)
-    found: list[Corners | None] = []
-    shape: tuple[int, ...] | None = None
-    for k, image in enumerate(images):
-        gray = as_gray(image, f"{name}[{k}]")
-        if shape is not None and gray.shape != shape:
-            raise VisionError(f"{name}[{k}] has shape {gray.shape}, the first image {shape}")
-        shape = gray.shape
-        corners, ids, _, _ = detector.detectBoard(gray)
-        ok = ids is not None and len(ids) >= MIN_CORNERS
-        found.append(_corners(ids, corners) if ok else None)
-    if shape is None:
-        raise VisionError(f"{name} is empty: calibration needs >= {MIN_VIEWS} views")
-    return found, (int(shape[1]), int(shape[0]))
+    found: tuple[list[Corners | None], list[Corners | None]] = ([], [])
+    shapes: list[tuple[int, ...] | None] = [None, None]
+    for k in range(len(left_images)):
+        for eye, (images, name) in enumerate(
+            ((left_images, "left_images"), (right_images, "right_images"))
+        ):
+            gray = as_gray(images[k], f"{name}[{k}]")
+            if shapes[eye] is not None and gray.shape != shapes[eye]:
+                raise VisionError(
+                    f"{name}[{k}] has shape {gray.shape}, the first image {shapes[eye]}"
+                )
+            shapes[eye] = gray.shape
+            corners, ids, _, _ = detector.detectBoard(gray)
+            ok = ids is not None and len(ids) >= MIN_CORNERS
+            found[eye].append(_corners(ids, corners) if ok else None)
+    left, right = shapes
+    if left is None or right is None:
+        raise VisionError(f"left_images is empty: calibration needs >= {MIN_VIEWS} views")
+    return (found[0], (int(left[1]), int(left[0]))), (found[1], (int(right[1]), int(right[0])))
 
 
 def _corners(ids: Any, corners: Any) -> Corners:
@@ -158,18 +169,18 @@ def _points(board: Any, corners: Corners) -> tuple[npt.NDArray[Any], npt.NDArray
 
 
 def _mono(
-    board: Any, detected: tuple[list[Corners | None], tuple[int, int]], name: str, flags: int
+    board: Any, detected: Detected, name: str, flags: int, problems: list[str]
 ) -> CameraModel:
+    """One eye's camera from its own distinct views; what is wrong with it is added to
+    ``problems`` (the pair is still fitted, so that every problem is told at once)."""
     views, size = detected
-    pairs = [_points(board, c) for c in views if c is not None]
-    if len(pairs) < MIN_VIEWS:
-        raise VisionError(
-            f"{name}: calibration needs >= {MIN_VIEWS} usable views, got {len(pairs)}"
-        )
-    obj, img = zip(*pairs, strict=True)
-    with opencv_errors(f"calibrateCamera ({name})"):
-        _, mat, dist, _, _ = cv2.calibrateCamera(obj, img, size, None, None, flags=flags)
-    return CameraModel(np.asarray(mat, dtype=np.float64), np.ravel(dist), size)
+    usable = [c for c in views if c is not None]
+    try:
+        model, _, _ = fit_views(board.getChessboardCorners(), usable, size, flags, name)
+    except CalibrationNotConverged as exc:
+        problems += exc.problems
+        return exc.model  # type: ignore[no-any-return]
+    return model
 
 
 def _common(a: Corners, b: Corners) -> tuple[Corners, Corners] | None:
@@ -188,24 +199,19 @@ def _at(corners: Corners, ids: npt.NDArray[np.int32]) -> npt.NDArray[np.float32]
 
 def _stereo(
     board: Any,
-    left: tuple[list[Corners | None], tuple[int, int]],
-    right: tuple[list[Corners | None], tuple[int, int]],
+    left: Detected,
+    right: Detected,
     model_l: CameraModel,
     model_r: CameraModel,
     flags: int,
 ) -> tuple[StereoModel, float]:
-    pairs = [
-        _common(a, b)
-        for a, b in zip(left[0], right[0], strict=True)
-        if a is not None and b is not None
-    ]
-    usable = [p for p in pairs if p is not None]
     if right[1] != left[1]:
         raise VisionError(f"left images are {left[1]} px, right images {right[1]} px")
+    usable = _distinct_pairs(left, right)
     if len(usable) < MIN_VIEWS:
         raise VisionError(
-            f"stereo calibration needs >= {MIN_VIEWS} views with >= {MIN_CORNERS} corners "
-            f"seen by both eyes, got {len(usable)}"
+            f"stereo calibration needs >= {MIN_VIEWS} distinct views with >= {MIN_CORNERS} "
+            f"corners seen by both eyes, got {len(usable)}"
         )
     obj = [_points(board, a)[0] for a, _ in usable]
     img_l = [_points(board, a)[1] for a, _ in usable]
@@ -224,3 +230,25 @@ def _stereo(
         invert(T_right_left),
     )
     return model, float(rms)
+
+
+def _distinct_pairs(left: Detected, right: Detected) -> list[tuple[Corners, Corners]]:
+    """The common corners of each pair both eyes saw, repeated pairs dropped.
+
+    Raises:
+        VisionError: a pair shows the board at the same place to both eyes.
+    """
+    tol = tolerance(left[1])
+    kept: list[tuple[Corners, Corners]] = []
+    for k, (a, b) in enumerate(zip(left[0], right[0], strict=True)):
+        pair = None if a is None or b is None else _common(a, b)
+        if pair is None:
+            continue
+        if same_view(pair[0], pair[1], tol):
+            raise VisionError(
+                f"pair {k}: the left and the right image show the board at the same place "
+                "(one image given for both eyes?)"
+            )
+        if not any(same_view(p[0], pair[0], tol) and same_view(p[1], pair[1], tol) for p in kept):
+            kept.append(pair)
+    return kept

@@ -22,8 +22,16 @@ import cv2
 import numpy as np
 
 from softarm.errors import ConfigError
-from softarm.files import atomic_path, read_text, write_text
-from softarm.vision.camera_files import _ROS_MODELS, _open, _ros_matrix
+from softarm.files import read_text, write_text
+from softarm.vision.calibration_checks import pair_problems
+from softarm.vision.camera_files import (
+    _ROS_MODELS,
+    _cv_reason,
+    _open,
+    _ros_matrix,
+    _size,
+    memory_storage,
+)
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
 from softarm.vision.stereo_calibration import StereoModel
@@ -35,17 +43,12 @@ def write_stereo(model: StereoModel, path: str | Path) -> None:
     """Write ``model`` as one OpenCV FileStorage file (see the module docstring)."""
     T_right_left = invert(model.T_left_right)
     size = model.left.image_size or (0, 0)
-    with atomic_path(path, "stereo file") as tmp:
-        fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE)
-        if not fs.isOpened():
-            raise ConfigError(f"cannot write stereo file {str(path)!r}")
-        try:
-            fs.write("image_width", int(size[0]))
-            fs.write("image_height", int(size[1]))
-            for key, value in _matrices(model, T_right_left).items():
-                fs.write(key, np.asarray(value, dtype=np.float64))
-        finally:
-            fs.release()
+    fs = memory_storage(path, "stereo file")
+    fs.write("image_width", int(size[0]))
+    fs.write("image_height", int(size[1]))
+    for key, value in _matrices(model, T_right_left).items():
+        fs.write(key, np.asarray(value, dtype=np.float64))
+    write_text(path, fs.releaseAndGetString(), "stereo file")
 
 
 def _matrices(model: StereoModel, T_right_left: np.ndarray) -> dict[str, Any]:
@@ -61,18 +64,31 @@ def _matrices(model: StereoModel, T_right_left: np.ndarray) -> dict[str, Any]:
 
 
 def read_stereo(path: str | Path) -> StereoModel:
-    """The pair of a ``stereo.yml`` that :func:`write_stereo` wrote.
+    """The pair of a ``stereo.yml`` that :func:`write_stereo` wrote, checked as the
+    harvest will use it: finite matrices of the right shapes, ``R``/``T`` (when given)
+    agreeing with ``T_left_right``, and a plausible pair
+    (:func:`~softarm.vision.calibration_checks.pair_problems`: a baseline of 5 mm to 2 m,
+    the right eye on the left eye's +x).
 
     Raises:
-        ConfigError: the file is missing, unparsable or lacks a key (named).
+        ConfigError: the file is missing, empty or unparsable, lacks a key, or holds a
+            value the harvest cannot use (one line, the key named).
     """
     text = read_text(path, "stereo file")
-    fs = _open(path, text.lstrip("\ufeff \t\r\n"))
+    fs = _open(path, text.lstrip("\ufeff \t\r\n"), "stereo file")
     try:
-        mats = {k: _mat(fs, k, path) for k in ("M1", "D1", "M2", "D2", "T_left_right")}
-        size = (int(fs.getNode("image_width").real()), int(fs.getNode("image_height").real()))
+        mats = {k: _mat(fs, k, path, shape) for k, shape in _SHAPES.items()}
+        extra = {k: _mat(fs, k, path, shape, required=False) for k, shape in _R_T.items()}
+        size = _size(fs, path)
     finally:
         fs.release()
+    where = f"stereo file {str(path)!r}"
+    if size is None:
+        raise ConfigError(f"{where}: image_width and image_height are missing")
+    _agree(mats["T_left_right"], extra, where)
+    problems = pair_problems(mats["T_left_right"])
+    if problems:
+        raise ConfigError(f"{where}: T_left_right: {problems[0]}")
     try:
         return StereoModel(
             CameraModel(mats["M1"], mats["D1"].ravel(), size),
@@ -80,15 +96,55 @@ def read_stereo(path: str | Path) -> StereoModel:
             mats["T_left_right"],
         )
     except ValueError as exc:
-        raise ConfigError(f"stereo file {str(path)!r}: {exc}") from None
+        raise ConfigError(f"{where}: {exc}") from None
 
 
-def _mat(fs: Any, key: str, path: str | Path) -> np.ndarray:
+#: The keys read and their shapes (None: any number of rows, one column).
+_SHAPES: dict[str, tuple[int, int] | None] = {
+    "M1": (3, 3), "D1": None, "M2": (3, 3), "D2": None, "T_left_right": (4, 4)
+}  # fmt: skip
+_R_T: dict[str, tuple[int, int] | None] = {"R": (3, 3), "T": (3, 1)}
+#: How far R and T may lie from the inverse of T_left_right (rotation entries, m): the
+#: file holds both at 16 significant digits.
+_AGREE = 1e-6
+
+
+def _mat(
+    fs: Any, key: str, path: str | Path, shape: tuple[int, int] | None, required: bool = True
+) -> Any:
+    """The finite matrix ``key`` of ``shape``; None when it is absent and not required."""
+    where = f"stereo file {str(path)!r}: {key}"
     node = fs.getNode(key)
-    mat = None if node.isNone() or not node.isMap() else node.mat()
+    if node.isNone() and not required:
+        return None
+    try:
+        mat = None if node.isNone() or not node.isMap() else node.mat()
+    except cv2.error as exc:
+        raise ConfigError(f"{where} is not a valid opencv-matrix ({_cv_reason(exc)})") from None
     if mat is None:
-        raise ConfigError(f"stereo file {str(path)!r}: {key} is missing or not a matrix")
-    return np.asarray(mat, dtype=np.float64)
+        raise ConfigError(f"{where} is missing or not a matrix")
+    mat = np.asarray(mat, dtype=np.float64)
+    if mat.shape != (shape or (mat.shape[0], 1)):
+        want = "one column" if shape is None else f"{shape[0]}x{shape[1]}"
+        raise ConfigError(f"{where} must be {want}, got shape {mat.shape}")
+    if not np.all(np.isfinite(mat)):
+        raise ConfigError(f"{where} holds a value that is not finite (nan or inf)")
+    return mat
+
+
+def _agree(T_left_right: np.ndarray, extra: dict[str, Any], where: str) -> None:
+    """``R`` and ``T`` (the left eye in the right eye's frame), when both are given,
+    must be the inverse of ``T_left_right``: the harvest reads only the latter."""
+    if extra["R"] is None or extra["T"] is None:
+        return
+    T_right_left = invert(T_left_right)
+    off_r = float(np.max(np.abs(T_right_left[:3, :3] - extra["R"])))
+    off_t = float(np.max(np.abs(T_right_left[:3, 3] - extra["T"].ravel())))
+    if off_r > _AGREE or off_t > _AGREE:
+        raise ConfigError(
+            f"{where}: R and T contradict T_left_right (off by {off_r:.3g} in rotation, "
+            f"{off_t:.3g} m): they must be its inverse; fix or remove them"
+        )
 
 
 def write_ros_stereo(model: StereoModel, left: str | Path, right: str | Path) -> None:
