@@ -36,7 +36,9 @@ def add_dry_run_options(p: argparse.ArgumentParser) -> None:
         "--record-frames", type=output_dir, metavar="DIR",
         help="--sim --world bush: record every camera frame, ripeness reading and "
         "pressure command in DIR, with DIR/hw.toml, the rig as a hardware configuration "
-        "(the dry run's input)",
+        "(the dry run's input). Recorded into a fresh folder beside DIR, moved into place "
+        "when the run ends: DIR must be new, empty or an earlier recording (it holds "
+        "frames.json), which is replaced whole; a stopped run leaves DIR as it was",
     )  # fmt: skip
     p.add_argument(
         "--frames", type=Path, metavar="DIR",
@@ -86,11 +88,15 @@ def replay_rounds(devices: ReplayDevices) -> int:
 
 
 def log_commands(devices: ReplayDevices, log: HarvestLog) -> None:
-    """Write each command the dry run would have sent into ``log`` as it is sent."""
+    """Write each command the dry run would have sent into ``log`` as it is sent. The
+    rig's close vents once more after a stop has completed and closed the log: that
+    vent is kept with the commands but not logged (the log ends with the stop)."""
     keep = devices.commands.append
 
     def logged(command: list[Any]) -> None:
         keep(command)
+        if log.closed:
+            return
         psi = command[2] if command[0] == "set" else None
         log.event("pressure_command", t=command[1], command=command[0], psi=psi)
 

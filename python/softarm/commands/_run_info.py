@@ -73,16 +73,34 @@ def write_run_bag(records: list[Any], path: Path | None, frames: str | Path | No
     print(f"bag: {path} ({summary.messages} messages on {len(summary.counts)} topics{with_images})")
 
 
-def write_log_bag(log: Path, path: Path | None, frames: Path | None = None) -> None:
+def write_log_bag(
+    log: Path, path: Path | None, frames: Path | None = None, run: int | None = None
+) -> None:
     """Write the records of the run log ``log`` to the MCAP bag ``path`` (nothing when
     None), with the frames recorded in ``frames``; a malformed record is an InputError
-    naming the file and the record."""
+    naming the file and the record. A log that ``--log`` appended to holds several runs:
+    ``run`` (1 = the first) picks one, and is needed then."""
     if path is None:
         return
     from softarm.errors import InputError
-    from softarm.harvest.log import read_log
 
     try:
-        write_run_bag(list(read_log(log)), path, frames)
+        write_run_bag(_one_run(log, run), path, frames)
     except InputError as exc:
         raise type(exc)(f"{log}: {exc}") from None
+
+
+def _one_run(log: Path, run: int | None) -> list[Any]:
+    """The records of run ``run`` of ``log`` (None: its only run)."""
+    from softarm.errors import InputError
+    from softarm.harvest.header import split_runs
+    from softarm.harvest.log import read_log
+
+    runs = split_runs(list(read_log(log)))
+    if run is None and len(runs) > 1:
+        raise InputError(
+            f"the log holds {len(runs)} runs (--log appends); choose one with --run 1..{len(runs)}"
+        )
+    if run is not None and not 1 <= run <= len(runs):
+        raise InputError(f"--run {run}: the log holds {len(runs)} run(s)")
+    return runs[0 if run is None else run - 1]

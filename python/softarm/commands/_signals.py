@@ -8,21 +8,36 @@ Every command that can pressurise the arm gets the same handling from here:
 * :func:`drives_arm` decorates its ``run(args)``: the signals raise :class:`Interrupted`,
   and the command ends with one line on stderr and exit status 130 or 143;
 * :func:`vents_on_stop` wraps the part that drives the arm: a stop vents it and, given
-  a run log, records why (``interrupted``) and syncs the log.
+  a run log, records why (``interrupted``) and syncs the log;
+* :func:`records_late_stop` wraps what a run writes after it ended: a stop then is
+  recorded in the run's log too.
+
+Commands that only write files get :func:`stops_on_signals`: a stop unwinds through
+their clean-up and ends them with one line, exit status 130 or 143.
 """
 
 from __future__ import annotations
 
 import functools
 import logging
+import os
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from types import FrameType
 from typing import Any, Protocol
 
-__all__ = ["Interrupted", "drives_arm", "raise_on_signals", "stop_arm", "vents_on_stop"]
+__all__ = [
+    "Interrupted",
+    "drives_arm",
+    "raise_on_signals",
+    "records_late_stop",
+    "stop_arm",
+    "stops_on_signals",
+    "vents_on_stop",
+]
 
 _log = logging.getLogger(__name__)
 
@@ -57,17 +72,64 @@ def _raise(signum: int, frame: FrameType | None) -> None:
 def raise_on_signals() -> Iterator[None]:
     """Inside the block, SIGINT and SIGTERM raise :class:`Interrupted`; the previous
     handlers are restored on the way out. Only the main thread can install handlers, so
-    elsewhere (a test runner's worker thread) the block runs unchanged."""
+    elsewhere (a test runner's worker thread) the block runs unchanged.
+
+    A signal that arrives while a finalizer runs (``__del__``, as when a harvest's
+    renderers are freed) raises inside it, and Python only prints "Exception ignored"
+    and goes on: the stop would be lost and the command exit 0. Such a swallowed stop
+    is kept (:func:`_keep_swallowed`) and signalled again once the finalizer returned,
+    or raised when the block ends first, so the command still ends as stopped."""
     try:
         previous = {s: signal.signal(s, _raise) for s in SIGNALS}
     except ValueError:  # not the main thread
         yield
         return
+    swallowed: list[Interrupted] = []
+    resends: list[threading.Timer] = []
+    hook = sys.unraisablehook
+    sys.unraisablehook = _keep_swallowed(swallowed, resends, hook)
     try:
         yield
     finally:
+        sys.unraisablehook = hook
+        if resends:  # the stop is raised below: a resent signal must not land later
+            for s in SIGNALS:
+                signal.signal(s, signal.SIG_IGN)
+            for timer in resends:
+                timer.cancel()
+                timer.join()
         for s, handler in previous.items():
             signal.signal(s, handler)
+    if swallowed:
+        raise swallowed[0]
+
+
+#: How soon (s) a stop a finalizer swallowed is signalled again, once it has returned.
+RESEND_S = 0.05
+
+
+def _keep_swallowed(
+    swallowed: list[Interrupted], resends: list[threading.Timer], hook: Callable[[Any], object]
+) -> Callable[[Any], object]:
+    """An unraisable hook that keeps an :class:`Interrupted` a finalizer swallowed (not
+    printed: the stop is reported once, as a stop) and passes anything else to ``hook``.
+    The kept stop is signalled again shortly, so that a run does not go on to its end
+    (the handlers are armed again: :func:`_raise` had set them to ignore)."""
+
+    def keep(unraisable: Any) -> object:
+        exc = unraisable.exc_value
+        if not isinstance(exc, Interrupted):
+            return hook(unraisable)
+        swallowed.append(exc)
+        for s in SIGNALS:
+            signal.signal(s, _raise)
+        timer = threading.Timer(RESEND_S, os.kill, (os.getpid(), exc.signum))
+        timer.daemon = True
+        resends.append(timer)
+        timer.start()
+        return None
+
+    return keep
 
 
 class EventLog(Protocol):
@@ -131,7 +193,41 @@ def vents_on_stop(vent: Callable[[str], object], log: EventLog | None = None) ->
         raise
 
 
+class ReopenableLog(EventLog, Protocol):
+    """A log that can be opened again for a record after the run closed it."""
+
+    def reopen(self) -> None: ...
+
+
+@contextmanager
+def records_late_stop(log: ReopenableLog) -> Iterator[None]:
+    """After a run, while its outputs (report, bag, plot) are written: a stop is recorded
+    in the run's ``log``, opened again for it, so that a run stopped now still ends its
+    log with the ``interrupted`` record. The arm was vented when the run ended."""
+    try:
+        yield
+    except (Interrupted, KeyboardInterrupt, SystemExit) as exc:
+        log.reopen()
+        stop_arm(lambda reason: None, exc, log)
+        raise
+
+
 Run = Callable[[Any], int]
+
+
+def stops_on_signals(run: Run) -> Run:
+    """Decorator for the ``run(args)`` of a command that writes files but drives no arm
+    (``dataset``, ``replay``): SIGINT and SIGTERM raise :class:`Interrupted`, so its
+    ``finally`` blocks remove what it left half-written, and ``softarm.cli.main`` ends it
+    with one line and exit status 130 or 143. Python's default SIGTERM ends the process
+    where it stands, temporary files and folders left behind."""
+
+    @functools.wraps(run)
+    def guarded(args: Any) -> int:
+        with raise_on_signals():
+            return run(args)
+
+    return guarded
 
 
 def drives_arm(command: str) -> Callable[[Run], Run]:

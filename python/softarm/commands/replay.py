@@ -6,9 +6,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from softarm.commands._args import data_file, int_range, non_negative_int, output_file
+from softarm.commands._args import (
+    data_file,
+    int_range,
+    non_negative_int,
+    output_file,
+    positive_int,
+)
 from softarm.commands._format import plural
 from softarm.commands._run_info import check_bag, write_log_bag
+from softarm.commands._signals import stops_on_signals
 from softarm.commands.harvest import MAX_BERRIES
 from softarm.errors import ParameterError
 
@@ -24,7 +31,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "Without --record or --bag the rerun viewer is started. Needs the viz extra: "
         "pip install 'softarm[viz]'; --bag alone needs only the ros extra: "
         "pip install 'softarm[ros]'. The log's header record gives the arm, the bush and "
-        "the cameras. Exit status 0, or 2 for a bad log or a missing extra.",
+        "the cameras. Exit status 0, 2 for a bad log or a missing extra, 130/143 stopped "
+        "by SIGINT/SIGTERM (no half-written bag is left).",
     )
     p.add_argument("log", type=data_file, help="run log written by `softarm harvest --log`")
     p.add_argument("--record", type=output_file, metavar="OUT.rrd", help="save the recording")
@@ -36,6 +44,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--frames", type=Path, metavar="DIR",
         help="with --bag: add the camera frames recorded in DIR (`harvest --sim --world bush "
         "--record-frames DIR`) as CompressedImage topics (docs/ros.md)",
+    )  # fmt: skip
+    p.add_argument(
+        "--run", type=positive_int, metavar="N", dest="run_number",
+        help="with --bag: the run to write from a log that --log appended to more than "
+        "once (1 = the first); needed when the log holds more than one run",
     )  # fmt: skip
     p.add_argument(
         "--view",
@@ -58,19 +71,22 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
+@stops_on_signals  # a stop removes the half-written bag and its temporary folder
 def run(args: argparse.Namespace) -> int:
     """Write the bag and/or the recording; returns 0."""
     check_bag(args.bag)
     if args.frames is not None and args.bag is None:
         raise ParameterError("--frames: adds the recorded frames to a bag; give --bag too")
+    if args.run_number is not None and args.bag is None:
+        raise ParameterError("--run: picks the run a bag is written from; give --bag too")
     if args.bag is not None and not args.view and args.record is None:
-        write_log_bag(args.log, args.bag, args.frames)
+        write_log_bag(args.log, args.bag, args.frames, args.run_number)
         return 0
     from softarm.viz.replay import replay
     from softarm.viz.rerun_sdk import require_rerun
 
     require_rerun()  # before the bag is written
-    write_log_bag(args.log, args.bag, args.frames)
+    write_log_bag(args.log, args.bag, args.frames, args.run_number)
     scene = None if args.sim_seed is None else (args.sim_seed, args.berries)
     n = replay(args.log, args.record, spawn=args.view or args.record is None, scene=scene)
     where = f"recording: {args.record}" if args.record is not None else "sent to the viewer"

@@ -8,12 +8,15 @@ is one :class:`~softarm.errors.ConfigError` line naming the file and the key.
 
 Writing (:mod:`~softarm.files.write`): a temporary file in the same folder, fsync'd and
 renamed over the target, so a failed write (full disk, file-size limit) is one
-:class:`~softarm.errors.OutputError` line and leaves the previous file intact.
+:class:`~softarm.errors.OutputError` line and leaves the previous file intact. A folder
+of outputs is written the same way (:mod:`~softarm.files.fresh`): filled aside, then
+moved into place.
 
 A leaf: imports nothing of softarm but :mod:`softarm.errors`.
 """
 
 from softarm.files.document import MAX_DEPTH, MAX_INT, check_document
+from softarm.files.fresh import FreshFolder
 from softarm.files.ranges import Range, integer, number, numbers, shown
 from softarm.files.read import (
     MAX_BYTES,
@@ -30,6 +33,7 @@ __all__ = [
     "MAX_BYTES",
     "MAX_DEPTH",
     "MAX_INT",
+    "FreshFolder",
     "Range",
     "atomic_path",
     "check_document",

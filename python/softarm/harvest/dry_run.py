@@ -33,6 +33,7 @@ from softarm.config import (
 )
 from softarm.harvest.bush_world import BushScene
 from softarm.harvest.frame_files import FrameRecorder
+from softarm.harvest.frame_index import BERRY_STATES, COMMANDS, RIPENESS
 from softarm.harvest.report import BerryResult
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
@@ -55,12 +56,6 @@ __all__ = [
     "write_rig_files",
 ]
 
-#: The stream of pressure commands: ``["set", t, [psi, ...]]`` or ``["vent", t]``.
-COMMANDS = "commands"
-#: The stream of the ripeness sensor's readings.
-RIPENESS = "ripeness"
-#: The stream of how each berry ended, in the order tried (:func:`berry_outcome`).
-BERRY_STATES = "berry_states"
 #: The hardware configuration written beside the frames.
 CONFIG = "hw.toml"
 

@@ -16,7 +16,10 @@ import numpy as np
 
 from softarm.errors import ConfigError
 from softarm.files import write_text
+from softarm.files.fresh import FreshFolder
+from softarm.files.images import read_image, write_image
 from softarm.files.read import load_json
+from softarm.harvest.frame_index import check_entry, check_streams
 from softarm.vision.crop import ImageCrop
 
 __all__ = ["INDEX", "TIME_TOLERANCE_S", "FrameFolder", "FrameRecorder"]
@@ -38,11 +41,19 @@ def _cv2() -> Any:
 
 
 class FrameRecorder:
-    """Records the frames of the cameras it wraps into ``folder``."""
+    """Records the frames of the cameras it wraps into ``folder``: into a fresh folder
+    beside it (:attr:`folder` while recording), moved into place by :meth:`save`, so
+    that an earlier recording there is replaced whole or not at all; :meth:`discard`
+    drops an unfinished one.
+
+    Raises:
+        OutputError: ``folder`` exists and holds other files than an earlier recording.
+    """
 
     def __init__(self, folder: str | Path) -> None:
-        self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
+        self.target = Path(folder)
+        self._fresh = FreshFolder(folder, "recording", INDEX)
+        self.folder = self._fresh.path
         self.entries: list[dict[str, Any]] = []
         self.streams: dict[str, list[Any]] = {}
 
@@ -80,7 +91,7 @@ class FrameRecorder:
         entry: dict[str, Any] = {"camera": camera, "n": n, "t": float(t), "file": None}
         if image is not None:
             entry["file"] = f"{camera}_{n:06d}.png"
-            _cv2().imwrite(str(self.folder / entry["file"]), np.asarray(image))
+            write_image(self.folder / entry["file"], np.asarray(image), "frame file")
             if (
                 isinstance(image, ImageCrop)
                 and image.origin is not None
@@ -90,11 +101,16 @@ class FrameRecorder:
         self.entries.append(entry)
 
     def save(self) -> Path:
-        """Write the index; its path."""
-        path = self.folder / INDEX
+        """Write the index and move the recording into place; the index's path."""
         index = {"frames": self.entries, "streams": self.streams}
-        write_text(path, json.dumps(index, indent=1) + "\n", "frames index")
-        return path
+        write_text(self.folder / INDEX, json.dumps(index, indent=1) + "\n", "frames index")
+        self._fresh.commit()
+        self.folder = self.target
+        return self.folder / INDEX
+
+    def discard(self) -> None:
+        """Drop an unfinished recording (nothing once :meth:`save` moved it into place)."""
+        self._fresh.discard()
 
 
 class FrameFolder:
@@ -111,10 +127,8 @@ class FrameFolder:
         frames = data.get("frames") if isinstance(data, dict) else None
         if not isinstance(frames, list):
             raise ConfigError(f"{self.folder / INDEX}: frames must be a list of entries")
-        streams = data.get("streams", {})
-        if not isinstance(streams, dict):
-            raise ConfigError(f"{self.folder / INDEX}: streams must be a table of lists")
-        self.streams: dict[str, list[Any]] = streams
+        # Every value the replay reads is checked here, before anything is replayed.
+        self.streams = check_streams(str(self.folder / INDEX), data.get("streams", {}))
         self.entries: dict[str, list[dict[str, Any]]] = {}
         for i, entry in enumerate(frames):
             self._check(i, entry)
@@ -122,8 +136,7 @@ class FrameFolder:
 
     def _check(self, i: int, entry: Any) -> None:
         where = f"{self.folder / INDEX}: frames[{i}]"
-        if not isinstance(entry, dict) or not {"camera", "n", "t", "file"} <= set(entry):
-            raise ConfigError(f"{where} must have camera, n, t and file")
+        check_entry(where, entry)
         earlier = self.entries.get(entry["camera"], [])
         if entry["n"] != len(earlier) or (earlier and entry["t"] < earlier[-1]["t"]):
             raise ConfigError(
@@ -160,7 +173,7 @@ class FrameFolder:
             entry = next(entries, None)
             if entry is None:
                 raise ConfigError(f"{self.folder}: no {camera} frame left to replay at t = {t}")
-            if abs(t - entry["t"]) > TIME_TOLERANCE_S:
+            if not abs(t - entry["t"]) <= TIME_TOLERANCE_S:  # a NaN time is not close
                 raise ConfigError(
                     f"{self.folder}: the replay left the recording: {camera} frame "
                     f"{entry['n']} asked for at t = {t!r} s, recorded at {entry['t']!r} s"
@@ -176,7 +189,7 @@ class FrameFolder:
         return lambda: (left(now()), right(now()))
 
     def _image(self, entry: dict[str, Any]) -> Any:
-        image = _cv2().imread(str(self.folder / entry["file"]), -1)  # IMREAD_UNCHANGED
+        image = read_image(self.folder / entry["file"], "frame file", error=ConfigError)
         if image is None:
             raise ConfigError(f"frame file {str(self.folder / entry['file'])!r} is not an image")
         if "origin" in entry:

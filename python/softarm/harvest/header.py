@@ -30,6 +30,7 @@ __all__ = [
     "find_header",
     "git_commit",
     "header_record",
+    "split_runs",
 ]
 
 #: The kind of the header record.
@@ -274,3 +275,19 @@ def find_header(records: Iterable[Any]) -> dict[str, Any] | None:
         if isinstance(r, dict) and r.get("kind") == HEADER:
             return r
     return None
+
+
+def split_runs(records: Sequence[Any]) -> list[list[Any]]:
+    """The runs of a log that ``--log`` appended to more than once: each header record
+    opens a run. Records before the first header are a run of their own (an older log's,
+    written before the header existed), unless they are only the mark of a cut-off line
+    (:data:`softarm.harvest.log.CUT_MARK`, which an appending run writes first)."""
+    from softarm.harvest.log import CUT_MARK
+
+    runs: list[list[Any]] = [[]]
+    for r in records:
+        if isinstance(r, dict) and r.get("kind") == HEADER:
+            runs.append([])
+        runs[-1].append(r)
+    first = [r for r in runs[0] if not (isinstance(r, dict) and r.get("kind") == CUT_MARK)]
+    return runs if first or len(runs) == 1 else runs[1:]

@@ -114,6 +114,17 @@ class HarvestLog:
         except OSError as exc:
             raise output_error(self.path or "", "log", exc) from None
 
+    @property
+    def closed(self) -> bool:
+        """Whether :meth:`close` was called on a log written to a file."""
+        return self._file is not None and self._file.closed
+
+    def reopen(self) -> None:
+        """Open the file again for appending after :meth:`close` (a stop recorded after
+        the run closed its log); nothing for a log that is open or kept in memory."""
+        if self.closed and self.path is not None:
+            self._file = self._open(self.path)
+
     def close(self) -> None:
         """Sync and close the file. Calling it twice is harmless."""
         if self._file is not None and not self._file.closed:

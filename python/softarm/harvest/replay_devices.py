@@ -10,6 +10,7 @@ hardware path itself.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from contextlib import ExitStack
 from typing import Any
@@ -18,15 +19,29 @@ import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.config import Config
-from softarm.errors import ConfigError
-from softarm.harvest.dry_run import COMMANDS, RIPENESS, CommandTap
+from softarm.errors import HardwareError
+from softarm.harvest.dry_run import CommandTap
 from softarm.harvest.frame_files import FrameFolder
+from softarm.harvest.frame_index import COMMANDS, RIPENESS, SEED
 from softarm.harvest.hw_perception import Pair
 from softarm.harvest.sim_devices import SimClock
 from softarm.perception_config import PerceptionConfig
 from softarm.vision.two_cameras import Frame
 
-__all__ = ["DryOutputs", "ReplayDevices", "ReplayLink", "compare_commands"]
+__all__ = [
+    "DryOutputs",
+    "RecordingExhaustedError",
+    "ReplayDevices",
+    "ReplayLink",
+    "compare_commands",
+]
+
+
+class RecordingExhaustedError(HardwareError):
+    """The replayed device has no recorded reply left for what the dry run asks: it went
+    further than the recorded run (another ripeness reading, a command never sent). A
+    device error, so the machine ends the berry in FAULT with this message as its
+    stated reason, vented, and stops the run (nothing further can be replayed)."""
 
 
 class DryOutputs:
@@ -76,9 +91,12 @@ class ReplayLink:
         if command == "NIR":
             value = next(self._ripeness, None)
             if value is None:
-                raise ConfigError(f"{self._where}: no ripeness reading left to replay")
+                raise RecordingExhaustedError(
+                    f"{self._where}: no ripeness reading left to replay (the dry run read "
+                    "more than the recorded run did)"
+                )
             return [repr(float(value))]
-        raise ConfigError(f"{self._where}: the recording has no reply to {command!r}")
+        raise RecordingExhaustedError(f"{self._where}: the recording has no reply to {command!r}")
 
     def close(self) -> None:
         pass
@@ -97,7 +115,7 @@ class ReplayDevices:
 
     def recorded_seed(self) -> int:
         """The seed the recorded run's planner used."""
-        return int(self.folder.stream("seed")[0])
+        return int(self.folder.stream(SEED)[0])
 
     def clock(self) -> SimClock:
         return self._clock
@@ -131,15 +149,22 @@ def compare_commands(sent: list[list[Any]], recorded: list[list[Any]]) -> dict[s
         if a[0] != b[0] or len(a) != len(b) or (a[0] == "set" and len(a[2]) != len(b[2])):
             first = i
             break
-        max_t = max(max_t, abs(a[1] - b[1]))
+        max_t = _worst(max_t, [a[1] - b[1]])
         if a[0] == "set":
-            max_psi = max(max_psi, float(np.max(np.abs(np.subtract(a[2], b[2])))))
+            max_psi = _worst(max_psi, np.subtract(a[2], b[2]))
     return {
         "count": (len(sent), len(recorded)),
         "max_psi": max_psi,
         "max_t": max_t,
         "first_mismatch": first,
     }
+
+
+def _worst(worst: float, differences: Any) -> float:
+    """The larger of ``worst`` and the largest magnitude of ``differences``; infinite
+    when one is not finite (``max(0.0, nan)`` would keep 0.0 and call NaN the same)."""
+    d = np.abs(np.asarray(differences, dtype=float))
+    return max(worst, float(np.max(d))) if np.all(np.isfinite(d)) else math.inf
 
 
 def recorded_commands(folder: FrameFolder) -> list[list[Any]]:

@@ -163,14 +163,12 @@ class SimRig:
         picked. The report keeps each berry's last attempt.
         """
         if self.scene is not None:
-            scene = self.scene
-            if self.survey is not None:
-                self.survey.run()
-            report = harvest_bush(
-                scene, self.machine.run_berry, self.gripper.delivered, on_berry,
-                on_look=lambda: self.machine.log_map(scene.bush_map),
-            )  # fmt: skip
-            return self._finish(report)
+            try:
+                return self._finish(self._harvest_bush(on_berry))
+            except BaseException:
+                if self.recorder is not None:  # an unfinished recording is not left behind
+                    self.recorder.discard()
+                raise
         report = HarvestReport()
         order = [b.tag_id for b in self.bush.berries]
         results: dict[int, BerryResult] = {}
@@ -188,6 +186,26 @@ class SimRig:
                 break
         report.berries = [results.get(t, BerryResult(t)) for t in order]
         return self._finish(report)
+
+    def _harvest_bush(self, on_berry: Callable[[int, BerryResult], None] | None) -> HarvestReport:
+        """The markerless harvest of the rendered bush, the survey first."""
+        assert self.scene is not None
+        scene = self.scene
+        if self.survey is not None:
+            self.survey.run()
+        return harvest_bush(
+            scene, self.machine.run_berry, self.gripper.delivered, on_berry,
+            on_look=lambda: self.machine.log_map(scene.bush_map),
+        )  # fmt: skip
+
+    def close(self) -> None:
+        """Free the rendered bush's OpenGL contexts (if any) now, rather than in
+        finalizers at exit, where a stop signal would be lost, and drop a recording the
+        run did not finish. Harmless twice."""
+        if self.recorder is not None:
+            self.recorder.discard()
+        if self.scene is not None:
+            self.scene.world.close()
 
     def _finish(self, report: HarvestReport) -> HarvestReport:
         report.extra.update(
@@ -211,6 +229,18 @@ def build_sim_rig(
     ``controller`` defaults to the control stack's (:func:`~softarm.harvest.rig.
     build_control_stack`, the same as the hardware's)."""
     o = options or SimRigOptions()
+    recorder = _recorder(o)  # first: a folder it may not replace is refused before work
+    try:
+        return _build_sim_rig(o, controller, recorder)
+    except BaseException:
+        if recorder is not None:  # no unfinished recording is left behind
+            recorder.discard()
+        raise
+
+
+def _build_sim_rig(
+    o: SimRigOptions, controller: Controller | None, recorder: FrameRecorder | None
+) -> SimRig:
     cfg = o.config
     nominal = softarm.SoftArm.blackberry()
     model = nominal if o.calibration is None else o.calibration.arm
@@ -221,7 +251,6 @@ def build_sim_rig(
     canes = [b.curve() for b in bush.branches]  # the truth: contacts are scored on it
     watch = _watch(o, plant, canes)
     clock = SimClock([plant.advance, watch.sample])
-    recorder = _recorder(o)
     bank = _bank(plant, clock, recorder)
     vision: CameraVision
     gripper: SimGripper

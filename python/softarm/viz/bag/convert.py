@@ -22,7 +22,7 @@ from softarm.errors import InputError
 from softarm.harvest.header import HEADER, find_header
 from softarm.viz.bag.markers import scene_markers
 from softarm.viz.bag.messages import Messages
-from softarm.viz.bag.scene import CANE_SAMPLES, RunScene, cane_branch
+from softarm.viz.bag.scene import CANE_SAMPLES, RunScene, cane_branch, stamp_ns
 from softarm.viz.records import _LEVELS, _seconds, as_pose, as_vector
 
 __all__ = ["TOPICS", "Converter", "Detection", "Message", "actuator_names"]
@@ -107,7 +107,7 @@ class Converter:
         return cls(m, RunScene.from_header(find_header(records)))
 
     def ns(self, t: float) -> int:
-        return self.scene.start_ns + round(t * 1e9)
+        return stamp_ns(self.scene.start_ns, t)
 
     def messages(self, records: Iterable[Any]) -> Iterator[Message]:
         """Every message of ``records``, the fixed frames first."""
@@ -139,6 +139,7 @@ class Converter:
             if self._pending is not None and t > self._pending[0]:
                 yield from self._flush()
             self.t = max(self.t, t)
+            self.ns(self.t)  # a stamp the bag cannot hold is named with this record
         if r["kind"] == "step":
             self._pending = (self.t, self._checked_step(r))
             return

@@ -14,18 +14,17 @@ from __future__ import annotations
 
 import dataclasses
 import heapq
-import math
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from softarm.errors import ConfigError
+from softarm.errors import ConfigError, InputError
 from softarm.harvest.frame_files import INDEX, FrameFolder
 from softarm.viz.bag.convert import Message
 from softarm.viz.bag.messages import Messages
-from softarm.viz.bag.scene import RunScene
+from softarm.viz.bag.scene import RunScene, stamp_ns
 
 __all__ = ["IMAGE_TOPICS", "STREAMS", "FrameImages", "image_format", "scaled_camera"]
 
@@ -96,13 +95,12 @@ class FrameImages:
         yield from heapq.merge(*(stream(c) for c in STREAMS), key=lambda item: item.ns)
 
     def _ns(self, entry: Mapping[str, Any]) -> int:
-        t = entry["t"]
-        if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
-            raise ConfigError(
-                f"{self.index}: {entry['camera']} frame {entry['n']}: t must be a number "
-                f"of seconds, got {t!r}"
-            )
-        return self.scene.start_ns + round(t * 1e9)
+        # The folder checked every t (finite); its stamp must still fit in the bag.
+        try:
+            return stamp_ns(self.scene.start_ns, entry["t"])
+        except InputError as exc:
+            where = f"{self.index}: {entry['camera']} frame {entry['n']}"
+            raise ConfigError(f"{where}: {exc}") from None
 
     def _decode(self, entry: Mapping[str, Any]) -> tuple[np.ndarray, bytes]:
         """The frame's pixels (for its size and pixel format) and its file's bytes."""

@@ -17,12 +17,27 @@ from softarm.errors import InputError
 from softarm.harvest.header import READABLE_FORMATS
 from softarm.sim.bush import Branch
 from softarm.units import MAX_PSI, METRES_PER_PSI
+from softarm.viz.bag.messages import NS_PER_S
 from softarm.viz.records import as_pose, as_vector
 
-__all__ = ["CANE_SAMPLES", "BerryMark", "RunScene", "cane_branch"]
+__all__ = [
+    "CAMERAS",
+    "CANE_SAMPLES",
+    "MAX_STAMP_NS",
+    "BerryMark",
+    "RunScene",
+    "cane_branch",
+    "stamp_ns",
+]
 
 #: Points along each cane's line strip.
 CANE_SAMPLES = 40
+#: The cameras a header may describe (each has its topics in the bag).
+CAMERAS = ("camera_c1", "camera_c2")
+#: The largest image side a header camera may have (pixels).
+MAX_PIXELS = 65535
+#: The last stamp a bag can hold: builtin_interfaces/Time keeps seconds in an int32.
+MAX_STAMP_NS = 2**31 * NS_PER_S - 1
 
 
 @dataclass(frozen=True)
@@ -72,9 +87,9 @@ class RunScene:
             raise InputError(f"header world must be an object, got {world!r:.60}")
         return cls(
             arm=_arm(header.get("arm")),
-            grasp_offset=float(header.get("grasp_offset_m", 0.03)),
+            grasp_offset=_number(header.get("grasp_offset_m", 0.03), "header grasp_offset_m"),
             frames={k: _frame(k, v) for k, v in (header.get("frames") or {}).items()},
-            cameras=dict(header.get("cameras") or {}),
+            cameras=_cameras(header.get("cameras")),
             branches=[_cane(c) for c in world.get("canes", [])],
             berries=[_berry(b) for b in world.get("berries", [])],
             pressure=_pressure(header.get("pressure_map")),
@@ -152,15 +167,69 @@ def _berry(value: Any) -> BerryMark:
 def _pressure(value: Any) -> tuple[float, FloatArray, FloatArray]:
     if value is None:
         return MAX_PSI, np.array(METRES_PER_PSI), np.zeros(1)
+    if not isinstance(value, Mapping):
+        raise InputError(f"header pressure_map must be an object, got {value!r:.60}")
     mpp = as_vector(value.get("metres_per_psi"), "header pressure_map.metres_per_psi")
     offset = as_vector(value.get("offset_m", [0.0]), "header pressure_map.offset_m")
     if not np.all(mpp > 0):
         raise InputError("header pressure_map.metres_per_psi must be positive")
-    return float(value.get("max_psi", MAX_PSI)), mpp, offset
+    return _number(value.get("max_psi", MAX_PSI), "header pressure_map.max_psi"), mpp, offset
+
+
+def _number(value: Any, name: str) -> float:
+    return float(as_vector([value], name)[0])
 
 
 def _start(value: Any) -> int:
-    """The header's start time: a non-negative integer of ns since the epoch."""
-    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-        raise InputError(f"header started_unix_ns must be a non-negative integer, got {value!r}")
+    """The header's start time: a non-negative integer of ns since the epoch, within
+    what a bag's stamps hold (:data:`MAX_STAMP_NS`)."""
+    if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= MAX_STAMP_NS:
+        raise InputError(
+            f"header started_unix_ns must be an integer of ns from 0 to {MAX_STAMP_NS} "
+            f"(a ROS 2 stamp keeps its seconds in 32 bits), got {str(value)[:40]}"
+        )
     return value
+
+
+def stamp_ns(start_ns: int, t: float) -> int:
+    """The stamp (ns since the epoch) of the time ``t`` (s, finite) of a run that
+    started at ``start_ns``; an InputError where a bag cannot hold it."""
+    ns = start_ns + round(t * NS_PER_S) if abs(t) <= MAX_STAMP_NS / NS_PER_S else -1
+    if not 0 <= ns <= MAX_STAMP_NS:
+        raise InputError(
+            f"t = {t!r} s from the run's start gives a stamp outside 0..{MAX_STAMP_NS} ns "
+            "(a ROS 2 stamp keeps its seconds in 32 bits)"
+        )
+    return ns
+
+
+def _cameras(value: Any) -> dict[str, Mapping[str, Any]]:
+    """The header's cameras: ``camera_c1`` and/or ``camera_c2``, each with an image
+    size (0 x 0: unknown), a 3 x 3 ``K`` and distortion ``D``, all finite."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise InputError(f"header cameras must be an object, got {value!r:.60}")
+    return {name: _camera(name, camera) for name, camera in value.items()}
+
+
+def _camera(name: Any, value: Any) -> dict[str, Any]:
+    where = f"header cameras.{name}"
+    if name not in CAMERAS:
+        raise InputError(f"{where}: the cameras are {' and '.join(CAMERAS)}")
+    if not isinstance(value, Mapping):
+        raise InputError(f"{where} must hold width, height, K and D, got {value!r:.60}")
+    size: list[Any] = [value.get("width"), value.get("height")]
+    whole = all(isinstance(v, int) and not isinstance(v, bool) for v in size)
+    if not (whole and all(0 <= v <= MAX_PIXELS for v in size)):
+        raise InputError(f"{where}: width and height must be integers 0..{MAX_PIXELS}, got {size}")
+    K = as_vector(np.ravel(_array(value.get("K"), f"{where}.K")), f"{where}.K", 9)
+    D = as_vector(np.ravel(_array(value.get("D", []), f"{where}.D")), f"{where}.D")
+    return {"width": size[0], "height": size[1], "K": K.reshape(3, 3), "D": D}
+
+
+def _array(value: Any, name: str) -> Any:
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers, got {value!r:.60}") from None

@@ -19,6 +19,7 @@ from typing import Any
 
 from softarm.errors import InputError, OutputError
 from softarm.files import atomic_path, check_target
+from softarm.harvest.header import split_runs
 from softarm.viz.bag.convert import TOPICS, Converter
 from softarm.viz.bag.deps import require_rosbags, typestore
 from softarm.viz.bag.images import IMAGE_TOPICS, FrameImages
@@ -65,7 +66,9 @@ def write_bag(
     when given; an existing file is replaced only once the new one is complete.
 
     Raises:
-        InputError: a record is malformed (the message names its number and field).
+        InputError: a record is malformed (the message names its number and field), or
+            the records hold more than one run (a log appended to: pick one with
+            :func:`softarm.harvest.header.split_runs`).
         ConfigError: the frames folder is broken: no index, a frame file missing or not
             an image (the file named).
         MissingDependencyError: rosbags (the ``ros`` extra) is not installed.
@@ -75,6 +78,9 @@ def write_bag(
     rosbag2 = require_rosbags()
     m = Messages(typestore())
     recs = list(records)
+    runs = len(split_runs(recs))
+    if runs > 1:  # the second run's clock restarts at 0: its steps would collapse
+        raise InputError(f"the records hold {runs} runs (header records); a bag holds one")
     converter = Converter.for_records(m, recs)
     # The folder is checked before any writing; the cameras are as the frames were taken.
     images = None if frames is None else FrameImages(m, frames, converter.scene)
