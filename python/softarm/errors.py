@@ -17,6 +17,7 @@ __all__ = [
     "HardwareError",
     "HardwareUnavailableError",
     "InputError",
+    "MissingDependencyError",
     "NonFiniteError",
     "OutOfRangeError",
     "OutputError",
@@ -110,3 +111,17 @@ class ConfigError(SoftarmError, ValueError):
 class OutputError(SoftarmError, OSError):
     """An output file cannot be written (missing folder, full disk, file-size limit); the
     previous file of that name, if any, is left as it was."""
+
+
+class MissingDependencyError(SoftarmError, ImportError):
+    """Something optional that this use needs is not installed. ``extra`` names the
+    softarm extra that provides it (``pip install 'softarm[EXTRA]'``), as the one-line
+    message does. Raised where the dependency is first needed, never at import."""
+
+    def __init__(self, message: str, extra: str) -> None:
+        super().__init__(message)
+        self.extra = extra
+
+    def __reduce__(self) -> tuple[type[MissingDependencyError], tuple[str, str]]:
+        # Pickled (Ray, multiprocessing) with its extra: the default would call cls(message).
+        return (type(self), (str(self.args[0]) if self.args else "", self.extra))

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import softarm
+from softarm.errors import MissingDependencyError
 from softarm.sim.cosserat.params import RodParameters, cantilever_sag, design_stiffness
 
 ARM = softarm.SoftArm.blackberry()
@@ -43,9 +44,9 @@ def test_missing_pyelastica_is_a_clear_error(monkeypatch) -> None:
 
     monkeypatch.delitem(__import__("sys").modules, "elastica", raising=False)
     monkeypatch.setattr(builtins, "__import__", no_elastica)
-    with pytest.raises(cosserat.MissingDependencyError, match=r"softarm\[cosserat\]"):
+    with pytest.raises(MissingDependencyError, match=r"softarm\[cosserat\]") as info:
         cosserat.require_elastica()
-    assert issubclass(cosserat.MissingDependencyError, softarm.SoftarmError)
+    assert info.value.extra == "cosserat" and isinstance(info.value, softarm.SoftarmError)
 
 
 elastica = pytest.importorskip("elastica")

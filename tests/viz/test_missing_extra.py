@@ -8,8 +8,8 @@ import sys
 import pytest
 
 from softarm.cli import main
-from softarm.errors import SoftarmError
-from softarm.viz.rerun_sdk import MissingDependencyError, require_rerun
+from softarm.errors import MissingDependencyError, SoftarmError
+from softarm.viz.rerun_sdk import require_rerun
 
 
 @pytest.fixture
@@ -22,6 +22,7 @@ def test_require_rerun_names_the_extra(no_rerun: None) -> None:
     with pytest.raises(MissingDependencyError, match=r"softarm\[viz\]") as info:
         require_rerun()
     assert isinstance(info.value, SoftarmError) and isinstance(info.value, ImportError)
+    assert info.value.extra == "viz"
 
 
 def test_replay_without_rerun_is_one_line_and_exit_2(no_rerun: None, tmp_path, capsys) -> None:

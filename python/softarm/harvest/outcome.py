@@ -7,18 +7,23 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 
 from softarm.checks import FloatArray
+from softarm.errors import SoftarmError
 from softarm.harvest.states import FaultReason
 
 __all__ = ["Ending", "Fault", "StageOutcome"]
 
 
-class Fault(Exception):
+class Fault(SoftarmError):
     """Raised inside a stage to enter the safe state for ``reason``. ``retreat_from``: the
     commanded elongations at which a closed loop gave up on the berry, the arm sound (a
     stall on the joint limits, a time-out): the machine backs out the way it came from
     there before it vents, and after a stall may re-approach. None: vent where it is.
     ``grasp_error``: in fine positioning, how far (m) the grasp point was from the berry
-    when the loop gave up (the machine may come back to its nearest attempt); else None."""
+    when the loop gave up (the machine may come back to its nearest attempt); else None.
+
+    A :class:`~softarm.errors.SoftarmError` like every error softarm raises: the machine
+    catches it (:data:`~softarm.harvest.machine.STAGE_ERRORS`), and one that escaped it
+    would still be one clean line at the command line, not a traceback."""
 
     def __init__(
         self,

@@ -6,15 +6,11 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from softarm.errors import SoftarmError
+from softarm.errors import MissingDependencyError
 
-__all__ = ["MissingDependencyError", "require"]
+__all__ = ["require"]
 
 INSTALL = "pip install 'softarm[sweep]'"
-
-
-class MissingDependencyError(SoftarmError, ImportError):
-    """An optional dependency is not installed."""
 
 
 def require(module: str) -> Any:
@@ -23,5 +19,5 @@ def require(module: str) -> Any:
         return importlib.import_module(module)
     except ImportError as exc:
         raise MissingDependencyError(
-            f"{module} is not installed ({exc.name} missing): {INSTALL}"
+            f"{module} is not installed ({exc.name} missing): {INSTALL}", "sweep"
         ) from None

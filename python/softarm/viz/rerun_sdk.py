@@ -11,11 +11,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from softarm.errors import SoftarmError
+from softarm.errors import MissingDependencyError, SoftarmError
 
 __all__ = [
     "INSTALL",
-    "MissingDependencyError",
     "ViewerUnavailableError",
     "close_recording",
     "open_recording",
@@ -34,10 +33,6 @@ VIEWER_FLUSH_S = 10.0
 TIMELINE = "sim_time"
 
 
-class MissingDependencyError(SoftarmError, ImportError):
-    """An optional dependency is not installed."""
-
-
 class ViewerUnavailableError(SoftarmError):
     """The rerun viewer cannot be started here (no display, no viewer executable)."""
 
@@ -49,7 +44,8 @@ def require_rerun() -> Any:
     except ImportError as exc:
         raise MissingDependencyError(
             f"the rerun view needs rerun-sdk, the optional extra 'viz' ({exc.name} "
-            f"missing): {INSTALL}"
+            f"missing): {INSTALL}",
+            "viz",
         ) from None
 
 
@@ -67,6 +63,8 @@ def open_recording(
     if record is None and not spawn:
         raise SoftarmError("open_recording: give a file to record to or spawn=True")
     rr = require_rerun()
+    if record is not None:  # outputs create their folders
+        Path(record).parent.mkdir(parents=True, exist_ok=True)
     stream = rr.RecordingStream(APPLICATION, recording_id=name)
     if spawn:
         _spawn_viewer(rr, stream)

@@ -13,17 +13,13 @@ import importlib
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from softarm.errors import SoftarmError
+from softarm.errors import MissingDependencyError
 
 if TYPE_CHECKING:  # imported lazily below (PyElastica is optional)
     from softarm.sim.cosserat.plant import CosseratPlant
     from softarm.sim.cosserat.rod import RodArm
 
-__all__ = ["CosseratPlant", "MissingDependencyError", "RodArm", "require_elastica"]
-
-
-class MissingDependencyError(SoftarmError, ImportError):
-    """An optional dependency is not installed."""
+__all__ = ["CosseratPlant", "RodArm", "require_elastica"]
 
 
 def require_elastica() -> ModuleType:
@@ -33,7 +29,8 @@ def require_elastica() -> ModuleType:
     except ImportError as exc:
         raise MissingDependencyError(
             "the Cosserat-rod plant needs PyElastica, the optional extra 'cosserat': "
-            "pip install 'softarm[cosserat]' (or pip install pyelastica)"
+            "pip install 'softarm[cosserat]' (or pip install pyelastica)",
+            "cosserat",
         ) from exc
 
 

@@ -20,7 +20,7 @@ import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
-from softarm.errors import SoftarmError
+from softarm.errors import MissingDependencyError
 from softarm.sim.render.culling import in_frustum
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.mjcf import (
@@ -43,8 +43,14 @@ CULLED_GROUP = 5
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
 
-class RenderUnavailableError(SoftarmError):
-    """The rendered world cannot run here: MuJoCo or an offscreen OpenGL is missing."""
+class RenderUnavailableError(MissingDependencyError):
+    """The rendered world cannot run here: MuJoCo (the ``render`` extra) or an offscreen
+    OpenGL (a system library no extra installs: the message says which to set up) is
+    missing. A :class:`~softarm.errors.MissingDependencyError` whose ``extra`` is
+    ``"render"``, so that one ``except`` covers every optional part that is absent."""
+
+    def __init__(self, message: str, extra: str = "render") -> None:
+        super().__init__(message, extra)
 
 
 HOW_TO_ENABLE = (

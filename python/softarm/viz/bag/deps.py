@@ -6,7 +6,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from softarm.viz.rerun_sdk import MissingDependencyError
+from softarm.errors import MissingDependencyError
 
 __all__ = ["DISTRO", "INSTALL", "require_rosbags", "typestore"]
 
@@ -22,7 +22,8 @@ def require_rosbags() -> Any:
         return importlib.import_module("rosbags.rosbag2")
     except ImportError as exc:
         raise MissingDependencyError(
-            f"--bag needs rosbags, the optional extra 'ros' ({exc.name} missing): {INSTALL}"
+            f"--bag needs rosbags, the optional extra 'ros' ({exc.name} missing): {INSTALL}",
+            "ros",
         ) from None
 
 
