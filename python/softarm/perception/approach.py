@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from softarm.checks import FloatArray
+from softarm.checks import FloatArray, as_array, as_pose, positive
+from softarm.errors import ParameterError
+from softarm.perception._inputs import instance
 from softarm.perception.berries import BerryDetection
 from softarm.vision.camera_model import CameraModel
 
@@ -33,8 +35,16 @@ MIN_CROSSING = np.radians(15.0)
 
 def distance_from_size(radius_m: float, radius_px: float, focal: float) -> float:
     """The distance (m) to the centre of a sphere of ``radius_m`` whose outline has
-    ``radius_px`` in an image of focal length ``focal`` (px): R / sin(atan(r / f))."""
-    return radius_m / float(np.sin(np.arctan2(radius_px, focal)))
+    ``radius_px`` in an image of focal length ``focal`` (px): R / sin(atan(r / f)).
+
+    Raises:
+        ParameterError: an argument that is not a finite number > 0 (a radius of 0 px
+            is a fruit infinitely far).
+    """
+    r, px, f = (
+        positive(radius_m, "radius_m"), positive(radius_px, "radius_px"), positive(focal, "focal")
+    )  # fmt: skip
+    return r / float(np.sin(np.arctan2(px, f)))
 
 
 class RayCrossing:
@@ -44,20 +54,33 @@ class RayCrossing:
         c1_centre: C1's (left eye's) optical centre in the base frame.
         position: the berry's position from C1's stereo (base frame), which gives C1's
             ray and, with ``radius`` (m), where and how large C2 should see it.
+
+    Raises:
+        InputError: a point that is not a finite (3,) array, the two the same, or a
+            radius that is not a finite number > 0.
     """
 
     def __init__(self, c1_centre: FloatArray, position: FloatArray, radius: float) -> None:
-        self.c1_centre = np.asarray(c1_centre, dtype=np.float64)
-        self.position = np.asarray(position, dtype=np.float64)
+        self.c1_centre = as_array(c1_centre, (3,), "c1_centre")
+        self.position = as_array(position, (3,), "position")
         ray = self.position - self.c1_centre
-        self.c1_ray = ray / np.linalg.norm(ray)
-        self.radius = float(radius)
+        length = float(np.linalg.norm(ray))
+        if length == 0.0:
+            raise ParameterError("position must differ from c1_centre: C1 has no ray to it")
+        self.c1_ray = ray / length
+        self.radius = positive(radius, "radius")
 
     def fix(
         self, det: BerryDetection, T_base_camera: FloatArray, camera: CameraModel
     ) -> FloatArray | None:
         """The berry's centre in the camera's frame, on the ray through ``det`` where it
-        passes nearest C1's ray; None when the two rays are too near parallel."""
+        passes nearest C1's ray; None when the two rays are too near parallel.
+
+        Raises:
+            InputError: ``T_base_camera`` is not a finite rigid 4x4 pose (PoseError),
+                ``det`` not a BerryDetection or ``camera`` not a CameraModel.
+        """
+        T_base_camera = _checked(det, T_base_camera, camera)
         x, y = camera.normalize(np.array([det.center]))[0]
         local = np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0])
         origin, ray = T_base_camera[:3, 3], T_base_camera[:3, :3] @ local
@@ -74,7 +97,9 @@ class RayCrossing:
         self, det: BerryDetection, T_base_camera: FloatArray, camera: CameraModel
     ) -> bool:
         """Whether ``det`` can be this berry: within its apparent radius of where C1
-        puts it, and of a size within SIZE_RANGE of what C1's radius gives there."""
+        puts it, and of a size within SIZE_RANGE of what C1's radius gives there.
+        Arguments and errors as :meth:`fix`."""
+        T_base_camera = _checked(det, T_base_camera, camera)
         p = np.linalg.inv(T_base_camera) @ np.append(self.position, 1.0)
         dist = float(np.linalg.norm(p[:3]))
         if p[2] <= 0.0 or dist <= self.radius:
@@ -84,3 +109,10 @@ class RayCrossing:
         offset = float(np.hypot(det.center[0] - centre[0], det.center[1] - centre[1]))
         ratio = det.radius / expected
         return offset <= max(expected, MIN_GATE_PX) and SIZE_RANGE[0] <= ratio <= SIZE_RANGE[1]
+
+
+def _checked(det: object, T_base_camera: object, camera: object) -> FloatArray:
+    """``T_base_camera`` as a checked pose, after ``det`` and ``camera``'s types."""
+    instance(det, BerryDetection, "det")
+    instance(camera, CameraModel, "camera")
+    return as_pose(T_base_camera, "T_base_camera")

@@ -21,19 +21,31 @@ import numpy.typing as npt
 
 from softarm.checks import FloatArray
 from softarm.errors import VisionError
+from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.vision.camera_model import CameraModel
 
 __all__ = [
+    "MAX_BLOBS",
     "BerryDetection",
     "DetectorSettings",
+    "Frame",
     "detect_berries",
     "detections_in_masks",
     "fruit_mask",
 ]
 
 Ripeness = Literal["ripe", "unripe"]
+#: The frame a detection's ``position`` is in: the camera's (``detect_berries`` with
+#: depth) or the arm's base (``locate_berries``).
+Frame = Literal["camera", "base"]
+#: The most fruit-shaped blobs one frame gives (both colour classes together): a view of
+#: a bush shows tens of fruit, not thousands. Beyond it the largest are kept (in their
+#: usual order), so that a frame of thousands of fruit-sized specks (a patterned sheet,
+#: a shaded net) costs a bounded time, above all in the stereo match that follows.
+MAX_BLOBS = 500
 # What OpenCV returns for a uint8 image (its stubs say any number array).
 _U8 = npt.NDArray[np.uint8]
+_Contour = npt.NDArray[np.int32]
 
 
 @dataclass(frozen=True)
@@ -60,9 +72,17 @@ class DetectorSettings:
 @dataclass(frozen=True)
 class BerryDetection:
     """One berry in an image: ``center`` (x, y) px, equivalent ``radius`` px, ``box``
-    (x, y, w, h), ``mask`` (H, W) bool, ``score`` in [0, 1], ``ripeness`` and its
-    ``probability``; ``position`` (3,) in the camera frame (m) and ``radius_m``, the
-    fruit's radius as its outline shows it, when depth was given."""
+    (x, y, w, h), ``score`` in [0, 1], ``ripeness`` and its ``probability``;
+    ``position`` (3,) m, in the frame ``frame`` names, and ``radius_m``, the fruit's
+    radius as its outline shows it, when the berry was placed.
+
+    ``mask`` is the berry's pixels over its box only (bool, (h, w)), not over the whole
+    frame: its pixel (r, c) is the image's (r + ``mask_offset[1]``, c +
+    ``mask_offset[0]``), and :meth:`mask_window` cuts it to any window of the image.
+    ``frame`` is ``"camera"`` for :func:`detect_berries` (positions from its depth image,
+    in the camera frame) and ``"base"`` for
+    :func:`~softarm.perception.stereo.locate_berries` (the arm's base frame).
+    """
 
     center: tuple[float, float]
     radius: float
@@ -73,6 +93,27 @@ class BerryDetection:
     probability: float
     position: FloatArray | None = None
     radius_m: float | None = None
+    #: (x, y) of the image pixel under ``mask[0, 0]``: (0, 0) for a full-frame mask.
+    mask_offset: tuple[int, int] = (0, 0)
+    frame: Frame = "camera"
+
+    def mask_window(self, x0: int, y0: int, x1: int, y1: int) -> npt.NDArray[np.bool_]:
+        """The berry's pixels on image columns ``x0:x1`` and rows ``y0:y1`` as an
+        (y1 - y0, x1 - x0) bool array, False beyond the mask."""
+        out = np.zeros((y1 - y0, x1 - x0), bool)
+        ox, oy = self.mask_offset
+        h, w = self.mask.shape
+        ax0, ay0, ax1, ay1 = max(x0, ox), max(y0, oy), min(x1, ox + w), min(y1, oy + h)
+        if ax0 < ax1 and ay0 < ay1:
+            out[ay0 - y0 : ay1 - y0, ax0 - x0 : ax1 - x0] = self.mask[
+                ay0 - oy : ay1 - oy, ax0 - ox : ax1 - ox
+            ]
+        return out
+
+    def full_mask(self, shape: tuple[int, ...]) -> npt.NDArray[np.bool_]:
+        """The berry's pixels over a whole image of ``shape`` (H, W, ...): for a
+        comparison with other full-frame masks (0.9 MB at 1280 x 720, so not kept)."""
+        return self.mask_window(0, 0, shape[1], shape[0])
 
     @property
     def ripe_vote(self) -> float:
@@ -97,17 +138,26 @@ def detect_berries(
     depth: npt.NDArray[np.floating] | None = None,
     settings: DetectorSettings | None = None,
 ) -> list[BerryDetection]:
-    """The berries in ``image`` (BGR uint8, as OpenCV reads it) seen by ``camera``.
+    """The berries in ``image`` (BGR uint8, as OpenCV reads it) seen by ``camera``; at
+    most :data:`MAX_BLOBS`.
 
-    ``depth`` (H, W) metres aligned with ``image`` (0 or NaN unknown) adds each
-    berry's ``position`` in the camera frame and a check of its physical size.
+    ``image`` must be the size of ``camera.image_size`` when the camera has one (a
+    frame of another size would be read through the wrong intrinsics).
+    ``depth`` (H, W) float metres aligned with ``image`` (0 or NaN unknown) adds each
+    berry's ``position`` in the camera frame (``frame`` "camera") and a check of its
+    physical size. A uint16 depth in millimetres (as ``softarm dataset`` writes it) is
+    refused: divide it by 1000 first.
 
     Raises:
-        VisionError: ``image`` is not an (H, W, 3) uint8 array, or ``depth`` does not
-            match it.
+        VisionError: ``image`` is not an (H, W, 3) uint8 array of at most
+            :data:`~softarm.perception._inputs.MAX_FRAME_PIXELS` pixels and of the
+            camera's image size, or ``depth`` is not a float array of its height and
+            width.
+        InputError: ``camera`` is not a CameraModel, or ``settings`` not a
+            DetectorSettings.
     """
-    s = settings or DetectorSettings()
-    _check(image, depth)
+    s = instance_or_default(settings, DetectorSettings, "settings")
+    _check(image, depth, instance(camera, CameraModel, "camera"))
     hsv = cast(_U8, cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV))
     ripe, unripe = _colour_masks(hsv, s)
     return detections_in_masks(ripe, unripe, camera, depth, s)
@@ -120,29 +170,51 @@ def detections_in_masks(
     depth: npt.NDArray[np.floating] | None,
     s: DetectorSettings,
 ) -> list[BerryDetection]:
-    """The berries of the ``ripe`` and ``unripe`` pixel masks, whatever made them (the
-    colour thresholds, a pixel network): closed, split into fruit-shaped blobs, each
-    placed and sized (the shape stage every detector shares)."""
+    """The berries of the ``ripe`` and ``unripe`` pixel masks ((H, W) uint8, 0/255),
+    whatever made them (the colour thresholds, a pixel network): closed, split into
+    fruit-shaped blobs (at most :data:`MAX_BLOBS`), each placed and sized (the shape
+    stage every detector shares). Arguments and errors as :func:`detect_berries`."""
+    _check_masks(ripe, unripe)
+    instance(camera, CameraModel, "camera")
+    instance(s, DetectorSettings, "settings")
+    depth = depth_metres(depth, ripe.shape)
+    blobs = [(c, area) for mask in (ripe, unripe) for c, area in _blobs(_close(mask), s)]
     out = []
-    for mask in (ripe, unripe):
-        for blob in _blobs(_close(mask), s):
-            det = _detection(blob, ripe, unripe, camera, depth, s)
-            if det is not None:
-                out.append(det)
+    for blob in _capped(blobs):
+        det = _detection(blob, ripe, unripe, camera, depth, s)
+        if det is not None:
+            out.append(det)
     return out
 
 
-def _check(image: object, depth: object) -> None:
-    if not isinstance(image, np.ndarray):
-        raise VisionError(f"image must be a numpy array, got {type(image).__name__}")
-    if image.dtype != np.uint8:
-        raise VisionError(f"image must be uint8 (BGR as OpenCV reads it), got {image.dtype}")
-    if image.ndim != 3 or image.shape[2] != 3 or min(image.shape[:2]) == 0:
-        raise VisionError(f"image must be (H, W, 3) BGR, got shape {image.shape}")
-    if depth is not None:
-        if not isinstance(depth, np.ndarray) or depth.shape != image.shape[:2]:
-            shape = getattr(depth, "shape", None)
-            raise VisionError(f"depth must be an (H, W) array like image, got shape {shape}")
+def _check(image: object, depth: object, camera: CameraModel | None = None) -> None:
+    """``image`` a BGR frame (of ``camera``'s image size when it has one) and ``depth``
+    None or float metres of its size."""
+    checked = bgr_image(image, "image")
+    depth_metres(depth, checked.shape)
+    if camera is not None:
+        bgr_image(checked, "image", camera.image_size)
+
+
+def _check_masks(ripe: object, unripe: object) -> None:
+    for name, mask in (("ripe", ripe), ("unripe", unripe)):
+        if not isinstance(mask, np.ndarray) or mask.dtype != np.uint8 or mask.ndim != 2:
+            raise VisionError(f"{name} must be an (H, W) uint8 mask, got {type(mask).__name__}")
+    assert isinstance(ripe, np.ndarray) and isinstance(unripe, np.ndarray)
+    if ripe.shape != unripe.shape:
+        raise VisionError(f"ripe {ripe.shape} and unripe {unripe.shape} masks differ in shape")
+
+
+def _capped(
+    blobs: list[tuple[npt.NDArray[np.int32], float]],
+) -> list[npt.NDArray[np.int32]]:
+    """The contours of ``blobs`` (contour, area), the MAX_BLOBS largest kept in their
+    order when there are more."""
+    if len(blobs) > MAX_BLOBS:
+        order = sorted(range(len(blobs)), key=lambda k: -blobs[k][1])
+        keep = set(order[:MAX_BLOBS])
+        blobs = [b for k, b in enumerate(blobs) if k in keep]
+    return [c for c, _ in blobs]
 
 
 def fruit_mask(
@@ -150,7 +222,8 @@ def fruit_mask(
 ) -> npt.NDArray[np.uint8]:
     """The pixels (0/255) of either fruit colour class in a BGR image, closed over the
     drupelet gaps: the silhouettes that stereo matches (:mod:`softarm.perception.stereo`)."""
-    s = settings or DetectorSettings()
+    s = instance_or_default(settings, DetectorSettings, "settings")
+    bgr_image(image, "image")
     hsv = cast(_U8, cv2.cvtColor(cv2.GaussianBlur(image, (3, 3), 0), cv2.COLOR_BGR2HSV))
     ripe, unripe = _colour_masks(hsv, s)
     return _close(cast(_U8, cv2.bitwise_or(ripe, unripe)))
@@ -178,8 +251,10 @@ def _close(mask: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
     return cast(_U8, cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel))
 
 
-def _blobs(mask: npt.NDArray[np.uint8], s: DetectorSettings) -> list[npt.NDArray[np.int32]]:
-    """Outer contours of the compact blobs of ``mask``, holes filled."""
+def _blobs(
+    mask: npt.NDArray[np.uint8], s: DetectorSettings
+) -> list[tuple[npt.NDArray[np.int32], float]]:
+    """Outer contours of the compact blobs of ``mask``, holes filled, with their areas."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     out = []
     for c in contours:
@@ -192,7 +267,7 @@ def _blobs(mask: npt.NDArray[np.uint8], s: DetectorSettings) -> list[npt.NDArray
             continue
         if max(a, b) > s.max_elongation * max(min(a, b), 1e-6):
             continue
-        out.append(cast(npt.NDArray[np.int32], c))
+        out.append((cast(_Contour, c), float(area)))
     return out
 
 
@@ -204,24 +279,27 @@ def _detection(
     depth: npt.NDArray[np.floating] | None,
     s: DetectorSettings,
 ) -> BerryDetection | None:
-    mask = np.zeros(ripe.shape, np.uint8)
-    cv2.drawContours(mask, [contour], -1, 255, thickness=cv2.FILLED)
+    # The blob's own box only: a full-frame mask per blob cost 0.9 MB and a full-frame
+    # pass each at 1280 x 720, 3.3 GB and 16 s for a frame of 3,600 specks.
+    bx, by, bw, bh = cv2.boundingRect(contour)
+    mask = np.zeros((bh, bw), np.uint8)
+    cv2.drawContours(mask, [contour], -1, 255, thickness=cv2.FILLED, offset=(-bx, -by))
     inside = mask > 0
-    n_ripe = int(np.count_nonzero(ripe[inside]))
-    n_unripe = int(np.count_nonzero(unripe[inside]))
+    box = (slice(by, by + bh), slice(bx, bx + bw))
+    n_ripe = int(np.count_nonzero(ripe[box][inside]))
+    n_unripe = int(np.count_nonzero(unripe[box][inside]))
     p_ripe = n_ripe / max(n_ripe + n_unripe, 1)
     m = cv2.moments(mask, binaryImage=True)
-    cx, cy = m["m10"] / m["m00"], m["m01"] / m["m00"]
+    cx, cy = bx + m["m10"] / m["m00"], by + m["m01"] / m["m00"]
     radius = float(np.sqrt(m["m00"] / np.pi))
     position = None
     if depth is not None:
-        position = _position(inside, (cx, cy), radius, camera, depth)
+        position = _position(inside, (cx, cy), radius, camera, depth[box])
         if position is not None and not _fruit_sized(radius, position[2], camera, s):
             return None
     purity = (n_ripe + n_unripe) / m["m00"]
     solidity = m["m00"] / max(cv2.contourArea(cv2.convexHull(contour)), 1.0)
     ripeness: Ripeness = "ripe" if p_ripe >= 0.5 else "unripe"
-    bx, by, bw, bh = cv2.boundingRect(contour)
     return BerryDetection(
         center=(float(cx), float(cy)),
         radius=radius,
@@ -234,6 +312,7 @@ def _detection(
         radius_m=None
         if position is None
         else radius * float(np.linalg.norm(position)) / camera.focal,
+        mask_offset=(int(bx), int(by)),
     )
 
 
@@ -244,7 +323,8 @@ def _position(
     camera: CameraModel,
     depth: npt.NDArray[np.floating],
 ) -> FloatArray | None:
-    """The berry's centre in the camera frame: the median depth of its visible surface,
+    """The berry's centre in the camera frame (``depth``: the box ``inside`` covers): the
+    median depth of its visible surface,
     pushed back by two thirds of its radius (the mean depth of a sphere's visible cap
     under orthographic weighting), along the ray through its image centre."""
     z = depth[inside]

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softarm.checks import FloatArray
+from softarm.checks import FloatArray, as_array
+from softarm.errors import InputError
 from softarm.perception.berries import BerryDetection, Ripeness, ripe_by_votes
 from softarm.perception.sight_lines import Placing, SightLine, same_line
 
@@ -59,21 +60,29 @@ class BushMap:
     unplaced: list[Placing] = field(default_factory=list)
 
     def update(self, detections: Iterable[BerryDetection]) -> int:
-        """Merge one view's detections (positions in the base frame); the number of
-        berries new to the map."""
+        """Merge one view's detections (positions in the base frame, as
+        :func:`~softarm.perception.stereo.locate_berries` gives them); the number of
+        berries new to the map. The whole view is checked before any of it is merged.
+
+        Raises:
+            InputError: a detection placed in the camera frame (``frame`` "camera"),
+                or a position that is not (3,) or not finite (ShapeError,
+                NonFiniteError): a NaN would spread to every berry it merges with.
+        """
+        placed = [(d, _base_position(d, k)) for k, d in enumerate(detections)]
         new = 0
-        for d in detections:
-            if d.position is None:
+        for d, position in placed:
+            if position is None:
                 continue
             vote = d.ripe_vote
-            known = self._near(d.position)
+            known = self._near(position)
             if known is None:
                 radius = d.radius_m or FRUIT_RADIUS
-                self.berries.append(MappedBerry(len(self.berries), d.position.copy(), radius, vote))
+                self.berries.append(MappedBerry(len(self.berries), position, radius, vote))
                 new += 1
             else:
                 n = known.sightings
-                known.position = (known.position * n + d.position) / (n + 1)
+                known.position = (known.position * n + position) / (n + 1)
                 known.radius = (known.radius * n + (d.radius_m or known.radius)) / (n + 1)
                 known.ripe_votes += vote
                 known.sightings = n + 1
@@ -95,7 +104,12 @@ class BushMap:
 
     def place(self, placing: Placing, position: FloatArray) -> MappedBerry:
         """Map the fruit of ``placing`` at ``position`` (C2 placed it); it leaves the
-        unplaced ones."""
+        unplaced ones.
+
+        Raises:
+            InputError: ``position`` is not a finite (3,) point.
+        """
+        position = as_array(position, (3,), "position")
         line = placing.line
         distance = float(np.linalg.norm(position - line.origin))
         berry = MappedBerry(
@@ -129,3 +143,15 @@ class BushMap:
         gaps = [float(np.linalg.norm(b.position - position)) for b in self.berries]
         k = int(np.argmin(gaps))
         return self.berries[k] if gaps[k] <= self.merge_distance else None
+
+
+def _base_position(d: BerryDetection, k: int) -> FloatArray | None:
+    """A copy of detection ``k``'s position, checked: in the base frame, (3,), finite."""
+    if d.position is None:
+        return None
+    if d.frame != "base":
+        raise InputError(
+            f"detections[{k}] is placed in the {d.frame} frame: the map holds base-frame "
+            "positions (locate_berries gives them)"
+        )
+    return as_array(d.position, (3,), f"detections[{k}].position")

@@ -19,14 +19,16 @@ The pipeline (:func:`fit_canes`):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
 from softarm._core import PolynomialCurve
-from softarm.checks import FloatArray
-from softarm.errors import VisionError
+from softarm.checks import FloatArray, as_array
+from softarm.errors import ParameterError, VisionError
+from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
 from softarm.perception.cane_pixels import CaneLook, cane_mask, half_width_px, stereo_disparity
 from softarm.perception.stereo_camera import StereoCamera
@@ -73,7 +75,7 @@ def fit_canes(
     left: npt.NDArray[np.uint8],
     right: npt.NDArray[np.uint8] | None,
     stereo: StereoCamera,
-    depth: FloatArray | None = None,
+    depth: npt.NDArray[np.floating[Any]] | None = None,
     settings: CaneSettings | None = None,
 ) -> list[CaneFit]:
     """The canes C1 sees, largest support first; [] when there is none.
@@ -82,16 +84,21 @@ def fit_canes(
         left, right: C1's BGR uint8 images as OpenCV reads them (distorted, the size of
             ``stereo.left.image_size``). ``right`` may be None when ``depth`` is given.
         stereo: the calibrated pair; ``stereo.T_base_left`` places the result.
-        depth: optional (H, W) depth in metres along the left eye's optical axis,
-            aligned with ``left`` (0 or NaN where unknown), e.g. from an RGB-D
-            camera; when given, stereo matching is skipped.
+        depth: optional (H, W) float depth in metres along the left eye's optical
+            axis, aligned with ``left`` (0 or NaN where unknown), e.g. from an RGB-D
+            camera; when given, stereo matching is skipped. A uint16 depth in
+            millimetres is refused, as by :func:`~softarm.perception.berries.
+            detect_berries`: divide it by 1000 first.
         settings: thresholds; the defaults were tuned on rendered bushes 0–4 and
             900–919.
 
     Raises:
-        VisionError: an empty image, a wrong dtype or shape, or sizes that disagree.
+        VisionError: an empty image, a wrong dtype or shape, a frame that is not the
+            calibrated size, or a depth that is not float metres of that size.
+        InputError: ``stereo`` is not a StereoCamera, or ``settings`` not a
+            CaneSettings.
     """
-    settings = settings or CaneSettings()
+    settings = instance_or_default(settings, CaneSettings, "settings")
     return fit_cane_points(cane_points(left, right, stereo, depth, settings), settings)
 
 
@@ -99,13 +106,13 @@ def cane_points(
     left: npt.NDArray[np.uint8],
     right: npt.NDArray[np.uint8] | None,
     stereo: StereoCamera,
-    depth: FloatArray | None = None,
+    depth: npt.NDArray[np.floating[Any]] | None = None,
     settings: CaneSettings | None = None,
 ) -> FloatArray:
     """(n, 4) rows, at most ``settings.max_points``: a point on a cane's centre line C1
     sees (base frame, m) and the cane's radius there (m); arguments and errors as
     :func:`fit_canes`."""
-    settings = settings or CaneSettings()
+    settings = instance_or_default(settings, CaneSettings, "settings")
     _check_inputs(left, right, stereo, depth)
     if depth is None:
         assert right is not None
@@ -119,41 +126,32 @@ def cane_points(
 def fit_cane_points(points: FloatArray, settings: CaneSettings | None = None) -> list[CaneFit]:
     """The canes among ``points`` (n, 4), as :func:`cane_points` gives them (and
     :func:`softarm.perception.cane_views.view_pair_points` for other views), largest
-    support first; [] when there are too few."""
-    settings = settings or CaneSettings()
+    support first; [] when there are too few.
+
+    Raises:
+        InputError: ``points`` is not a finite (n, 4) array (ShapeError,
+            NonFiniteError), or a radius (its last column) is not > 0
+            (ParameterError); ``settings`` is not a CaneSettings.
+    """
+    settings = instance_or_default(settings, CaneSettings, "settings")
+    points = as_array(points, (None, 4), "points")
+    if np.any(points[:, 3] <= 0.0):
+        raise ParameterError("points[:, 3], the canes' radii, must all be > 0 m")
     if len(points) < settings.search.min_support:
         return []
     return _fit_all(points[:, :3], points[:, 3], settings)
 
 
 def _check_inputs(left: object, right: object, stereo: StereoCamera, depth: object) -> None:
-    size = stereo.left.image_size
-    assert size is not None  # StereoCamera requires it
-    _check_image("left", left, size)
+    """The checks of :func:`softarm.perception._inputs`, shared with the berries."""
+    instance(stereo, StereoCamera, "stereo")
+    checked = bgr_image(left, "left", stereo.left.image_size)
     if depth is None:
         if right is None:
             raise VisionError("right is None: give the right image or a depth image")
-        _check_image("right", right, size)
+        bgr_image(right, "right", stereo.right.image_size)
         return
-    if not isinstance(depth, np.ndarray) or depth.dtype.kind != "f":
-        raise VisionError(f"depth must be a float array in metres, got {_describe(depth)}")
-    if depth.shape != (size[1], size[0]):
-        raise VisionError(f"depth must be {size[1]}x{size[0]} like left, got {depth.shape}")
-
-
-def _check_image(name: str, image: object, size: tuple[int, int]) -> None:
-    if not isinstance(image, np.ndarray) or image.size == 0:
-        raise VisionError(f"{name} must be a non-empty BGR image, got {_describe(image)}")
-    if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 3:
-        raise VisionError(f"{name} must be (H, W, 3) uint8 BGR, got {_describe(image)}")
-    if image.shape[:2] != (size[1], size[0]):
-        raise VisionError(f"{name} is {image.shape[1]}x{image.shape[0]}, the camera {size}")
-
-
-def _describe(value: object) -> str:
-    if isinstance(value, np.ndarray):
-        return f"{value.dtype} array of shape {value.shape}"
-    return type(value).__name__
+    depth_metres(depth, checked.shape)
 
 
 def _stereo_points(
@@ -177,7 +175,7 @@ def _stereo_points(
 
 
 def _depth_points(
-    left: npt.NDArray[np.uint8], depth: FloatArray,
+    left: npt.NDArray[np.uint8], depth: npt.NDArray[np.floating[Any]],
     stereo: StereoCamera, settings: CaneSettings,
 ) -> FloatArray:  # fmt: skip
     """As :func:`_stereo_points`, from a depth image aligned with the left eye."""

@@ -22,6 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import VisionError
+from softarm.perception._inputs import instance, instance_or_default
 from softarm.perception.berries import (
     BerryDetection,
     DetectorSettings,
@@ -135,7 +136,7 @@ class NetDetector:
             VisionError: ``image`` is not an (H, W, 3) uint8 array, or ``depth`` does
                 not match it.
         """
-        s = settings or DetectorSettings()
-        _check(image, depth)
+        s = instance_or_default(settings, DetectorSettings, "settings")
+        _check(image, depth, instance(camera, CameraModel, "camera"))
         ripe, unripe = self.masks(image)
         return detections_in_masks(ripe, unripe, camera, depth, s)

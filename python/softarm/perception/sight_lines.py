@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from softarm.checks import FloatArray
+from softarm.checks import FloatArray, as_pose
+from softarm.perception._inputs import instance
 from softarm.perception.berries import BerryDetection, ripe_by_votes
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
@@ -60,8 +61,12 @@ class SightLine:
 
 def sight_lines(detections: list[BerryDetection], stereo: StereoCamera) -> list[SightLine]:
     """The sight lines of ``detections`` (from :func:`~softarm.perception.stereo.
-    locate_berries`: centres in the rectified left image) that have no position."""
-    rect = stereo.rectification
+    locate_berries`: centres in the rectified left image) that have no position.
+
+    Raises:
+        InputError: ``stereo`` is not a StereoCamera.
+    """
+    rect = instance(stereo, StereoCamera, "stereo").rectification
     K = rect.P1[:3, :3]
     R = stereo.T_base_left[:3, :3] @ rect.R1.T  # rectified left frame -> base
     out = []
@@ -86,7 +91,14 @@ def crossing(
     """Where the ray of ``camera`` (at ``T_base_camera``) through ``det`` crosses
     ``line`` (the midpoint of their closest points, base frame), or None: the rays pass
     farther apart than RAY_GAP, cross at less than MIN_CROSSING, meet behind either
-    camera, or the fruit's size in either image does not fit a fruit there."""
+    camera, or the fruit's size in either image does not fit a fruit there.
+
+    Raises:
+        InputError: ``T_base_camera`` is not a finite rigid 4x4 pose (PoseError), or
+            ``camera`` not a CameraModel.
+    """
+    T_base_camera = as_pose(T_base_camera, "T_base_camera")
+    instance(camera, CameraModel, "camera")
     x, y = camera.normalize(np.array([det.center]))[0]
     local = np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0])
     o2, u2 = T_base_camera[:3, 3], T_base_camera[:3, :3] @ local

@@ -31,12 +31,12 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.checks import FloatArray
+from softarm.perception._inputs import bgr_image, instance
 from softarm.perception.berries import (
     BerryDetection,
     DetectorSettings,
-    detect_berries,
-    fruit_mask,
 )
+from softarm.perception.detector.choice import detect_berries, fruit_mask  # the chosen detector
 from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
 
@@ -65,9 +65,23 @@ def locate_berries(
     stereo: StereoCamera,
     settings: DetectorSettings | None = None,
 ) -> list[BerryDetection]:
-    """The berries of a stereo pair with ``position`` (3,) in the BASE frame; ``center``,
-    ``box`` and ``mask`` refer to the rectified left image. A berry that cannot be
-    matched in the right image is returned without a position."""
+    """The berries of a stereo pair with ``position`` (3,) in the BASE frame (each
+    detection's ``frame`` is ``"base"``); ``center``, ``box`` and ``mask`` refer to the
+    rectified left image. A berry that cannot be matched in the right image is returned
+    without a position. At most :data:`~softarm.perception.berries.MAX_BLOBS`.
+
+    Raises:
+        VisionError: ``left`` or ``right`` is not an (H, W, 3) uint8 BGR image of its
+            eye's calibrated ``image_size`` (a frame of another size is refused, not
+            cropped or scaled: the calibration would place every berry wrongly).
+        InputError: ``stereo`` is not a StereoCamera, or ``settings`` not a
+            DetectorSettings.
+    """
+    instance(stereo, StereoCamera, "stereo")
+    if settings is not None:
+        instance(settings, DetectorSettings, "settings")
+    bgr_image(left, "left", stereo.left.image_size)
+    bgr_image(right, "right", stereo.right.image_size)
     rect = stereo.rectification
     mx, my = rect.maps[0]
     L = cast(npt.NDArray[np.uint8], cv2.remap(left, mx, my, cv2.INTER_LINEAR))
@@ -90,7 +104,7 @@ def locate_berries(
             centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
             position = (stereo.T_base_left @ np.append(centre, 1.0))[:3]
             radius_m = det.radius * float(np.linalg.norm(centre)) / rect.focal
-        out.append(replace(det, position=position, radius_m=radius_m))
+        out.append(replace(det, position=position, radius_m=radius_m, frame="base"))
     return out
 
 
@@ -134,7 +148,7 @@ def _cost_curve(
     if x0 < 0 or y0 < 0 or x1 > width or y1 > height:
         return None
     template = left[y0:y1, x0:x1]
-    mask = det.mask[y0:y1, x0:x1].astype(np.uint8)
+    mask = det.mask_window(x0, y0, x1, y1).astype(np.uint8)
     mask = cv2.dilate(mask, np.ones((3, 3), np.uint8)).astype(np.float32)
     lo = max(int(np.floor(disparity_range[0])), 0)
     hi = int(np.ceil(disparity_range[1]))

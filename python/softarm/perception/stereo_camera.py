@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.checks import FloatArray
+from softarm.checks import FloatArray, as_pose
 from softarm.errors import VisionError
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
@@ -27,7 +27,19 @@ __all__ = ["Rectification", "StereoCamera"]
 @dataclass(frozen=True)
 class StereoCamera:
     """Both eyes' intrinsics (with image sizes), the left eye in the base frame and the
-    right eye in the left eye's frame."""
+    right eye in the left eye's frame.
+
+    Checked when built, not at the first rectification: both poses finite 4x4 rigid
+    transforms (a rotation scaled x5 would put every berry five times as far), and
+    the right eye to the left eye's right, along its +x axis (an eye on -x, from
+    swapped eyes, would put berries behind the camera).
+
+    Raises:
+        VisionError: an eye is not a CameraModel with an image size, or the right
+            eye is not mostly along the left eye's +x axis.
+        PoseError: ``T_base_left`` or ``T_left_right`` is not a finite 4x4 pose with
+            an orthonormal rotation.
+    """
 
     left: CameraModel
     right: CameraModel
@@ -35,10 +47,22 @@ class StereoCamera:
     T_left_right: FloatArray
 
     def __post_init__(self) -> None:
+        for name in ("left", "right"):
+            if not isinstance(getattr(self, name), CameraModel):
+                got = type(getattr(self, name)).__name__
+                raise VisionError(f"{name} must be a CameraModel, got {got}")
         if self.left.image_size is None or self.right.image_size is None:
             raise VisionError("a stereo camera needs both eyes' image_size")
+        for name in ("T_base_left", "T_left_right"):
+            object.__setattr__(self, name, as_pose(getattr(self, name), name))
         if self.baseline <= 0:
             raise VisionError("a stereo camera needs two distinct optical centres")
+        x, y, z = self.T_left_right[:3, 3]
+        if x <= max(abs(y), abs(z)):
+            raise VisionError(
+                f"T_left_right puts the right eye at {[float(x), float(y), float(z)]} m: it "
+                "must lie mostly along the left eye's +x axis (eyes swapped?)"
+            )
 
     @property
     def baseline(self) -> float:
