@@ -35,7 +35,7 @@ BAD = [
     (["harvest", "--sim", "--seed", "five"], "--seed"),
     (["harvest", "--sim", "--berries", "0"], "--berries"),
     (["harvest", "--sim", "--report", "{tmp}"], "--report"),
-    (["harvest", "--sim", "--log", "{tmp}/missing/log.jsonl"], "--log"),
+    (["harvest", "--sim", "--log", "/proc/nope/log.jsonl"], "--log"),
     (["harvest", "--sim", "--plot", "{tmp}/run.unknown"], "--plot"),
     (["harvest", "--sim", "--plot", "{tmp}"], "--plot"),
     (["harvest", "--sim", "--report", "/proc/nope/r.json"], "--report"),
@@ -46,7 +46,7 @@ BAD = [
     (["experiment", "all", "--out", "/proc/nope"], "--out"),
     (["experiment", "position", "--report", "{tmp}"], "--report"),
     (["plan", "--repeats", "-1"], "--repeats"),
-    (["plan", "--plot", "nodir/x.png"], "--plot"),
+    (["plan", "--plot", "/proc/nope/x.png"], "--plot"),
     (["bench", "--seconds", "1e308"], "--seconds"),
     (["bench", "--seconds", "nan"], "--seconds"),
 ]

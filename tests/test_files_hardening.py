@@ -168,9 +168,10 @@ def test_write_to_a_device_is_one_line_and_replaces_nothing() -> None:
     assert Path("/dev/full").is_char_device()
 
 
-def test_write_into_a_missing_folder_is_one_line(tmp_path: Path) -> None:
-    with pytest.raises(OutputError, match="missing"):
-        write_text(tmp_path / "missing" / "r.json", "{}")
+def test_write_under_a_file_is_one_line(tmp_path: Path) -> None:
+    (tmp_path / "a_file").write_text("")  # a missing folder is made; one under a file cannot
+    with pytest.raises(OutputError, match="a_file"):
+        write_text(tmp_path / "a_file" / "missing" / "r.json", "{}")
 
 
 def test_a_failed_write_leaves_the_previous_file_and_no_temporary(tmp_path: Path) -> None:

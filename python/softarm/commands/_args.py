@@ -229,15 +229,17 @@ def _nearest_existing(path: Path) -> Path:
 
 
 def output_file(text: str) -> Path:
-    """A ``type=`` for a file the command will write: not a directory, in an existing,
-    writable directory, and writable itself if it exists. Nothing is created."""
+    """A ``type=`` for a file the command will write: not a directory, writable itself
+    if it exists, in a writable directory or in folders that can be made in one (the
+    nearest existing one writable). Nothing is created here: as every output of softarm
+    (file or folder), the command creates the missing folders when it writes."""
     path = Path(text)
     if not text or text.endswith(("/", os.sep)) or path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a directory; give a file name")
-    parent = path.parent
+    parent = _nearest_existing(path.parent)
     if not parent.is_dir():
         raise argparse.ArgumentTypeError(
-            f"cannot write {text!r}: folder {str(parent)!r} does not exist"
+            f"cannot write {text!r}: {str(parent)!r} is a file, not a folder"
         )
     if path.exists() and not path.is_file():
         raise argparse.ArgumentTypeError(

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from softarm.commands._args import add_quiet
+from softarm.commands._args import add_quiet, output_file
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -20,7 +20,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "Needs the sweep extra: pip install 'softarm[sweep]'.",
     )
     p.add_argument("spec", type=Path, help="sweep spec (TOML: [sweep], [sweep.plant], [tune])")
-    p.add_argument("--out", type=Path, required=True, help="gains file to write (TOML)")
+    p.add_argument("--out", type=output_file, required=True, help="gains file to write (TOML)")
     p.add_argument("--samples", type=int, help="candidates to try (default: [tune] samples)")
     p.add_argument("--address", help="join this Ray cluster (default: start Ray on this machine)")
     p.add_argument("--cpus", type=int, help="cores of the local Ray (default: all)")

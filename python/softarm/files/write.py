@@ -96,10 +96,12 @@ def atomic_path(path: str | Path, what: str = "output file") -> Iterator[Path]:
     """A temporary path beside ``path`` for a writer that needs a file name (OpenCV, a
     recording); once the block ends without an error it is fsync'd and renamed over
     ``path``. On any error the temporary file is removed; an ``OSError`` becomes one
-    :class:`OutputError` line and the previous ``path`` is left as it was."""
+    :class:`OutputError` line and the previous ``path`` is left as it was. Missing
+    folders of ``path`` are created (every output of softarm, file or folder, does so)."""
     target = check_target(path, what)
     tmp = _temporary_name(target)
     try:
+        target.parent.mkdir(parents=True, exist_ok=True)
         os.close(_create(tmp, target))
         yield tmp
         _replace(tmp, target)

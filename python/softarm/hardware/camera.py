@@ -31,6 +31,21 @@ def import_cv2() -> ModuleType:
         ) from exc
 
 
+def _quietly_open(cv2: ModuleType, source: int | str) -> Any:
+    """``cv2.VideoCapture(source)`` without OpenCV's own log lines (``[ WARN:0@0.012]
+    global cap_v4l.cpp ... can't open camera by index``, one per backend tried): a
+    device that cannot be opened is one :class:`HardwareUnavailableError` line instead."""
+    log = getattr(getattr(cv2, "utils", None), "logging", None)
+    if log is None:  # an OpenCV built without its logging module
+        return cv2.VideoCapture(source)
+    level = log.getLogLevel()
+    log.setLogLevel(log.LOG_LEVEL_SILENT)
+    try:
+        return cv2.VideoCapture(source)
+    finally:
+        log.setLogLevel(level)
+
+
 class OpenCVCamera:
     """A :class:`~softarm.hardware.protocols.Camera` on ``cv2.VideoCapture``.
 
@@ -47,7 +62,7 @@ class OpenCVCamera:
     ) -> None:
         cv2 = import_cv2()
         self.source = source
-        self._cap: Any = cv2.VideoCapture(source)
+        self._cap: Any = _quietly_open(cv2, source)
         if not self._cap.isOpened():
             self._cap.release()
             self._cap = None

@@ -38,6 +38,7 @@ def plot_run(rig: SimRig, report: HarvestReport, path: str | Path) -> None:
     ax_o = fig.add_subplot(grid[1, 2], sharex=ax_p)
     plot_errors(ax_p, ax_o, rig.machine.log.records, colours)
     fig.tight_layout()
+    Path(path).parent.mkdir(parents=True, exist_ok=True)  # outputs create their folders
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

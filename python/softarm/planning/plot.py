@@ -108,6 +108,7 @@ def plot_plan(
         fig.suptitle(title)
     fig.tight_layout(rect=(0, 0.06, 1, 1))
     out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)  # outputs create their folders
     fig.savefig(out, dpi=110)
     plt.close(fig)
     return out

@@ -244,11 +244,18 @@ def _header(spec: SweepSpec, samples: int, m: dict[str, float], base: dict[str, 
 
 
 def _bar_callback(
-    tune: Any, candidates: int, per_candidate: int, enabled: bool, file: Any = None
+    tune: Any,
+    candidates: int,
+    per_candidate: int,
+    enabled: bool,
+    file: Any = None,
+    lines: Any = None,
 ) -> Any:
     """A Tune callback drawing the search's progress: one tick per trial of a candidate
     (``candidates`` x ``per_candidate`` in all), the candidates finished and the best
-    score so far after the bar. Drawn on a terminal only (``file``: default stderr)."""
+    score so far after the bar. Drawn on a terminal only (``file``: default stderr);
+    elsewhere (CI, a pipe, nohup) one line per finished candidate goes to ``lines``
+    (default stdout), so that a long search is not silent."""
     tqdm = require("tqdm").tqdm
 
     class Bar(tune.Callback):  # type: ignore[misc]
@@ -264,7 +271,7 @@ def _bar_callback(
             self.done: dict[str, int] = {}  # trials done, by candidate (Tune's trial id)
             self.reports = 0  # the candidates' reports received
             self.finished = 0  # candidates
-            self.drawn = time.monotonic()
+            self.drawn = self.started = time.monotonic()
 
         @property
         def count(self) -> int:
@@ -282,9 +289,11 @@ def _bar_callback(
             self._set(trial, per_candidate)
             self.finished += 1
             self.best = max(self.best, score)
-            self.bar.set_postfix_str(
-                f"{self.finished}/{candidates} candidates, best {self.best:.4f}"
-            )
+            done = f"{self.finished}/{candidates} candidates, best {self.best:.4f}"
+            self.bar.set_postfix_str(done)
+            if enabled and self.bar.disable:  # no terminal: a plain line instead
+                elapsed = tqdm.format_interval(time.monotonic() - self.started)
+                print(f"tune: {done}, {elapsed} elapsed", file=lines or sys.stdout, flush=True)
 
         def on_trial_result(self, iteration: int, trials: Any, trial: Any, result: Any,
                             **info: Any) -> None:  # fmt: skip
