@@ -85,7 +85,8 @@ def run(args: argparse.Namespace) -> int:
     except CalibrationNotConverged as exc:
         for problem in exc.problems:
             print(f"softarm camera: not converged: {problem}", file=sys.stderr)
-        print(f"calibration NOT converged (rms {exc.rms:.3f} px): no files written to {args.out}")
+        where = shown(args.out)
+        print(f"calibration NOT converged (rms {exc.rms:.3f} px): no files written to {where}")
         return 1
 
 
@@ -139,6 +140,12 @@ class Halves(Sequence[Any]):
         return split_side_by_side(self.frames[k], f"images[{k}]")[self.side]
 
 
+def shown(path: Path) -> str:
+    """``path`` for the terminal: bytes that are not UTF-8 as ``\\xff`` escapes (printed
+    as they are, they would stop the command with a UnicodeEncodeError)."""
+    return str(path).encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
 def read_images(paths: list[Path], what: str) -> ImageFiles:
     """The images of ``paths`` (files, or folders of image files in name order), each
     read when it is used."""
@@ -165,7 +172,7 @@ def _mono(images: Sequence[Any], board: tuple[Any, ...], out: Path) -> int:
     k = model.matrix
     print(f"{len(images)} images, rms {rms:.3f} px; fx {k[0, 0]:.2f}, fy {k[1, 1]:.2f}, "
           f"cx {k[0, 2]:.2f}, cy {k[1, 2]:.2f} px")  # fmt: skip
-    print(f"wrote {out / 'camera.yml'} (OpenCV), {out / 'camera.yaml'} (ROS)")
+    print(f"wrote {shown(out / 'camera.yml')} (OpenCV), {shown(out / 'camera.yaml')} (ROS)")
     return 0
 
 
@@ -186,5 +193,7 @@ def _stereo(
     fl, fr = model.left.matrix[0, 0], model.right.matrix[0, 0]
     print(f"{len(left)} stereo views, rms {rms:.3f} px; fx left {fl:.2f}, right {fr:.2f} px; "
           f"baseline {1e3 * model.baseline:.2f} mm")  # fmt: skip
-    print(f"wrote {out}/left.yml, right.yml (OpenCV), left.yaml, right.yaml (ROS), stereo.yml")
+    print(
+        f"wrote {shown(out)}/left.yml, right.yml (OpenCV), left.yaml, right.yaml (ROS), stereo.yml"
+    )
     return 0

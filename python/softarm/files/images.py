@@ -34,6 +34,7 @@ __all__ = [
     "encode_image",
     "image_header",
     "read_image",
+    "read_image_bytes",
     "write_image",
 ]
 
@@ -155,6 +156,15 @@ def read_image(
 ) -> npt.NDArray[Any]:
     """The pixels of the image file ``path`` (see :func:`decode_image`); ``what`` names
     its role in the one-line ``error`` (a missing, special or oversized file too)."""
+    data = read_image_bytes(path, what, error=error)
+    return decode_image(data, f"{what} {str(path)!r}", flags, max_pixels=max_pixels, error=error)
+
+
+def read_image_bytes(
+    path: str | Path, what: str, *, error: type[SoftarmError] = InputError
+) -> bytes:
+    """The bytes of the image file ``path``: a regular file of at most
+    :data:`MAX_FILE_BYTES` (else one line naming ``what`` and the file)."""
     name = f"{what} {str(path)!r}"
     with open_regular(path, what, error) as f:
         try:
@@ -163,7 +173,7 @@ def read_image(
             raise error(f"cannot read {name}: {exc.strerror or exc}") from None
     if len(data) > MAX_FILE_BYTES:
         raise error(f"cannot read {name}: larger than {MAX_FILE_BYTES} bytes")
-    return decode_image(data, name, flags, max_pixels=max_pixels, error=error)
+    return data
 
 
 def encode_image(image: npt.NDArray[Any], suffix: str = ".png") -> bytes:

@@ -150,7 +150,8 @@ def pair_problems(T_left_right: npt.NDArray[Any]) -> list[str]:
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         return ["T_left_right must be a finite 4x4 pose"]
     t = T[:3, 3]
-    baseline = float(np.linalg.norm(t))
+    largest = float(np.max(np.abs(t)))  # scaled first: the norm of 1e308 would overflow
+    baseline = largest * float(np.linalg.norm(t / largest)) if largest > 0 else 0.0
     lo, hi = BASELINE_RANGE
     if not lo <= baseline <= hi:
         return [f"the baseline is {1e3 * baseline:.4g} mm: a stereo pair's is {1e3 * lo:g} mm "
