@@ -4,8 +4,9 @@ from C1's stereo pair or C2's view, and the canes fitted as curves from C1's dep
 The public surface, what the harvest and a user call:
 
 * berries: :func:`detect_berries` (one image, positions from an optional depth image,
-  camera frame; by the detector :func:`use_detector` chose), :func:`locate_berries` (C1's stereo pair, base frame), each giving
-  :class:`BerryDetection` objects whose ``frame`` says which;
+  camera frame; by the detector :func:`use_detector` chose), :func:`locate_berries`
+  (C1's stereo pair, base frame), each giving :class:`BerryDetection` objects whose
+  ``frame`` says which;
 * canes: :func:`fit_canes` (C1's pair or a depth image), :func:`cane_points` and
   :func:`fit_cane_points` (points from several views, fitted together),
   :func:`view_pair_points` (two C2 views), :func:`cane_map_error`;
@@ -33,7 +34,6 @@ from softarm.perception.berries import (
     detections_in_masks,
     ripe_by_votes,
 )
-from softarm.perception.detector.choice import detect_berries, fruit_mask, use_detector
 from softarm.perception.bush_map import BushMap, MappedBerry
 from softarm.perception.bush_vision import BushVision
 from softarm.perception.cane_curves import CurveSearch
@@ -41,6 +41,7 @@ from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.cane_pixels import CaneLook
 from softarm.perception.cane_views import view_pair_points
 from softarm.perception.canes import CaneFit, CaneSettings, cane_points, fit_cane_points, fit_canes
+from softarm.perception.detector.choice import detect_berries, fruit_mask, use_detector
 from softarm.perception.overlay import draw_bush_map
 from softarm.perception.sight_lines import Placing, SightLine, crossing, sight_lines
 from softarm.perception.stereo import locate_berries
