@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from softarm.commands._args import add_quiet, float_range, int_range, output_dir, positive_int
 from softarm.commands._looks import LOOKS
+from softarm.commands._signals import stops_on_signals
 from softarm.errors import ParameterError
 
 if TYPE_CHECKING:
@@ -28,9 +29,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "C2, written to OUT/images, its depth (16-bit PNG, mm) to OUT/depth, its instance map "
         "to OUT/instances and every berry and cane to OUT/annotations.json (COCO). Runs on Ray "
         "across the cores when the sweep extra is installed, else one image after the other. "
-        "Needs MuJoCo with an offscreen OpenGL (MUJOCO_GL=egl). See docs/dataset.md.",
+        "Needs MuJoCo with an offscreen OpenGL (MUJOCO_GL=egl). The set is written into a "
+        "fresh folder beside OUT and moved into place when complete: a stop (exit 130/143) "
+        "or a failure leaves OUT as it was. See docs/dataset.md.",
     )
-    p.add_argument("--out", type=output_dir, required=True, help="output folder")
+    p.add_argument(
+        "--out", type=output_dir, required=True,
+        help="output folder: new, empty, or an earlier dataset (it holds annotations.json), "
+        "which the new set replaces whole once complete; any other folder is refused",
+    )  # fmt: skip
     p.add_argument("--images", type=positive_int, required=True, help="how many images")
     p.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="dataset seed")
     p.add_argument("--workers", type=int_range(1, MAX_WORKERS), help="cores used (default: all)")
@@ -66,6 +73,7 @@ def default_rig(scale: float = 1.0, world: str = "bush", look: str = "random") -
     )  # fmt: skip
 
 
+@stops_on_signals  # a stop removes the unfinished set and shuts Ray down
 def run(args: argparse.Namespace) -> int:
     """Exit 0 once every image and annotations.json are written."""
     from softarm.commands._progress import Progress

@@ -19,7 +19,6 @@ See docs/dataset.md for the format and its caveats.
 from __future__ import annotations
 
 import json
-import logging
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -33,6 +32,7 @@ import numpy.typing as npt
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError, SoftarmError
+from softarm.files import FreshFolder
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.render.coco import (
     CATEGORIES,
@@ -41,6 +41,7 @@ from softarm.sim.render.coco import (
     mask_bbox,
     mask_polygons,
 )
+from softarm.sim.render.dataset_ray import on_ray, ray_or_none
 from softarm.sim.render.renderer import RenderedFrame
 from softarm.sim.render.row import STAGE_RIPENESS
 from softarm.sim.render.row_look import LOOKS, RowLook
@@ -61,6 +62,8 @@ BERRIES = (4, 12)
 MIN_PIXELS = 4
 #: Depth PNGs hold millimetres in 16 bits: at most 65.535 m.
 DEPTH_SCALE = 1000.0
+#: The COCO file of a set (and the mark of an earlier set a new one may replace).
+ANNOTATIONS = "annotations.json"
 
 
 @dataclass(frozen=True)
@@ -321,64 +324,15 @@ def render_sample(out_dir: str | Path, seed: int, index: int, rig: DatasetRig) -
     return {"image": record, "annotations": [a for _, a in labelled]}
 
 
-def _ray_or_none() -> Any:
-    try:
-        import ray
-    except ImportError:
-        return None
-    return ray
-
-
 def ray_workers(images: int, workers: int | None) -> int:
     """How many Ray workers :func:`write_dataset` uses for ``images`` (all cores when
     ``workers`` is None); 0 when it renders in this process (Ray not installed, one
     worker, or fewer than three images: Ray's start would cost more than it saves)."""
     if workers is None:
         workers = os.cpu_count() or 1
-    if workers < 2 or images < 3 or _ray_or_none() is None:
+    if workers < 2 or images < 3 or ray_or_none() is None:
         return 0
     return workers
-
-
-def _on_ray(
-    ray: Any,
-    out_dir: Path,
-    seed: int,
-    indices: range,
-    rig: DatasetRig,
-    workers: int,
-    on_image: Callable[[], None],
-) -> list[dict[str, Any]]:
-    """Render ``indices`` as Ray tasks on a private local Ray of ``workers`` CPUs."""
-    ours = not ray.is_initialized()
-    if ours:
-        ray.init(
-            address="local", num_cpus=workers, include_dashboard=False, log_to_driver=False,
-            logging_level=logging.ERROR,
-        )  # fmt: skip
-    try:
-        task = ray.remote(num_cpus=1)(render_sample)
-        rig_ref = ray.put(rig)
-        pending = {task.remote(str(out_dir), seed, i, rig_ref): i for i in indices}
-        results: dict[int, dict[str, Any]] = {}
-        while pending:
-            ready, _ = ray.wait(list(pending), num_returns=1)
-            results[pending.pop(ready[0])] = _ray_result(ray, ready[0])
-            on_image()
-        return [results[i] for i in indices]
-    finally:
-        if ours:
-            ray.shutdown()
-
-
-def _ray_result(ray: Any, ref: Any) -> dict[str, Any]:
-    """A task's result; a softarm error raised in the task is raised here as itself."""
-    try:
-        return ray.get(ref)  # type: ignore[no-any-return]
-    except ray.exceptions.RayTaskError as exc:
-        if isinstance(exc.cause, SoftarmError):
-            raise exc.cause from None
-        raise
 
 
 def _coco(samples: list[dict[str, Any]], seed: int, rig: DatasetRig) -> dict[str, Any]:
@@ -411,30 +365,33 @@ def write_dataset(
     on_image: Callable[[], None] = lambda: None,
 ) -> dict[str, Any]:
     """Render ``images`` labelled images of seed ``seed`` into ``out_dir`` and write
-    ``annotations.json``; returns the COCO document. The first image is rendered here
-    (a missing renderer is one clear :class:`RenderUnavailableError`), the others as Ray
-    tasks over ``workers`` cores (default: all) when Ray is installed and ``workers`` > 1,
-    else one after the other. ``on_image`` is called after each image."""
+    ``annotations.json``; returns the COCO document. The set is written into a fresh
+    folder beside ``out_dir`` and moved into place once complete (an earlier set there
+    is replaced whole; a stop or failure leaves it as it was); a folder holding other
+    files than a dataset is refused (:class:`~softarm.files.FreshFolder`). The first
+    image is rendered here (a missing renderer is one clear
+    :class:`RenderUnavailableError`), the others as Ray tasks over ``workers`` cores
+    (default: all; :mod:`~softarm.sim.render.dataset_ray`) when Ray is installed and
+    ``workers`` > 1, else one after the other. ``on_image`` is called after each image."""
     from softarm.files import write_text
 
     if images < 1:
         raise ParameterError(f"images must be >= 1, got {images}")
     if workers is not None and workers < 1:
         raise ParameterError(f"workers must be >= 1, got {workers}")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    samples = [render_sample(out, seed, 0, rig)]
-    on_image()
-    rest = range(1, images)
-    ray_cores = ray_workers(images, workers)
-    if ray_cores:
-        samples += _on_ray(_ray_or_none(), out, seed, rest, rig, ray_cores, on_image)
-    else:
-        for i in rest:
-            samples.append(render_sample(out, seed, i, rig))
-            on_image()
-    coco = _coco(samples, seed, rig)
-    write_text(
-        out / "annotations.json", json.dumps(coco, separators=(",", ":")), "annotations.json"
-    )
+    with FreshFolder(out_dir, "dataset", ANNOTATIONS) as out:
+        samples = [render_sample(out, seed, 0, rig)]
+        on_image()
+        rest = range(1, images)
+        ray_cores = ray_workers(images, workers)
+        if ray_cores:
+            samples += on_ray(
+                ray_or_none(), render_sample, out, seed, rest, rig, ray_cores, on_image
+            )
+        else:
+            for i in rest:
+                samples.append(render_sample(out, seed, i, rig))
+                on_image()
+        coco = _coco(samples, seed, rig)
+        write_text(out / ANNOTATIONS, json.dumps(coco, separators=(",", ":")), ANNOTATIONS)
     return coco
