@@ -27,6 +27,7 @@ from typing import Any
 from softarm._core import Gains
 from softarm.errors import ConfigError, ParameterError
 from softarm.files import parse_toml, read_text, write_text
+from softarm.hardware.camera import source_problem
 from softarm.hardware.limits import (
     BAUD,
     FULL_SCALE_PSI,
@@ -348,8 +349,8 @@ def _pose(t: _Table, name: str) -> Matrix | None:
 
 def _camera(t: _Table, default_source: int) -> CameraConfig:
     source = t.get("source", default_source)
-    if isinstance(source, bool) or not isinstance(source, int | str):
-        raise t.error("source", "must be a device index or a path/URL string")
+    if source_problem(source) is not None:
+        raise t.error("source", str(source_problem(source)))
     file = t.get("file", None)
     if file is not None and (not isinstance(file, str) or not file):
         raise t.error("file", "must be a path string")
@@ -376,7 +377,7 @@ def _build(root: _Table) -> Config:
     serial = _serial(root.table("serial"))
     plant_model = _plant_model(root.table("plant_model"), len(channels.names))
     harvest = _harvest(root.table("harvest"))
-    perception = parse_perception(root.table("perception"))
+    perception = parse_perception(root.table("perception")) if "perception" in root.data else None
     root.done()
     return Config(arm, gains, calibration, channels, serial, plant_model, harvest, perception)
 

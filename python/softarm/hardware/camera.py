@@ -13,11 +13,31 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from softarm.errors import HardwareError, HardwareUnavailableError
+from softarm.errors import HardwareError, HardwareUnavailableError, InputError
 
-__all__ = ["OpenCVCamera", "import_cv2"]
+__all__ = ["MAX_DEVICE_INDEX", "OpenCVCamera", "import_cv2", "source_problem"]
 
 Image = npt.NDArray[np.uint8]
+
+#: Largest OpenCV device index: from 100 on, OpenCV reads the hundreds as a backend
+#: (``200 + k`` is V4L2 device k). -1 ("any camera") crashes some drivers.
+MAX_DEVICE_INDEX = 99
+
+
+def source_problem(source: Any) -> str | None:
+    """Why ``source`` cannot be an OpenCV video source, or None: a device index in
+    [0, :data:`MAX_DEVICE_INDEX`], or a non-empty path/URL string that is UTF-8 (OpenCV
+    takes it as a C string: a name that is not, or holds a NUL, crashes or truncates)."""
+    if isinstance(source, bool) or not isinstance(source, int | str):
+        return "must be a device index or a path/URL string"
+    if isinstance(source, int):
+        ok = 0 <= source <= MAX_DEVICE_INDEX
+        return None if ok else f"must be a device index in [0, {MAX_DEVICE_INDEX}]"
+    try:
+        source.encode("utf-8")
+    except UnicodeEncodeError:
+        return "must be a UTF-8 path/URL string (OpenCV cannot open other names)"
+    return None if source and "\0" not in source else "must be a non-empty path/URL string"
 
 
 def import_cv2() -> ModuleType:
@@ -54,15 +74,23 @@ class OpenCVCamera:
         width, height: requested frame size, or ``None`` for the driver's default.
 
     Raises:
+        InputError: ``source`` is no video source (:func:`source_problem`).
         HardwareUnavailableError: OpenCV is missing or the device cannot be opened.
     """
 
     def __init__(
         self, source: int | str = 0, width: int | None = None, height: int | None = None
     ) -> None:
+        problem = source_problem(source)
+        if problem is not None:
+            raise InputError(f"camera source {problem}, got {source!r}")
         cv2 = import_cv2()
         self.source = source
-        self._cap: Any = _quietly_open(cv2, source)
+        try:
+            self._cap: Any = _quietly_open(cv2, source)
+        except cv2.error as exc:  # what the checks above cannot foresee
+            why = " ".join(str(exc).split())[:200]
+            raise HardwareUnavailableError(f"cannot open camera {source!r}: {why}") from None
         if not self._cap.isOpened():
             self._cap.release()
             self._cap = None

@@ -104,16 +104,13 @@ class FrameImages:
 
     def _decode(self, entry: Mapping[str, Any]) -> tuple[np.ndarray, bytes]:
         """The frame's pixels (for its size and pixel format) and its file's bytes."""
-        import cv2
+        from softarm.files.images import decode_image, read_image_bytes
 
         path = self.frames.folder / str(entry["file"])
-        try:
-            data = path.read_bytes()
-        except OSError as exc:
-            raise ConfigError(f"cannot read frame file {str(path)!r}: {exc.strerror}") from None
+        data = read_image_bytes(path, "frame file", error=ConfigError)
         image = None
         if data.startswith((_PNG, _JPEG)):
-            image = cv2.imdecode(np.frombuffer(data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+            image = decode_image(data, f"frame file {str(path)!r}", error=ConfigError)
         if image is None:
             raise ConfigError(f"frame file {str(path)!r} is not a PNG or JPEG image")
         return image, data
