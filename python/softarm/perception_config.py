@@ -70,10 +70,9 @@ def _device(source: int | str, folder: str | None) -> int | str:
     return resolve(source, folder)
 
 
-def parse_perception(t: _Table) -> PerceptionConfig | None:
-    """``[perception]`` checked key by key (None when the table is absent)."""
-    if not t.data:
-        return None
+def parse_perception(t: _Table) -> PerceptionConfig:
+    """``[perception]`` checked key by key; a key not given takes its default (an empty
+    table is the ZED2 on device 0 with ``stereo.yml``, not no table)."""
     stereo = _choice(t, "stereo", STEREO_SOURCES, "zed2")
     calibration = t.get("calibration", "stereo.yml")
     if not isinstance(calibration, str) or not calibration:
@@ -84,6 +83,9 @@ def parse_perception(t: _Table) -> PerceptionConfig | None:
         if name in t.data:
             raise t.error(name, f"is not a key of stereo = {stereo!r} (it takes {wanted})")
     sources = {name: _source(t, name, 0 if name == "device" else None) for name in wanted}
+    eyes = [_device(sources[name], t.folder) for name in wanted]
+    if len(eyes) == 2 and eyes[0] == eyes[1]:
+        raise t.error("right", "must be another device than perception.left (one per eye)")
     berries = _choice(t, "berries", BERRY_MODES, "markerless")
     survey = t.get("survey", True)
     if not isinstance(survey, bool):
@@ -103,10 +105,14 @@ def _choice(t: _Table, name: str, allowed: tuple[str, ...], default: str) -> str
 
 
 def _source(t: _Table, name: str, default: int | None) -> int | str:
+    from softarm.hardware.camera import source_problem
+
     value: Any = t.get(name, ... if default is None else default)
-    if isinstance(value, bool) or not isinstance(value, int | str) or value == "":
-        raise t.error(name, "must be a device index or a path/URL string")
-    return value
+    problem = source_problem(value)
+    if problem is not None:
+        raise t.error(name, problem)
+    source: int | str = value
+    return source
 
 
 def check_perception(perception: PerceptionConfig | None) -> None:
