@@ -25,14 +25,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
-from softarm.errors import ParameterError, SoftarmError
+from softarm.errors import ParameterError
 from softarm.files import FreshFolder
+from softarm.files.images import write_image
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.render.coco import (
     CATEGORIES,
@@ -245,8 +245,7 @@ def _category(world: RenderedBush, berry: Berry) -> str:
 
 def _write_png(path: Path, image: npt.NDArray[Any]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(path), image):
-        raise SoftarmError(f"out: could not write {path}")
+    write_image(path, image, "out: image")
 
 
 def _depth_mm(depth: npt.NDArray[np.float32]) -> npt.NDArray[np.uint16]:
