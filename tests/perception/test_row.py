@@ -205,3 +205,17 @@ def test_the_row_dataset_has_stages(tmp_path: Path) -> None:
             want = {"ripe": "berry_ripe", "turning": "berry_turning"}.get(stage, "berry_unripe")
             assert names[a["category_id"]] == want
     assert json.loads((tmp_path / "annotations.json").read_text()) == coco
+
+
+def test_harvest_takes_a_look_for_the_row_only(capsys: pytest.CaptureFixture[str]) -> None:
+    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["harvest", "--sim", "--world", "row", "--look", "noon"])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and err.count("\n") == 1 and "--look" in err
+    assert main(["harvest", "--sim", "--world", "bush", "--look", "sun"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--look" in err and "--world row" in err
+    with pytest.raises(ParameterError, match="look"):
+        build_sim_rig(SimRigOptions(world="bush", look="sun"))

@@ -33,6 +33,7 @@ from softarm.commands._dry_run import (
     replay_rounds,
 )
 from softarm.commands._format import plural
+from softarm.commands._looks import LOOKS
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
 from softarm.commands._run_info import (
@@ -101,10 +102,16 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="write the run as a ROS 2 bag (rosbag2, MCAP; ros extra; docs/ros.md)",
     )  # fmt: skip
     p.add_argument(
-        "--world", choices=("tags", "bush"), default="tags",
+        "--world", choices=("tags", "bush", "row"), default="tags",
         help="--sim: 'tags', berries tagged and canes mapped (fast); 'bush', the rendered "
         "bush, berries and canes found by the cameras (render extra, MUJOCO_GL=egl); "
+        "'row', the same bush inside a hedgerow in daylight (--look); "
         "--berries counts ripe and unripe together, 30%% unripe",
+    )  # fmt: skip
+    p.add_argument(
+        "--look", choices=LOOKS, default=None,
+        help="--world row: the daylight family (default random: one of the four drawn "
+        "from the seed; docs/perception.md, 'The daylight row')",
     )  # fmt: skip
     p.add_argument(
         "--survey", action=argparse.BooleanOptionalAction, default=None,
@@ -124,8 +131,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
-#: The share of unripe fruit on a rendered bush (``--world bush``).
+#: The share of unripe fruit on a rendered bush (``--world bush`` or ``row``).
 BUSH_UNRIPE_FRACTION = 0.3
+#: The worlds the renderer draws.
+RENDERED = ("bush", "row")
 
 
 @drives_arm("harvest")
@@ -140,12 +149,14 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     check_dry_run(args)
-    check_render(args.sim and args.world == "bush")
-    if args.survey is not None and not (args.sim and args.world == "bush"):
+    check_render(args.sim and args.world in RENDERED)
+    if args.survey is not None and not (args.sim and args.world in RENDERED):
         raise ParameterError(
-            "--survey/--no-survey: for the rendered bush (--sim --world bush); "
+            "--survey/--no-survey: for the rendered bush (--sim --world bush or row); "
             "on the arm, [perception] survey"
         )
+    if args.look is not None and not (args.sim and args.world == "row"):
+        raise ParameterError("--look: for the rendered row (--sim --world row)")
     check_bag(args.bag)
     check_view(args.view, args.record)
     configure_logging(args.quiet)
@@ -153,9 +164,11 @@ def run(args: argparse.Namespace) -> int:
     gains = _gains(args)
     if args.sim:
         args.seed = 0 if args.seed is None else args.seed
-        if args.world == "bush":
-            options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
+        if args.world in RENDERED:
+            options.update(world=args.world, unripe_fraction=BUSH_UNRIPE_FRACTION)
             options.update(survey=args.survey is not False, record_frames=args.record_frames)
+        if args.world == "row":
+            options.update(look=args.look)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,
             gains=gains, view=args.view, record=args.record, bag=args.bag, args=args, **options,

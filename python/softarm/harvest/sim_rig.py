@@ -51,6 +51,7 @@ from softarm.perception.bush_vision import BushVision
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.plant import ArmPlant
+from softarm.sim.render.row_look import RowLook
 from softarm.sim.render.world import world_for
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.vision import MarkerCube
@@ -95,8 +96,12 @@ class SimRigOptions:
     lag_control: str = "predictor"
     #: "tags": every berry wears an ArUco tag and the canes are mapped (fast, for
     #: controller sweeps); "bush": the rendered bush, berries and canes found by
-    #: perception (softarm.perception), the markerless harvest.
+    #: perception (softarm.perception), the markerless harvest; "row": the same in
+    #: the daylight row around the bush (softarm.sim.render.row).
     world: str = "tags"
+    #: ``world = "row"``: the daylight family (softarm.sim.render.row_look.LOOKS; None:
+    #: "random", one of them drawn from the seed).
+    look: str | None = None
     #: In the rendered bush, C2 surveys the canes C1 fitted before the first berry
     #: (:mod:`softarm.harvest.cane_survey`; ``--no-survey`` turns it off), as the
     #: hardware does unless ``[perception] survey = false``.
@@ -254,7 +259,7 @@ def _build_sim_rig(
     bank = _bank(plant, clock, recorder)
     vision: CameraVision
     gripper: SimGripper
-    if o.world == "bush":
+    if o.world in RENDERED:
         parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
         scene, vision, gripper, canes = _bush_world(
             o, bush, plant, model, cams, parts, clock, recorder
@@ -322,8 +327,10 @@ def _pressure_map(o: SimRigOptions) -> PressureMap:
 def _bush(o: SimRigOptions, plant: ArmPlant, cams: SimCameras) -> Bush:
     """The bush of ``o``'s seed, in the true actuators' reach: 0-70 psi (or less if the
     regulators saturate lower) through each one's true elongation per psi."""
-    if o.world not in ("tags", "bush"):
-        raise ParameterError(f"world = {o.world!r}: must be 'tags' or 'bush'")
+    if o.world not in ("tags", *RENDERED):
+        raise ParameterError(f"world = {o.world!r}: must be 'tags', 'bush' or 'row'")
+    if o.look is not None and o.world != "row":
+        raise ParameterError(f"look = {o.look!r}: for the rendered row (world = 'row')")
     true_upper = min(MAX_PSI, o.plant.max_psi) * plant.sim.metres_per_psi
     return Bush.generate(
         plant.arm, o.n_berries, o.seed, grasp_offset=o.config.grasp_offset,
@@ -336,8 +343,10 @@ def _recorder(o: SimRigOptions) -> FrameRecorder | None:
     """The recorder of ``--record-frames`` (the rendered bush only)."""
     if o.record_frames is None:
         return None
-    if o.world != "bush":
-        raise ParameterError("record_frames: records the rendered bush (world = 'bush') only")
+    if o.world not in RENDERED:
+        raise ParameterError(
+            "record_frames: records the rendered worlds (world = 'bush' or 'row') only"
+        )
     recorder = FrameRecorder(o.record_frames)
     recorder.record("seed", o.seed)
     return recorder
@@ -377,6 +386,8 @@ def _watch(o: SimRigOptions, plant: ArmPlant, canes: list[softarm.PolynomialCurv
     return ArmWatch(plant, Clearance(plant.arm, canes, o.config.grasp_offset))
 
 
+#: The worlds drawn by the renderer: the bush, and the bush in the daylight row.
+RENDERED = ("bush", "row")
 #: C2's image in the rendered bush is rendered at half size (320 x 240): the berry
 #: fills much of it in the last centimetres, and the software rasteriser's cost goes
 #: with the pixels.
@@ -398,7 +409,7 @@ def _bush_world(
     the clearance avoid: fitted from C1 without the rig's own ``parts``. With ``recorder``
     every frame is recorded, and the rig's hardware configuration written beside."""
     cfg = o.config
-    scene = _bush_scene(bush, plant, cams, clock, recorder)
+    scene = _bush_scene(bush, plant, cams, clock, recorder, _look(o, bush))
     canes = scene.fit_canes(parts, CANE_REACH)
     vision = _bush_vision(scene, cams, cfg.grasp_offset, recorder)
     gripper = BushGripper(
@@ -414,12 +425,22 @@ def _bush_world(
     return scene, vision, gripper, canes
 
 
+def _look(o: SimRigOptions, bush: Bush) -> RowLook | None:
+    """The row's look of ``o`` (drawn from the bush's seed), None for the bush."""
+    return RowLook.named(o.look or "random", bush.seed) if o.world == "row" else None
+
+
 def _bush_scene(
-    bush: Bush, plant: ArmPlant, cams: SimCameras, clock: SimClock, recorder: FrameRecorder | None
+    bush: Bush,
+    plant: ArmPlant,
+    cams: SimCameras,
+    clock: SimClock,
+    recorder: FrameRecorder | None,
+    look: RowLook | None = None,
 ) -> BushScene:
-    """The rendered bush, C1 registered on its base tag, the first C1 look merged
-    into its map."""
-    world = world_for(bush, cams, BASE_TAG_ID, c2_scale=C2_SCALE)
+    """The rendered bush (in the row with ``look``), C1 registered on its base tag, the
+    first C1 look merged into its map."""
+    world = world_for(bush, cams, BASE_TAG_ID, look=look, c2_scale=C2_SCALE)
     scene = BushScene(world, BushMap(), bush, plant)
     if recorder is not None:
         scene.read_pair = recorder.wrap_pair(scene.pair, clock.now)

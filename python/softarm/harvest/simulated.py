@@ -45,8 +45,10 @@ def simulate(
         on_berry: called as ``on_berry(i, result)`` after each berry (a retried berry
             calls it again).
         **options: any other field of ``SimRigOptions``: ``plant`` (a ``PlantConfig``),
-            ``gains`` (resolver gain keywords, as ``--gains``), ``world`` ("tags" or
-            "bush", the rendered bush: render extra), ``calibration``, ``identified``,
+            ``gains`` (resolver gain keywords, as ``--gains``), ``world`` ("tags",
+            "bush", the rendered bush: render extra, or "row", the bush in the daylight
+            row, with ``look``: "sun", "overcast", "backlight", "dusk" or "random"),
+            ``calibration``, ``identified``,
             ``config`` (a ``HarvestConfig``), ``unripe_fraction``, ...
 
     Raises:
@@ -59,7 +61,7 @@ def simulate(
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
 
     _check_options(options, SimRigOptions)
-    if options.get("world") == "bush":  # before the log: a typed error, not MuJoCo's
+    if options.get("world") in ("bush", "row"):  # before the log: a typed error, not MuJoCo's
         from softarm.sim.render.gl_check import require_offscreen_gl
 
         require_offscreen_gl()

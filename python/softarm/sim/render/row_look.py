@@ -78,6 +78,7 @@ LOOK_RANGES: dict[str, dict[str, tuple[float, float]]] = {
         "gain": (0.3, 0.8),
         "read_noise": (2.0, 5.0),
         "blur_px_s": (60.0, 300.0),
+        "exposure_bias": (0.35, 0.6),
     },
 }
 

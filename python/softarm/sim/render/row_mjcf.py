@@ -83,7 +83,9 @@ def row_scene_xml(spec: mjcf.SceneSpec, row: Row, shadows: bool) -> tuple[str, d
 
 
 def _head(spec: mjcf.SceneSpec, look: RowLook, meshes: str, shadows: bool) -> str:
-    amb = look.ambient
+    # The sky's light: the ambient tinted by the sky (blue under a clear sky, grey under
+    # cloud, cold at dusk against the orange sun).
+    amb = mjcf._v(look.ambient * (0.6 + 0.4 * look.sky_zenith / look.sky_zenith.max()))
     sun = look.light_colour * look.light_intensity
     pos = CENTRE - 6.0 * look.light_direction  # above the scene, where the sun is
     fill = 0.12 + 0.25 * float(np.mean(look.sky_horizon)) * (look.ambient > 0.4)
@@ -92,8 +94,8 @@ def _head(spec: mjcf.SceneSpec, look: RowLook, meshes: str, shadows: bool) -> st
         f'<visual><global offwidth="1280" offheight="720"/>'
         f'<quality shadowsize="{SHADOW_SIZE if shadows else 0}" '
         f'offsamples="{mjcf.OFFSCREEN_SAMPLES}" numslices="14" numstacks="8"/>'
-        f'<headlight ambient="{amb} {amb} {amb}" diffuse="0 0 0" specular="0 0 0"/>'
-        f'<map znear="0.005" zfar="30" shadowclip="1.2"/></visual>'
+        f'<headlight ambient="{amb}" diffuse="0 0 0" specular="0 0 0"/>'
+        f'<map znear="0.005" zfar="40" shadowclip="1.2"/></visual>'
         f'<statistic extent="{EXTENT}" center="{mjcf._v(CENTRE)}"/>'
         f"<asset>{mjcf._tag_materials(spec)}{meshes}{_materials(look)}</asset><worldbody>"
         f'<light name="sun" directional="true" castshadow="{str(shadows).lower()}" '
@@ -119,12 +121,12 @@ def _materials(look: RowLook) -> str:
         f'width="256" height="256"/>'
         f'<texture name="soil" type="2d" builtin="flat" rgb1="{soil}" rgb2="{soil2}" '
         f'mark="random" random="0.25" markrgb="{soil2}" width="512" height="512"/>'
-        f'<material name="soil" texture="soil" texrepeat="24 24" specular="0.05"/>'
+        f'<material name="soil" texture="soil" texrepeat="80 80" specular="0.05"/>'
         f'<texture name="leafvein" type="2d" file="leafvein.png"/>'
         f'<material name="leaf" texture="leafvein" specular="0.25" shininess="0.3"/>'
         f'<material name="deadleaf" texture="leafvein" specular="0.5" shininess="0.6"/>'
         f'<texture name="hedge" type="2d" file="hedge.png"/>'
-        f'<material name="hedge" texture="hedge" texrepeat="5 2" specular="0.1"/>'
+        f'<material name="hedge" texture="hedge" texrepeat="12 4" specular="0.1"/>'
         f'{ripe}<material name="waxy" specular="0.35" shininess="0.45"/>'
         f'<material name="plastic" specular="0.6" shininess="0.7"/>'
     )
@@ -136,7 +138,7 @@ def _ground(look: RowLook, rng: np.random.Generator) -> str:
     black = rng.uniform() < 0.6  # black plastic; else dark wood-chip mulch
     colour = np.array([0.05, 0.05, 0.055]) if black else np.array([0.16, 0.11, 0.07])
     return (
-        f'<geom name="bg_ground" type="plane" size="12 12 0.1" pos="0 0.5 {GROUND_Z}" '
+        f'<geom name="bg_ground" type="plane" size="40 40 0.1" pos="0 0.5 {GROUND_Z}" '
         f'material="soil" rgba="{mjcf._rgba(look.ground_colour * 1.6)}"/>'
         f'<geom name="clutter_mulch0" type="box" size="{ROW_HALF + 0.6} 0.4 0.002" '
         f'pos="0 {mulch_y} {GROUND_Z + 0.002}" material="plastic" rgba="{mjcf._rgba(colour)}" '
@@ -166,7 +168,7 @@ def _trellis() -> str:
     )
     depth = (
         f'<geom name="bg_hedge" type="box" size="{ROW_HALF + 0.6} 0.05 0.7" '
-        f'pos="0 {ROW_Y + 0.3} 0.3" material="hedge" rgba="0.9 0.9 0.9 1"/>'
+        f'pos="0 {ROW_Y + 0.3} 0.3" material="hedge" rgba="0.6 0.6 0.6 1"/>'
     )
     return posts + wires + depth
 
@@ -175,11 +177,11 @@ def _next_row(look: RowLook, rng: np.random.Generator) -> str:
     """The next row, 2.8 m behind: its hedge and a few big foliage masses."""
     y = ROW_Y + 2.8
     out = [
-        f'<geom name="bg_nextrow" type="box" size="6 0.25 0.75" pos="0 {y} 0.3" '
+        f'<geom name="bg_nextrow" type="box" size="30 0.25 0.75" pos="0 {y} 0.3" '
         f'material="hedge" rgba="0.7 0.75 0.7 1"/>'
     ]
     for k in range(24):
-        pos = np.array([rng.uniform(-4, 3), y - rng.uniform(0.2, 0.4), rng.uniform(-0.2, 1.0)])
+        pos = np.array([rng.uniform(-8, 3), y - rng.uniform(0.2, 0.4), rng.uniform(-0.2, 1.0)])
         size = rng.uniform(0.12, 0.3, 3)
         colour = look.leaf_colour * rng.uniform(0.5, 1.0)
         out.append(
