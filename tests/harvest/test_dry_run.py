@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from render_required import need_mujoco, unavailable
 from softarm.cli import main
 from softarm.harvest.frame_files import INDEX
 
@@ -23,7 +24,7 @@ SEED = 902
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    pytest.importorskip("mujoco")
+    need_mujoco()
     folder = tmp_path_factory.mktemp("dry") / "rec"
     args = [
         "harvest",
@@ -37,7 +38,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ]
     status = main([*args, "--record-frames", str(folder), "-q"])
     if not (folder / INDEX).is_file():
-        pytest.skip("the rendered bush is unavailable here (EGL)")
+        unavailable("the rendered bush is unavailable here (EGL)")
     assert status == 0
     return folder
 

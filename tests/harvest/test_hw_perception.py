@@ -112,14 +112,13 @@ def test_a_missing_stereo_file_names_the_key(tmp_path: Path) -> None:
 
 @pytest.fixture(scope="module")
 def bush() -> Any:
-    """A small rendered bush (the sim rig's own map and canes), or a skip."""
+    """A small rendered bush (the sim rig's own map and canes), or a skip (a failure
+    where the render is required)."""
+    from render_required import rendering
     from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
-    from softarm.sim.render import RenderUnavailableError
 
-    try:
+    with rendering():
         return build_sim_rig(SimRigOptions(n_berries=3, seed=330, world="bush"))
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
 
 
 @pytest.mark.usefixtures("no_devices")

@@ -9,18 +9,16 @@ import os
 
 import pytest
 
+from render_required import rendering
 from softarm.harvest.sim_rig import SimRig, SimRigOptions, build_sim_rig
-from softarm.sim.render import RenderUnavailableError
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 
 @pytest.fixture(scope="module")
 def harvested() -> tuple[SimRig, dict]:
-    try:
+    with rendering():
         rig = build_sim_rig(SimRigOptions(n_berries=4, seed=330, world="bush", unripe_fraction=0.3))
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
     return rig, rig.run().to_dict()
 
 

@@ -222,23 +222,23 @@ def test_no_cane_in_view_is_an_empty_list(stereo: StereoCamera) -> None:
 
 @pytest.fixture(scope="module")
 def rendered():
-    pytest.importorskip("mujoco")
+    from render_required import need_mujoco, rendering
+
+    need_mujoco()
     import softarm
     from softarm.harvest.sim_rig import default_cameras
     from softarm.harvest.sim_vision import BASE_TAG_ID
     from softarm.sim.bush import Bush
-    from softarm.sim.render import RenderedBush, RenderUnavailableError
+    from softarm.sim.render import RenderedBush
 
     arm = softarm.SoftArm.blackberry()
     cams = default_cameras()
     bush = Bush.generate(arm, 4, 4, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
-    try:
+    with rendering():
         world = RenderedBush(
             bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2,
             cams.T_ee_cube, cams.T_base_tag, BASE_TAG_ID, cams.base_tag,
         )  # fmt: skip
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
     left, right = world.c1(truth=True)
     yield bush, world.stereo, left, right
     world.close()

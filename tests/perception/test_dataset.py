@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
+from render_required import need_mujoco, rendering
 from softarm._core import SoftArm
 from softarm.cli import main
 from softarm.commands.dataset import default_rig
@@ -23,12 +24,10 @@ SCALE = 0.25  # C1 320 x 180, C2 160 x 120
 
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
-    pytest.importorskip("mujoco")
+    need_mujoco()
     out = tmp_path_factory.mktemp("dataset")
-    try:
+    with rendering():
         coco = write_dataset(out, 2, SEED, default_rig(SCALE), workers=1)
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
     return out, coco
 
 
@@ -123,7 +122,7 @@ def test_no_renderer_is_one_line(
 
 @pytest.mark.slow
 def test_ray_writes_the_same_set_as_a_loop(tmp_path: Path) -> None:
-    pytest.importorskip("mujoco")
+    need_mujoco()
     pytest.importorskip("ray")
     rig = default_rig(SCALE)
     loop = write_dataset(tmp_path / "loop", 3, SEED, rig, workers=1)

@@ -39,15 +39,13 @@ def _T_left_right() -> np.ndarray:
 @pytest.fixture(scope="module")
 def views() -> tuple[list[np.ndarray], list[np.ndarray]]:
     """12 simultaneous (left, right) views of the board in front of the pair."""
-    from softarm.sim.render import RenderUnavailableError
+    from render_required import rendering
     from softarm.sim.render.charuco import BoardSpec, CharucoScene, board_poses
 
     spec = BoardSpec(*BOARD)
-    try:
+    with rendering():
         scene = CharucoScene(spec, {"left": (LEFT, np.eye(4)), "right": (RIGHT, _T_left_right())})
         shots = [scene.render(T) for T in board_poses(spec, 12, seed=1, centre=(0.06, 0.0))]
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
     scene.close()
     return [s["left"] for s in shots], [s["right"] for s in shots]
 
