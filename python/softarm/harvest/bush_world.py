@@ -219,7 +219,7 @@ def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
     mapped = {t.tag_id for e in scene.bush_map.berries if (t := scene.truth_of(e.id)) is not None}
     unmapped = [b.tag_id for b in ripe if b.tag_id not in mapped]
     return {
-        "world": "bush",
+        "world": "bush" if scene.world.row is None else "row",
         "ripe_in_reach": len(ripe),
         "ripe_harvested": sum(b.ripeness >= 0.5 for b in picked.values()),
         "unripe_picked": sum(b.ripeness < 0.5 for b in picked.values()),
