@@ -165,9 +165,8 @@ def _ros_matrix(name: str, mat: np.ndarray) -> list[str]:
 def _open(path: str | Path, body: str, what: str = "camera file") -> Any:
     if not body.strip():  # OpenCV's own error for it is an opaque SystemError
         raise ConfigError(f"{what} {str(path)!r} is empty")
-    flags = cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY
-    try:
-        fs = cv2.FileStorage(body, flags)
+    try:  # the text itself, never a path: OpenCV takes a path as a C string
+        fs = cv2.FileStorage(body, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
     except (cv2.error, SystemError) as exc:  # some parse errors surface as SystemError
         msg = str(exc).strip().splitlines()[-1] if str(exc).strip() else type(exc).__name__
         raise ConfigError(f"cannot parse {what} {str(path)!r}: {msg}") from None
