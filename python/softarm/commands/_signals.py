@@ -239,15 +239,15 @@ def drives_arm(command: str) -> Callable[[Run], Run]:
     def decorate(run: Run) -> Run:
         @functools.wraps(run)
         def guarded(args: Any) -> int:
-            with raise_on_signals():
-                try:
+            try:
+                with raise_on_signals():  # its end may raise a stop a finalizer swallowed
                     return run(args)
-                except Interrupted as exc:
-                    log = getattr(exc, "written_log", None)  # set by stop_arm
-                    where = f"; log {log}" if log else ""
-                    _log.info("softarm %s %s: arm vented", command, exc)
-                    print(f"softarm {command}: {exc}: arm vented{where}", file=sys.stderr)
-                    return exc.exit_status
+            except Interrupted as exc:
+                log = getattr(exc, "written_log", None)  # set by stop_arm
+                where = f"; log {log}" if log else ""
+                _log.info("softarm %s %s: arm vented", command, exc)
+                print(f"softarm {command}: {exc}: arm vented{where}", file=sys.stderr)
+                return exc.exit_status
 
         guarded.drives_arm = True  # type: ignore[attr-defined]
         return guarded

@@ -43,7 +43,7 @@ from softarm.commands._run_info import (
     start_log,
     write_run_bag,
 )
-from softarm.commands._signals import drives_arm, vents_on_stop
+from softarm.commands._signals import drives_arm, records_late_stop, vents_on_stop
 from softarm.errors import ConfigError, HardwareUnavailableError, ParameterError
 from softarm.harvest_config import HarvestConfig
 
@@ -236,17 +236,43 @@ def run_sim(
     seen = rig.scene.picture() if rig.scene is not None and plot_path is not None else None
     viewer = _viewer(rig, view, record)
     try:
-        with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
-            report = _harvest(rig, berries, quiet)
+        try:
+            with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
+                report = _harvest(rig, berries, quiet)
+        finally:
+            if viewer is not None:
+                viewer.close()  # the recording complete, even after a stop
+        # The run's log is closed; a stop while the outputs are written is recorded in it.
+        with records_late_stop(rig.machine.log):
+            _sim_outputs(rig, report, report_path, bag, rig_options.record_frames, plot_path, seen)
+            rig.close()  # the renderers freed here, not by finalizers at exit
     finally:
-        if viewer is not None:
-            viewer.close()  # the recording complete, even after a stop
+        rig.close()
+    if log_path is not None:
+        print(f"log: {log_path}")
+    if record is not None:
+        print(f"recording: {record}")
+    done = all(b.final_state.value == "done" for b in report.berries)
+    return 0 if done and not off_tolerance(report, rig.machine) else 1
+
+
+def _sim_outputs(
+    rig: SimRig,
+    report: HarvestReport,
+    report_path: Path | None,
+    bag: Path | None,
+    frames: Any,
+    plot_path: Path | None,
+    seen: Any,
+) -> None:
+    """The summary line, then the report, the bag (with the recorded ``frames``) and the
+    plot (with what C1 saw at IDLE, ``seen``) where asked for."""
     report.header = rig.machine.log.records[0]
     print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
     if report_path is not None:
         report.save(report_path)
         print(f"report: {report_path}")
-    write_run_bag(rig.machine.log.records, bag, rig_options.record_frames)
+    write_run_bag(rig.machine.log.records, bag, frames)
     if plot_path is not None:
         _plot(rig, report, plot_path)
         print(f"plot: {plot_path}")
@@ -254,12 +280,6 @@ def run_sim(
             seen_path = plot_path.with_name(plot_path.stem + "_c1.png")
             _save_image(seen, seen_path)
             print(f"what C1 saw: {seen_path}")
-    if log_path is not None:
-        print(f"log: {log_path}")
-    if record is not None:
-        print(f"recording: {record}")
-    done = all(b.final_state.value == "done" for b in report.berries)
-    return 0 if done and not off_tolerance(report, rig.machine) else 1
 
 
 def _save_image(image: Any, path: Path) -> None:
@@ -366,15 +386,17 @@ def _run_hardware(args: argparse.Namespace) -> int:
     finally:
         rig.close()  # vents and releases every device, whatever happened
         log.close()
-    report.header = log.records[0]
-    print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
-    status = 0 if report.stopped is None and not off_tolerance(report, rig.machine) else 1
-    if devices is not None and sent is not None:
-        status = max(status, dry_run_verdict(devices, sent, report))
-    if args.report:
-        report.save(args.report)
-        print(f"report: {args.report}")
-    write_run_bag(log.records, args.bag, args.frames)  # --dry-run: the frames it replayed
+    # The log is closed; a stop while the outputs are written is recorded in it.
+    with records_late_stop(log):
+        report.header = log.records[0]
+        print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
+        status = 0 if report.stopped is None and not off_tolerance(report, rig.machine) else 1
+        if devices is not None and sent is not None:
+            status = max(status, dry_run_verdict(devices, sent, report))
+        if args.report:
+            report.save(args.report)
+            print(f"report: {args.report}")
+        write_run_bag(log.records, args.bag, args.frames)  # --dry-run: the frames replayed
     return status
 
 
