@@ -130,6 +130,11 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'softarm' has no attribute {name!r}")
 
 
+#: Modules that serve the command line and the package itself, not a user of the API:
+#: importable, left out of ``dir(softarm)``.
+_INTERNAL = frozenset({"checks", "cli", "commands", "files"})
+
+
 def __dir__() -> list[str]:
     # The lazily imported subpackages are part of the API: list them beside the names.
-    return sorted({*__all__, *_LAZY_SUBPACKAGES})
+    return sorted({*__all__, *(_LAZY_SUBPACKAGES - _INTERNAL)})

@@ -266,7 +266,7 @@ impl Plan {
     fn __repr__(&self) -> String {
         format!(
             "Plan(reached={}, iterations={}, min_clearance={}, termination={:?})",
-            self.inner.reached,
+            crate::resolver::py_bool(self.inner.reached),
             self.inner.iterations,
             self.inner.min_clearance,
             self.inner.termination.name()

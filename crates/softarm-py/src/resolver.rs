@@ -247,7 +247,9 @@ impl StepResult {
     fn __repr__(&self) -> String {
         format!(
             "StepResult(saturated={}, position_error={:.3e}, orientation_error={:.3e})",
-            self.info.saturated, self.info.position_error, self.info.orientation_error
+            py_bool(self.info.saturated),
+            self.info.position_error,
+            self.info.orientation_error
         )
     }
 }
@@ -332,13 +334,22 @@ impl Solution {
         format!(
             "Solution(converged={}, steps={}, best_step={}, position_error={:.3e}, \
              orientation_error={:.3e}, termination={:?})",
-            self.inner.converged,
+            py_bool(self.inner.converged),
             self.inner.steps,
             self.inner.best_step,
             self.inner.position_error,
             self.inner.orientation_error,
             self.inner.termination.name()
         )
+    }
+}
+
+/// A bool as Python writes it in a repr (`True`, not Rust's `true`).
+pub(crate) fn py_bool(b: bool) -> &'static str {
+    if b {
+        "True"
+    } else {
+        "False"
     }
 }
 

@@ -31,7 +31,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "across the cores when the sweep extra is installed, else one image after the other. "
         "Needs MuJoCo with an offscreen OpenGL (MUJOCO_GL=egl). The set is written into a "
         "fresh folder beside OUT and moved into place when complete: a stop (exit 130/143) "
-        "or a failure leaves OUT as it was. See docs/dataset.md.",
+        "or a failure leaves OUT as it was. Then 8-bit previews of the depth and instance "
+        "maps, for an image viewer, go to OUT/preview. See docs/dataset.md.",
     )
     p.add_argument(
         "--out", type=output_dir, required=True,
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     from softarm.commands._progress import Progress
     from softarm.sim.render.dataset import ray_workers, write_dataset
     from softarm.sim.render.gl_check import require_offscreen_gl
+    from softarm.sim.render.preview import write_previews
 
     require_offscreen_gl()  # one line naming the fix, before OUT is created
     if args.look is not None and args.world != "row":
@@ -90,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
         coco = write_dataset(
             args.out, args.images, args.seed, rig, workers=args.workers, on_image=progress.advance
         )
+    write_previews(args.out)  # 8-bit PNGs of depth/ and instances/ a viewer shows
     counts = {c["id"]: 0 for c in coco["categories"]}
     for annotation in coco["annotations"]:
         counts[annotation["category_id"]] += 1

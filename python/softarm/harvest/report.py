@@ -74,7 +74,24 @@ class HarvestReport:
     @property
     def success_rate(self) -> float:
         """Harvested berries over berries attempted or pending (0 when there are none)."""
-        return sum(b.harvested for b in self.berries) / len(self.berries) if self.berries else 0.0
+        return self.harvested / self.attempted if self.berries else 0.0
+
+    @property
+    def harvested(self) -> int:
+        """Berries grasped, ripe, and brought home (``to_dict()["harvested"]``)."""
+        return sum(b.harvested for b in self.berries)
+
+    @property
+    def attempted(self) -> int:
+        """Berries attempted or pending: one result each (``to_dict()["attempted"]``)."""
+        return len(self.berries)
+
+    @property
+    def cane_map(self) -> dict[str, float] | None:
+        """How well the rendered bush's canes were mapped (median and p95 error mm,
+        coverage, precision, length m; docs/perception.md), None in the tag world."""
+        value = self.extra.get("cane_map")
+        return dict(value) if isinstance(value, dict) else None
 
     def to_dict(self) -> dict[str, Any]:
         """The report as a JSON-ready dict."""
@@ -83,8 +100,8 @@ class HarvestReport:
                 {
                     **({} if self.header is None else {"header": self.header}),
                     "success_rate": self.success_rate,
-                    "harvested": sum(b.harvested for b in self.berries),
-                    "attempted": len(self.berries),
+                    "harvested": self.harvested,
+                    "attempted": self.attempted,
                     "stopped": self.stopped,
                     "berries": [b.to_dict() for b in self.berries],
                     **self.extra,

@@ -12,7 +12,7 @@ sensor in the gripper keeps the last word at the grasp.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, cast
 
 import cv2
@@ -87,7 +87,7 @@ class BerryDetection:
     center: tuple[float, float]
     radius: float
     box: tuple[int, int, int, int]
-    mask: npt.NDArray[np.bool_]
+    mask: npt.NDArray[np.bool_] = field(repr=False)  # a repr of a few lines, not pixels
     score: float
     ripeness: Ripeness
     probability: float
