@@ -158,3 +158,24 @@ def test_opencv_camera_refuses_what_is_no_source() -> None:
     lines = done.stdout.strip().splitlines()
     assert done.returncode == 0 and len(lines) == 7, done
     assert all(line.startswith("InputError camera source") for line in lines), lines
+
+
+def test_config_check_refuses_every_pair_the_harvest_refuses() -> None:
+    """What StereoCamera refuses when the harvest builds it, read_stereo's pair check
+    refuses first, so that `config check` never says ready for it."""
+    from softarm.errors import VisionError
+    from softarm.perception.stereo_camera import StereoCamera
+    from softarm.vision.calibration_checks import pair_problems
+
+    rng = np.random.default_rng(42)
+    translations = [*rng.normal(0.0, 0.1, (200, 3)), (0.1, 0.1, 0.0), (0.1, 0.0, -0.1)]
+    refused = 0
+    for t in translations:
+        T = np.eye(4)
+        T[:3, 3] = t
+        try:
+            StereoCamera(CAMERA, CAMERA, np.eye(4), T)
+        except VisionError:
+            refused += 1
+            assert pair_problems(T), t
+    assert refused > 100  # the sample does reach the refusals

@@ -15,7 +15,7 @@ baseline of 438 mm for 120. The checks here are the ones such data fails:
 * **reprojection** (:data:`MAX_RMS_PX`): an RMS above it is no calibration (a stereo pair
   whose images do not pair up, a board of the wrong size);
 * **the pair** (:func:`pair_problems`): a baseline of plausible length
-  (:data:`BASELINE_RANGE`), the right eye on the left eye's +x.
+  (:data:`BASELINE_RANGE`), the right eye mostly along the left eye's +x.
 
 A calibration that fails one after fitting raises :class:`CalibrationNotConverged`,
 which carries the model and the problems, so that ``softarm camera calibrate`` can show
@@ -144,8 +144,8 @@ def rms_problem(name: str, rms: float) -> list[str]:
 
 def pair_problems(T_left_right: npt.NDArray[Any]) -> list[str]:
     """What is implausible in the right eye's pose ``T_left_right`` (4x4, m, in the left
-    eye's frame): a baseline outside :data:`BASELINE_RANGE`, or the right eye not on the
-    left eye's +x (swapped eyes, or a pair that is not side by side)."""
+    eye's frame): a baseline outside :data:`BASELINE_RANGE`, or the right eye not mostly
+    along the left eye's +x (swapped eyes, or a pair that is not side by side)."""
     T = np.asarray(T_left_right, dtype=np.float64)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         return ["T_left_right must be a finite 4x4 pose"]
@@ -156,9 +156,11 @@ def pair_problems(T_left_right: npt.NDArray[Any]) -> list[str]:
     if not lo <= baseline <= hi:
         return [f"the baseline is {1e3 * baseline:.4g} mm: a stereo pair's is {1e3 * lo:g} mm "
                 f"to {hi:g} m"]  # fmt: skip
-    if t[0] < 0.5 * baseline:
+    # As StereoCamera requires: mostly along +x (a vertical pair is not side by side).
+    if t[0] <= max(abs(t[1]), abs(t[2])):
+        at = ", ".join(f"{1e3 * v:.1f}" for v in t)
         return [
-            f"the right eye is at x = {1e3 * t[0]:.1f} mm of the left (baseline "
-            f"{1e3 * baseline:.1f} mm): it must be on the left eye's +x (eyes swapped?)"
+            f"the right eye is at ({at}) mm of the left: it must lie mostly along the left "
+            "eye's +x (eyes swapped?)"
         ]
     return []
