@@ -122,3 +122,24 @@ def test_a_stop_while_the_bag_is_written_is_recorded_in_the_log(
     assert records[-1]["signal"] == "SIGTERM" and records[-1]["exit_status"] == 143
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.jsonl"]  # no bag, no temp
     assert "softarm harvest: interrupted by SIGTERM" in capsys.readouterr().err
+
+
+def test_a_dry_run_stopped_while_it_reads_the_recording_says_so_in_its_log(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Item 16: a dry run stopped before its rig was built (reading the recording) left
+    an empty log; the stop is recorded from the moment the log exists."""
+    from softarm.commands import harvest
+
+    def stopped(args: Any) -> Any:
+        os.kill(os.getpid(), signal.SIGTERM)
+        raise AssertionError("the signal did not arrive")
+
+    monkeypatch.setattr(harvest, "replay_devices", stopped)
+    (tmp_path / "hw.toml").write_text("")
+    log = tmp_path / "dry.jsonl"
+    argv = ["harvest", "--config", str(tmp_path / "hw.toml"), "--frames", str(tmp_path)]
+    assert main([*argv, "--dry-run", "--log", str(log), "-q"]) == 143
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    assert [r["kind"] for r in records] == ["interrupted"]
+    assert records[0]["signal"] == "SIGTERM"

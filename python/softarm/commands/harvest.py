@@ -356,13 +356,13 @@ def _run_hardware(args: argparse.Namespace) -> int:
 
     log = HarvestLog(args.log)  # first of all: a stop during set-up is recorded in it
     try:
-        devices = replay_devices(args)  # --dry-run: the recording's, else the drivers
-        if args.seed is None:
-            args.seed = 0 if devices is None else devices.recorded_seed()
-        if devices is not None:
-            log_commands(devices, log)
         # Nothing is pressurised yet; a device opened so far is vented by its own close.
         with vents_on_stop(lambda reason: None, log):
+            devices = replay_devices(args)  # --dry-run: the recording's, else the drivers
+            if args.seed is None:
+                args.seed = 0 if devices is None else devices.recorded_seed()
+            if devices is not None:
+                log_commands(devices, log)
             rig = _hardware_rig(args, log, devices)
     except HardwareUnavailableError as exc:
         log.close()
