@@ -220,6 +220,11 @@ def test_no_cane_in_view_is_an_empty_list(stereo: StereoCamera) -> None:
     assert fit_canes(grey, None, stereo, depth=np.full((480, 640), np.nan, np.float32)) == []
 
 
+#: The rendered bush the cane-map accuracy is judged on: from the seeds reserved for CI
+#: (90000-90999, never tuned on nor reported: docs/architecture.md, "Seeds").
+CANE_SEED = 90000
+
+
 @pytest.fixture(scope="module")
 def rendered():
     from render_required import need_mujoco, rendering
@@ -233,7 +238,7 @@ def rendered():
 
     arm = softarm.SoftArm.blackberry()
     cams = default_cameras()
-    bush = Bush.generate(arm, 4, 4, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
+    bush = Bush.generate(arm, 4, CANE_SEED, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
     with rendering():
         world = RenderedBush(
             bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2,
