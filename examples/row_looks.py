@@ -1,9 +1,10 @@
 """Pictures of the daylight row (``--world row``), one per look, and what it costs to
 render: C1's left eye on the same bush and seed in each look (``sun``, ``overcast``,
 ``backlight``, ``dusk``), as delivered (the camera model applied), written as
-``row_<look>.png``; then the milliseconds per C1 frame (pinhole render, and the whole
-delivered frame) of the row with and without shadows and of the rendered bush, the
-medians of ``--repeats`` renders, into ``row_render_cost.json``.
+``row_<look>.png`` (scaled down to ``--width``); then the milliseconds per C1 frame
+(the pinhole render, and the whole delivered frame) of the row with and without
+shadows and of the rendered bush, the medians of ``--repeats`` renders, into
+``row_render_cost.json``.
 
 The pictures in docs/img and the figures in docs/perception.md come from::
 
@@ -56,11 +57,18 @@ def _cost(bush: Bush, cams: Any, seed: int, repeats: int) -> dict[str, Any]:
         ("bush", None, True),
     ):
         world = _world(bush, cams, look, shadows)
+
+        def pinhole(w: RenderedBush = world) -> object:
+            return w.renderer.render("c1_left")
+
+        def delivered(w: RenderedBush = world) -> object:
+            return w.c1_left()
+
         try:
             out[name] = {
                 "geoms": int(world.renderer.model.ngeom),
-                "pinhole_ms": _median_ms(lambda w=world: w.renderer.render("c1_left"), repeats),
-                "delivered_ms": _median_ms(lambda w=world: w.c1_left(), repeats),
+                "pinhole_ms": _median_ms(pinhole, repeats),
+                "delivered_ms": _median_ms(delivered, repeats),
             }
         finally:
             world.close()
@@ -80,6 +88,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seed", type=int, default=21, help="bush and look seed")
     parser.add_argument("--repeats", type=int, default=5, help="renders per cost figure")
     parser.add_argument("--no-cost", action="store_true", help="pictures only")
+    parser.add_argument(
+        "--width", type=int, default=960, help="pictures scaled down to this width (px)"
+    )
     args = parser.parse_args(argv)
     cams = default_cameras()
     bush = Bush.generate(
@@ -91,7 +102,11 @@ def main(argv: list[str] | None = None) -> None:
         world = _world(bush, cams, RowLook.named(name, args.seed))
         try:
             path = args.out / f"row_{name}.png"
-            cv2.imwrite(str(path), world.c1_left().colour)
+            image: Any = world.c1_left().colour
+            if args.width < image.shape[1]:  # the docs' copy: smaller files
+                height = round(image.shape[0] * args.width / image.shape[1])
+                image = cv2.resize(image, (args.width, height), interpolation=cv2.INTER_AREA)
+            cv2.imwrite(str(path), image)
             print(f"{name}: {path}", flush=True)
         finally:
             world.close()

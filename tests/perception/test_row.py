@@ -219,3 +219,21 @@ def test_harvest_takes_a_look_for_the_row_only(capsys: pytest.CaptureFixture[str
     assert err.count("\n") == 1 and "--look" in err and "--world row" in err
     with pytest.raises(ParameterError, match="look"):
         build_sim_rig(SimRigOptions(world="bush", look="sun"))
+
+
+def test_culled_renders_keep_the_shadows_of_what_is_out_of_the_picture(row: Any) -> None:
+    """A window (and the frame) leaves out the geoms it cannot see, but not those whose
+    shadows fall into it: the same pixels as with nothing left out."""
+    full = _world(RowLook.named("sun", SEED))
+    try:
+        full.renderer._cullable = full.renderer._cullable[:0]
+        np.testing.assert_array_equal(
+            row.renderer.render("c1_left").colour, full.renderer.render("c1_left").colour
+        )
+        for origin in ((20, 30), (150, 100), (250, 10)):
+            np.testing.assert_array_equal(
+                row.renderer.render_window("c1_left", origin, 64),
+                full.renderer.render_window("c1_left", origin, 64),
+            )
+    finally:
+        full.close()

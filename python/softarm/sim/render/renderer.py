@@ -39,6 +39,12 @@ OCCLUDER_GROUP = 2
 #: The geom group a geom outside a render's frustum is moved to for that render: MuJoCo's
 #: default visualisation options, and those :meth:`BushRenderer.render` builds, hide it.
 CULLED_GROUP = 5
+#: Where the row's sun casts shadows, a geom is kept in a render when its bounding
+#: sphere, swept SHADOW_REACH m along the sunlight, meets the frustum: the sweep as
+#: spheres 2 * SHADOW_STEP apart, each grown by SHADOW_STEP (they cover it).
+SHADOW_REACH = 3.0
+SHADOW_STEP = 0.125
+SHADOW_STEPS = np.arange(SHADOW_STEP, SHADOW_REACH, 2 * SHADOW_STEP)
 
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
@@ -118,6 +124,10 @@ class BushRenderer:
         # stale): only the rest of the scene is culled.
         self._groups = self.model.geom_group.copy()
         self._cullable = np.flatnonzero(self.labels.kind != KINDS.index("arm"))
+        self._shadow_travel: FloatArray | None = None
+        if spec.row is not None and spec.shadows:
+            sun = np.asarray(spec.look.light_direction, float)
+            self._shadow_travel = sun / np.linalg.norm(sun)
 
     def push_leaves(self, body: FloatArray, radius: FloatArray) -> None:
         """Move aside every leaf that the arm's body (spheres at ``body`` (N, 3) with
@@ -266,7 +276,14 @@ class BushRenderer:
         cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
         centres = (d.geom_xpos[self._cullable] - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
         radii = m.geom_rbound[self._cullable]
-        shown = in_frustum(centres, radii, size, self.cameras[camera].focal, principal)
+        focal = self.cameras[camera].focal
+        shown = in_frustum(centres, radii, size, focal, principal)
+        if self._shadow_travel is not None:  # a caster out of the picture may shade it
+            travel = self._shadow_travel @ d.cam_xmat[cam].reshape(3, 3)
+            for t in SHADOW_STEPS:
+                shown |= in_frustum(
+                    centres + t * travel, radii + SHADOW_STEP, size, focal, principal
+                )
         m.geom_group[self._cullable[~shown]] = CULLED_GROUP
         try:
             yield

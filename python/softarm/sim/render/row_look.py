@@ -185,7 +185,7 @@ def look_table() -> str:
     rule = "| --- |" + " --- |" * len(FAMILIES)
     rows = [
         f"| {key} | "
-        + " | ".join(f"{LOOK_RANGES[f][key][0]:g}–{LOOK_RANGES[f][key][1]:g}" for f in FAMILIES)
+        + " | ".join(f"{LOOK_RANGES[f][key][0]:g} to {LOOK_RANGES[f][key][1]:g}" for f in FAMILIES)
         + " |"
         for key in _COMMON
     ]
