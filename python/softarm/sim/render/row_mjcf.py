@@ -19,11 +19,22 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import numpy.typing as npt
+from scipy.spatial import ConvexHull
 
 from softarm.checks import FloatArray
 from softarm.sim.render import mjcf
 from softarm.sim.render.look import _mix
-from softarm.sim.render.row import GROUND_Z, POSTS_X, ROW_HALF, ROW_Y, WIRES_Z, Row, RowFruit
+from softarm.sim.render.row import (
+    GROUND_Z,
+    POSTS_X,
+    ROW_FRUIT_ID,
+    ROW_HALF,
+    ROW_Y,
+    WIRES_Z,
+    Row,
+    RowFruit,
+)
 from softarm.sim.render.row_look import RowLook
 from softarm.vision.cube import FACE_PER_MARKER
 
@@ -61,7 +72,7 @@ def row_scene_xml(spec: mjcf.SceneSpec, row: Row, shadows: bool) -> tuple[str, d
         _next_row(look, rng),
         *(mjcf._cane(i, b.points(24), look) for i, b in enumerate(spec.bush.branches)),
         *(
-            mjcf._cane(n_bush + i, b.points(ROW_CANE_SEGMENTS + 1), look)
+            _row_cane(n_bush + i, b.points(ROW_CANE_SEGMENTS + 1), look)
             for i, b in enumerate(row.canes)
         ),
         *(_fruit(f, look, rng) for f in row.fruit),
@@ -79,6 +90,12 @@ def row_scene_xml(spec: mjcf.SceneSpec, row: Row, shadows: bool) -> tuple[str, d
     sides = {spec.cube_marker, spec.tag_length}
     meshes = "".join(mjcf._quad_mesh(FACE_PER_MARKER * m) for m in sides)
     meshes += _fruit_meshes() + _leaf_meshes()
+    meshes += "".join(
+        _tube_mesh(
+            f"canetube{n_bush + i}", b.points(ROW_CANE_SEGMENTS + 1), _cane_radius(n_bush + i)
+        )
+        for i, b in enumerate(row.canes)
+    )
     return _head(spec, look, meshes, shadows) + "".join(parts) + "</worldbody></mujoco>", assets
 
 
@@ -206,7 +223,8 @@ def _fruit(fruit: RowFruit, look: RowLook, rng: np.random.Generator) -> str:
     else:
         red = _mix(rng, [0.55, 0.06, 0.08], [0.38, 0.04, 0.08])
         colours, material = [look.ripe_shade(rng), red], f"ripe{int(rng.integers(3))}"
-    meshes = [f"fruit{b}"] if len(colours) == 1 else [f"fruit{b}_low", f"fruit{b}_high"]
+    mesh = f"fruit{b}" if tag < ROW_FRUIT_ID else f"fruitc{b}"
+    meshes = [mesh] if len(colours) == 1 else [f"{mesh}_low", f"{mesh}_high"]
     out = [
         f'<body name="berry{tag}" pos="{mjcf._v(fruit.position)}">'
         f'<geom name="berry{tag}_0" type="ellipsoid" size="{mjcf._v(half * 0.9)}" '
@@ -223,11 +241,30 @@ def _fruit(fruit: RowFruit, look: RowLook, rng: np.random.Generator) -> str:
     return "".join(out)
 
 
+def _coarse_sphere() -> tuple[FloatArray, npt.NDArray[np.int64]]:
+    """The unit icosahedron (12 vertices, 20 faces outward): the row's own fruit's
+    drupelets, a few pixels each in C1."""
+    vertices = mjcf.ICOSPHERE[0][:12]  # the subdivided sphere keeps them first
+    faces = ConvexHull(vertices).simplices
+    normals = np.cross(
+        vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]]
+    )
+    inward = np.einsum("ij,ij->i", normals, vertices[faces].mean(axis=1)) < 0
+    faces[inward] = faces[inward][:, ::-1]
+    return vertices, faces.astype(np.int64)
+
+
 def _fruit_meshes() -> str:
     """Each size bin's drupelets: all of them, and split into the part below and above
-    the fruit's middle (turning fruit)."""
+    the fruit's middle (turning fruit); 80-face drupelets for the bush's berries (C2
+    sees them from a few centimetres), 20-face ones for the row's (``fruitc``): the
+    row's 30-70 fruit were most of its triangles, drawn twice with the shadow map."""
+    return _drupelet_meshes("fruit", mjcf.ICOSPHERE) + _drupelet_meshes("fruitc", _coarse_sphere())
+
+
+def _drupelet_meshes(prefix: str, sphere: tuple[FloatArray, npt.NDArray[np.int64]]) -> str:
     out = []
-    vertices, faces = mjcf.ICOSPHERE
+    vertices, faces = sphere
     golden = np.pi * (3.0 - np.sqrt(5.0))
     for b, scale in enumerate(FRUIT_BINS):
         half = mjcf.BERRY_HALF * scale
@@ -240,9 +277,9 @@ def _fruit_meshes() -> str:
             )
         radius = half[0] * 0.32
         parts = {
-            f"fruit{b}": centres,
-            f"fruit{b}_low": [c for c in centres if c[2] < 0.1 * half[2]],
-            f"fruit{b}_high": [c for c in centres if c[2] >= 0.1 * half[2]],
+            f"{prefix}{b}": centres,
+            f"{prefix}{b}_low": [c for c in centres if c[2] < 0.1 * half[2]],
+            f"{prefix}{b}_high": [c for c in centres if c[2] >= 0.1 * half[2]],
         }
         for name, cs in parts.items():
             verts = np.vstack([vertices * radius + c for c in cs])
@@ -252,6 +289,45 @@ def _fruit_meshes() -> str:
                 f'face="{" ".join(str(i) for i in faces_all.ravel())}"/>'
             )
     return "".join(out)
+
+
+def _cane_radius(index: int) -> float:
+    """A cane's radius, as :func:`softarm.sim.render.mjcf._cane` draws it."""
+    return 0.0025 + 0.0015 * ((index * 7919) % 100) / 100.0
+
+
+def _row_cane(index: int, points: FloatArray, look: RowLook) -> str:
+    """A row cane: its first segment a capsule (``cane{i}_0``, whose radius the dataset
+    reads), the whole cane one six-sided tube mesh (``canetube{i}``): a capsule chain
+    costs the rasteriser a few hundred triangles a segment."""
+    rgba = mjcf._rgba(look.cane_colour * (0.85 + 0.3 * ((index * 31) % 10) / 10))
+    radius = _cane_radius(index)
+    return mjcf._capsule(f"cane{index}_0", points[0], points[1], radius, rgba) + (
+        f'<geom name="cane{index}_1" type="mesh" mesh="canetube{index}" rgba="{rgba}" '
+        f'group="2" contype="0" conaffinity="0"/>'
+    )
+
+
+def _tube_mesh(name: str, points: FloatArray, radius: float, sides: int = 6) -> str:
+    """A tube of ``radius`` along ``points`` (N, 3) as a mesh asset, open at its ends,
+    its faces outward."""
+    tangents = np.gradient(points, axis=0)
+    rings = []
+    for p, t in zip(points, tangents, strict=True):
+        R = mjcf.z_to(t)
+        angles = np.arange(sides) * 2 * np.pi / sides
+        ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(sides)]) * radius
+        rings.append(ring @ R.T + p)
+    verts = np.vstack(rings)
+    faces = []
+    for i in range(len(points) - 1):
+        for k in range(sides):
+            a, b = i * sides + k, i * sides + (k + 1) % sides
+            faces += [(a, b, b + sides), (a, b + sides, a + sides)]
+    return (
+        f'<mesh name="{name}" inertia="shell" vertex="{mjcf._v(verts.ravel())}" '
+        f'face="{" ".join(str(i) for i in np.array(faces).ravel())}"/>'
+    )
 
 
 def leaf_outline(length: float, stations: int = 9) -> tuple[FloatArray, FloatArray]:
