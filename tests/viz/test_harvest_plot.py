@@ -54,7 +54,7 @@ def test_harvest_figure_draws_the_gripper_and_labels_berries(tmp_path, monkeypat
     (fig,) = kept
     scene, zoom = fig.axes[0], fig.axes[1]
     labels = scene.get_legend_handles_labels()[1]
-    for want in ("canes", "gripper at grasp", "arm at grasp", "berry harvested (its tag above)"):
+    for want in ("canes", "gripper at grasp", "arm at grasp", "berry harvested (filled; its tag)"):
         assert want in labels
     tags = {str(b.tag_id) for b in rig.bush.berries}
     for ax in (scene, zoom):

@@ -233,7 +233,11 @@ def run_sim(
     header = sim_header(rig, rig_options, args)
     start_log(rig.machine.log, header)
     # What C1 saw at IDLE, before the arm moved (the rendered bush only).
-    seen = rig.scene.picture() if rig.scene is not None and plot_path is not None else None
+    seen = None
+    if rig.scene is not None and plot_path is not None:
+        from softarm.harvest.c1_picture import c1_picture
+
+        seen = c1_picture(rig.scene, seed)
     viewer = _viewer(rig, view, record)
     try:
         try:
@@ -389,7 +393,11 @@ def _run_hardware(args: argparse.Namespace) -> int:
     # The log is closed; a stop while the outputs are written is recorded in it.
     with records_late_stop(log):
         report.header = log.records[0]
-        print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
+        tol = Tolerance.of(getattr(rig.machine, "config", None))
+        tagged = not getattr(rig, "markerless", False)
+        for i, result in enumerate(report.berries):  # after the run: the lines a sim prints
+            print(line(i, len(report.berries), result, None, tol=tol, tagged=tagged))
+        print(summary(report.to_dict(), tol))
         status = 0 if report.stopped is None and not off_tolerance(report, rig.machine) else 1
         if devices is not None and sent is not None:
             status = max(status, dry_run_verdict(devices, sent, report))
@@ -498,14 +506,15 @@ def line(
     i: int,
     n: int,
     r: Any,
-    wall: float,
+    wall: float | None,
     retry: bool = False,
     tol: Tolerance | None = None,
     *,
     tagged: bool = True,
 ) -> str:
     """One line per berry: its outcome, its position and orientation errors (flagged
-    when outside ``tol``), and its own simulated and wall time. A berry is named by its
+    when outside ``tol``), and its own simulated and wall time (``wall`` None: on the
+    arm or in a dry run, the run's own time alone). A berry is named by its
     tag, or (not ``tagged``: the rendered bush) by its number in the bush map, the
     number of the C1 picture."""
     d = r.to_dict()
@@ -517,10 +526,9 @@ def line(
     tag += ", retry" if retry else ""
     why = outside(d, tol or Tolerance()) if d["harvested"] else []
     flag = f"  OUTSIDE TOLERANCE ({', '.join(why)})" if why else ""
-    return (
-        f"berry {i + 1}/{n} ({tag}): {what:<16} error {pos_s:>9}, {ang_s:>8}  "
-        f"took {d['duration_s']:.1f} s simulated, {wall:.1f} s wall{flag}"
-    )
+    took = f"took {d['duration_s']:.1f} s"
+    took += f" simulated, {wall:.1f} s wall" if wall is not None else ""
+    return f"berry {i + 1}/{n} ({tag}): {what:<16} error {pos_s:>9}, {ang_s:>8}  {took}{flag}"
 
 
 def summary(d: dict[str, Any], tol: Tolerance | None = None) -> str:
@@ -532,6 +540,9 @@ def summary(d: dict[str, Any], tol: Tolerance | None = None) -> str:
     pos = [p for p, _ in errs if p is not None]
     ang = [a for _, a in errs if a is not None]
     mean = f"{sum(pos) / len(pos):.2f} mm" if pos else "-"
+    # The simulation knows the true errors; the arm and a dry run, the cameras' alone.
+    true = any(b.get("true_position_error_mm") is not None for b in harvested)
+    source = "(true, from the simulation)" if true else "(as the cameras measured it)"
     mean_ang = f"{sum(ang) / len(ang):.1f} deg" if ang else "-"
     extra = ""
     off = sum(1 for b in harvested if outside(b, tol))
@@ -549,5 +560,5 @@ def summary(d: dict[str, Any], tol: Tolerance | None = None) -> str:
             extra += f", {plural(d['unripe_left'], 'unripe berry')} left on the bush"
     return (
         f"harvested {d['harvested']}/{d['attempted']} ({100 * d['success_rate']:.0f} %), "
-        f"mean fine-positioning error {mean}, {mean_ang}{extra}"
+        f"mean fine-positioning error {mean}, {mean_ang} {source}{extra}"
     )

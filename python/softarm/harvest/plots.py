@@ -1,6 +1,9 @@
 """Plots of a simulated harvest: the gripper's path and the arm and gripper at each grasp
 among the berries and canes, and the position and orientation errors against time per
-berry. Each berry has one colour in every panel (its tag written beside it)."""
+berry. Each berry has one colour in every panel and is named as on the console: by its
+tag in the tag world, by its number in the bush map (the C1 picture's) in the rendered
+bush. Filled: harvested; hollow: not; a green diamond: unripe; the dotted lines are the
+tolerances a grasp must meet."""
 
 from __future__ import annotations
 
@@ -16,28 +19,55 @@ from softarm.harvest.sim_rig import SimRig
 from softarm.viz.arm import arm_line, clip_to_box
 from softarm.viz.gripper import gripper_polylines
 
-__all__ = ["berry_colours", "berry_paths", "plot_errors", "plot_run", "plot_scene"]
+__all__ = ["berry_colours", "berry_paths", "plot_errors", "plot_run", "plot_scene", "run_ids"]
+
+#: The colour of what is drawn for an unripe berry, and of a berry the run never named.
+UNRIPE, UNNAMED = "yellowgreen", "0.45"
 
 
 def berry_colours(tags: list[int]) -> dict[int, str]:
-    """One matplotlib colour per berry tag, in the bush's order (the same in every panel)."""
+    """One matplotlib colour per berry id (a tag, or a bush-map number), in the run's
+    order (the same in every panel)."""
     return {tag: f"C{k % 10}" for k, tag in enumerate(tags)}
+
+
+def run_ids(rig: SimRig, report: HarvestReport) -> dict[int, int]:
+    """Each true berry's id as the run named it (the log, the report, the console): its
+    tag in the tag world; in the rendered bush, the number of the bush-map entry that
+    stood for it (a berry the map never placed is left out)."""
+    if rig.scene is None:
+        return {b.tag_id: b.tag_id for b in rig.bush.berries}
+    ids: dict[int, int] = {}
+    for result in report.berries:
+        true = rig.scene.truth_of(result.tag_id)
+        if true is not None:
+            ids.setdefault(true.tag_id, result.tag_id)
+    return ids
+
+
+def _tolerance(rig: SimRig) -> tuple[float, float]:
+    """The grasp tolerance of the rig's ``[harvest]``: position (mm), pointing (deg)."""
+    config = rig.machine.config
+    return 1e3 * config.fine_tolerance, config.angle_tolerance_deg
 
 
 def plot_run(rig: SimRig, report: HarvestReport, path: str | Path) -> None:
     """The scene (whole, and zoomed on the berries) and the errors in one image."""
     import matplotlib.pyplot as plt
 
-    colours = berry_colours([b.tag_id for b in rig.bush.berries])
+    colours = berry_colours([b.tag_id for b in report.berries])
     fig = plt.figure(figsize=(19, 6.8))
     grid = fig.add_gridspec(2, 3, width_ratios=(1.0, 1.0, 1.25))
-    plot_scene(fig.add_subplot(grid[:, 0], projection="3d"), rig, report, colours)
+    scene = fig.add_subplot(grid[:, 0], projection="3d")
+    plot_scene(scene, rig, report, colours)
     ax_z = fig.add_subplot(grid[:, 1], projection="3d")
     plot_scene(ax_z, rig, report, colours, zoom=True)
     ax_p = fig.add_subplot(grid[0, 2])
     ax_o = fig.add_subplot(grid[1, 2], sharex=ax_p)
-    plot_errors(ax_p, ax_o, rig.machine.log.records, colours)
-    fig.tight_layout()
+    plot_errors(ax_p, ax_o, rig.machine.log.records, colours, _tolerance(rig), _named(rig, report))
+    fig.legend(*scene.get_legend_handles_labels(), loc="lower left", ncol=4, fontsize=7,
+               frameon=False)  # fmt: skip
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # outputs create their folders
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -147,25 +177,64 @@ def plot_scene(
         for j, part in enumerate(gripper_polylines(np.asarray(arm.forward(q)), offset)):
             line(part, color=colour, lw=2.5 if zoom else 1.5,
                  label="gripper at grasp" if k == 0 and j == 0 else None)  # fmt: skip
-    done = {b.tag_id for b in report.berries if b.harvested}
+    ids, picked = run_ids(rig, report), set(rig.gripper.delivered)
+    prefix = "" if rig.scene is None else "#"
     for b in rig.bush.berries:
-        c = colours[b.tag_id]
-        ax.scatter(*b.position, s=45 if zoom else 50, depthshade=False, alpha=0.85, edgecolor=c,
-                   linewidth=1.5, facecolor=c if b.tag_id in done else "none")  # fmt: skip
-        lift = 0.06 * (hi[2] - lo[2])
-        ax.text(*np.add(b.position, (0.0, 0.0, lift)), str(b.tag_id), color=c,
-                fontsize=9 if zoom else 8, ha="center", weight="bold")  # fmt: skip
+        _berry(ax, b, ids.get(b.tag_id), colours, b.tag_id in picked, prefix, zoom, hi[2] - lo[2])
     ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), zlim=(lo[2], hi[2]))
     ax.set(xlabel="x (m)", ylabel="y (m)")
     ax.set_zlabel("z (m)")
     ax.set_box_aspect((1, 1, 1))
+    named = "tag" if rig.scene is None else "bush-map number, as on the console"
     if zoom:
-        ax.set_title("around the berries (tags above, same colours as the errors)")
+        ax.set_title("around the berries (colours as in the errors)")
         return
-    ax.scatter([], [], s=40, color="0.3", label="berry harvested (its tag above)")
+    _legend(ax, named, rig.scene is not None)
+    unripe = sum(b.ripeness < 0.5 and b.tag_id not in picked for b in rig.bush.berries)
+    left = f", {unripe} unripe left" if unripe else ""
+    ax.set_title(f"seed {rig.bush.seed}: {report.harvested}/{report.attempted} harvested{left}")
+
+
+def _berry(
+    ax: Any, b: Any, run_id: int | None, colours: dict[int, str], picked: bool,
+    prefix: str, zoom: bool, height: float,
+) -> None:  # fmt: skip
+    """One true berry: a circle in its run colour (filled once picked), a green diamond
+    if unripe, grey if the run never named it; its run name above."""
+    unripe = b.ripeness < 0.5
+    c = UNRIPE if unripe else colours.get(run_id, UNNAMED) if run_id is not None else UNNAMED
+    ax.scatter(*b.position, s=45 if zoom else 50, depthshade=False, alpha=0.9, edgecolor=c,
+               linewidth=1.5, facecolor=c if picked else "none",
+               marker="D" if unripe else "o")  # fmt: skip
+    text = "?" if run_id is None else f"{prefix}{run_id}"
+    if unripe:
+        text = "unripe" if run_id is None else f"{text} unripe"
+    ax.text(*np.add(b.position, (0.0, 0.0, 0.06 * height)), text, color=c,
+            fontsize=9 if zoom else 8, ha="center", weight="bold")  # fmt: skip
+
+
+def _legend(ax: Any, named: str, bush: bool) -> None:
+    """The berries' markers, for the scene's legend (the lines are labelled as drawn)."""
+    ax.scatter([], [], s=40, color="0.3", label=f"berry harvested (filled; its {named})")
     ax.scatter([], [], s=40, facecolor="none", edgecolor="0.3", label="berry not harvested")
-    ax.legend(loc="upper left", fontsize=7, framealpha=0.85)
-    ax.set_title(f"seed {rig.bush.seed}: {len(done)}/{len(report.berries)} harvested")
+    ax.scatter([], [], s=40, marker="D", facecolor="none", edgecolor=UNRIPE, label="unripe berry")
+    if bush:
+        ax.scatter([], [], s=40, facecolor="none", edgecolor=UNNAMED,
+                   label="ripe berry the map never placed (?)")  # fmt: skip
+    # Drawn by plot_run under the figure, not over the box.
+
+
+def _named(rig: SimRig, report: HarvestReport) -> dict[int, str]:
+    """Each berry of the run (by its id in the log) as the errors' legend names it: as
+    on the console, flagged when harvested outside tolerance."""
+    pos_mm, ang_deg = _tolerance(rig)
+    names = {}
+    for r in report.berries:
+        name = f"tag {r.tag_id}" if rig.scene is None else f"#{r.tag_id}"
+        pos, ang = r.true_position_error_mm, r.true_orientation_error_deg
+        off = (pos is not None and pos > pos_mm) or (ang is not None and ang > ang_deg)
+        names[r.tag_id] = f"{name} OUTSIDE TOLERANCE" if r.harvested and off else name
+    return names
 
 
 def _cube(lo: Any, hi: Any | None = None) -> tuple[FloatArray, FloatArray]:
@@ -183,9 +252,12 @@ def plot_errors(
     ax_o: Any,
     records: list[dict[str, Any]],
     colours: dict[int, str] | None = None,
+    tolerance: tuple[float, float] | None = None,
+    names: dict[int, str] | None = None,
 ) -> None:
     """Position error (mm, log scale) and pointing error (deg) against time from each
-    berry's start, in placement and fine positioning (as the cameras measured them)."""
+    berry's start, in placement and fine positioning (as the cameras measured them);
+    ``tolerance`` (mm, deg) drawn as dotted lines, ``names``: each berry's legend."""
     berries: dict[int, list[dict[str, Any]]] = {}
     for r in records:
         if r["kind"] == "step" and r["position_error_m"] is not None:
@@ -197,7 +269,8 @@ def plot_errors(
         for stage, style in (("initial_placement", "--"), ("fine_positioning", "-")):
             part = [s for s in steps if s["state"] == stage]
             t = [s["t"] - t0 for s in part]
-            label = f"tag {tag}" if stage == "fine_positioning" else None
+            name = (names or {}).get(tag, f"tag {tag}")
+            label = name if stage == "fine_positioning" else None
             ax_p.semilogy(
                 t,
                 [1e3 * s["position_error_m"] for s in part],
@@ -209,11 +282,18 @@ def plot_errors(
             ax_o.plot(
                 t, [np.degrees(s["orientation_error_rad"]) for s in part], style, color=colour
             )
-    ax_p.axhline(1.0, color="k", ls=":", lw=0.8)
+    if tolerance is not None:
+        ax_p.axhline(tolerance[0], color="k", ls=":", lw=0.9,
+                     label=f"tolerance {tolerance[0]:g} mm")  # fmt: skip
+        ax_o.axhline(tolerance[1], color="k", ls=":", lw=0.9)
+        ax_o.text(0.99, tolerance[1], f"tolerance {tolerance[1]:g} deg", ha="right",
+                  va="bottom", fontsize=7, transform=ax_o.get_yaxis_transform())  # fmt: skip
     ax_p.set(
-        ylabel="position error (mm)",
+        ylabel="position error (mm, measured)",
         title="closed loop: placement (dashed, to the pre-grasp point), fine positioning (solid)",
     )
-    ax_o.set(xlabel="time from the first closed-loop step (s)", ylabel="pointing error (deg)")
+    ax_o.set(
+        xlabel="time from the first closed-loop step (s)", ylabel="pointing error (deg, measured)"
+    )
     if berries:
         ax_p.legend(fontsize=7, ncol=2)
