@@ -4,6 +4,7 @@ filtering and two-camera fusion (paper sections II-C and III-D, eq. 21–22)."""
 from softarm.vision.base_registration import BaseRegistration
 from softarm.vision.baseline import OpenCVBaseline
 from softarm.vision.calibration import calibrate_charuco, calibrate_chessboard
+from softarm.vision.calibration_checks import CalibrationNotConverged
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 from softarm.vision.cube import CubePose, CubeTracker, MarkerCube
@@ -23,6 +24,7 @@ from softarm.vision.two_cameras import CameraVision, register_c1
 
 __all__ = [
     "BaseRegistration",
+    "CalibrationNotConverged",
     "CameraFusion",
     "CameraModel",
     "CameraVision",
