@@ -107,6 +107,8 @@ def test_an_implausible_pair_is_one_line(
          "M1 holds a value that is not finite"),
         (lambda t: "", "is empty"),
         (lambda t: "\n  \n", "is empty"),
+        (lambda t: "\x00\x01 junk", "holds a NUL byte"),
+        (lambda t: "a: [[[", "cannot parse stereo file .*Missing , between"),
         (lambda t: re.sub(r"image_width: \d+\n", "", t), "image_width"),
         (lambda t: re.sub(r"(T_left_right:\s*!!opencv-matrix\s*rows: )4", r"\g<1>3", t),
          "T_left_right"),

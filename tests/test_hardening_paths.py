@@ -195,6 +195,9 @@ def test_an_image_is_refused_by_its_header(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setattr(cv2, "imdecode", lambda *a: pytest.fail("decoded"))
     with pytest.raises(ConfigError, match="20000 x 20000 pixels"):
         decode_image(bytes(big), "frame", error=ConfigError)
+    big[16:24] = struct.pack(">II", 0, 0)  # libpng would print warnings of its own
+    with pytest.raises(InputError, match="header says 0 x 0 pixels"):
+        decode_image(bytes(big), "frame")
 
 
 def test_a_special_or_unwritable_image_path_is_one_line(tmp_path: Path) -> None:

@@ -132,15 +132,22 @@ def decode_image(
     if header is None:
         raise error(f"cannot read {name}: not a PNG, JPEG, BMP or TIFF image")
     w, h, per_pixel = header
+    if w == 0 or h == 0:  # refused here: libpng would print its own warnings
+        raise error(f"cannot read {name}: its header says {w} x {h} pixels")
     if w * h > max_pixels or w * h * per_pixel > MAX_DECODED_BYTES:
         raise error(
             f"cannot read {name}: {w} x {h} pixels of {per_pixel} bytes is larger than an image "
             f"may be ({max_pixels} pixels, {MAX_DECODED_BYTES} bytes)"
         )
+    log = cv2.utils.logging
+    level = log.getLogLevel()
+    log.setLogLevel(log.LOG_LEVEL_SILENT)  # a broken file is our one line, not OpenCV's
     try:
         image = cv2.imdecode(np.frombuffer(data, dtype=np.uint8), flags)
     except cv2.error:
         image = None
+    finally:
+        log.setLogLevel(level)
     if image is None or image.size == 0:
         raise error(f"cannot read {name}: it does not decode as an image")
     return image

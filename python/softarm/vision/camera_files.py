@@ -163,13 +163,19 @@ def _ros_matrix(name: str, mat: np.ndarray) -> list[str]:
 
 
 def _open(path: str | Path, body: str, what: str = "camera file") -> Any:
-    if not body.strip():  # OpenCV's own error for it is an opaque SystemError
+    # OpenCV's own errors for these are opaque (a SystemError, an assertion on "buf").
+    if not body.strip():
         raise ConfigError(f"{what} {str(path)!r} is empty")
+    if "\0" in body:
+        raise ConfigError(f"{what} {str(path)!r} holds a NUL byte: it is not a text file")
     try:  # the text itself, never a path: OpenCV takes a path as a C string
         fs = cv2.FileStorage(body, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
-    except (cv2.error, SystemError) as exc:  # some parse errors surface as SystemError
-        msg = str(exc).strip().splitlines()[-1] if str(exc).strip() else type(exc).__name__
-        raise ConfigError(f"cannot parse {what} {str(path)!r}: {msg}") from None
+    except (cv2.error, SystemError) as exc:
+        # A parse error surfaces as a SystemError whose cause is the cv2.error.
+        cause = exc.__cause__ if isinstance(exc.__cause__, cv2.error) else exc
+        text = " ".join(str(cause).split()).partition(" error: ")[2].partition(") ")[2]
+        why = text.replace(" in function ", ": ")[:200] or type(exc).__name__
+        raise ConfigError(f"cannot parse {what} {str(path)!r}: {why}") from None
     if not fs.isOpened():
         raise ConfigError(f"cannot parse {what} {str(path)!r}")
     return fs

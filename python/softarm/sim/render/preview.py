@@ -57,11 +57,13 @@ def write_previews(out: str | Path) -> int:
     ``depth/`` and ``instances/``; the number of previews written."""
     import cv2
 
+    from softarm.files.images import read_image
+
     root = Path(out)
     written = 0
     for folder, draw in zip(FOLDERS, (depth_preview, instance_preview), strict=True):
         for source in sorted((root / folder).glob("*.png")):
-            image = cv2.imread(str(source), cv2.IMREAD_UNCHANGED)
+            image = read_image(source, "dataset image")  # bytes to OpenCV, not the path
             if image is None or image.dtype != np.uint16 or image.ndim != 2:
                 raise InputError(f"{source}: not a 16-bit single-channel PNG")
             ok, png = cv2.imencode(".png", draw(np.asarray(image, np.uint16)))
