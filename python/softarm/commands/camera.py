@@ -10,9 +10,10 @@ side-by-side frames, the ZED2 over USB video; ``--right``: a second camera's ima
 with the first's in name order) writes ``left.yml``, ``right.yml`` (OpenCV),
 ``left.yaml``, ``right.yaml`` (ROS, rectified) and ``stereo.yml`` (both eyes and
 ``T_left_right``). Exit status 0; 1 when the calibration is not converged (its data
-fails a check of :mod:`softarm.vision.calibration_checks`: too few distinct or tilted
-views, an RMS above 2 px, an implausible baseline, swapped eyes), each problem told and
-no file written; 2 with one line naming the bad argument or file.
+fails a check of :mod:`softarm.vision.calibration_checks`: views not tilted enough,
+uncertain intrinsics, an RMS above 2 px, an implausible baseline, swapped eyes), each
+problem told and no file written; 2 with one line naming the bad argument or file (fewer
+than 3 distinct views, one image given for both eyes).
 
 Each image is read when it is used and not kept (only its corners are), through
 :func:`softarm.files.images.read_image`: an image of more than 20 M pixels is refused
