@@ -92,10 +92,19 @@ def test_a_lagging_arm_does_not_cut_across_a_cane_on_its_way_to_the_first_berry(
     # correction piled up while the arm trailed a whole lag behind, and the arm cut
     # across from where it was to where the command had gone. The transport now holds a
     # command whose way from the lag model's arm is not clear (`transport_held`).
-    rig, report, kinds = _on_a_slow_plant(tmp_path, n_berries=8, seed=504)
+    # A reproduction on the diagnosis seed it was traced on: the mechanism, not the
+    # accuracy (that is judged on a fresh bush below).
+    rig, _, kinds = _on_a_slow_plant(tmp_path, n_berries=8, seed=504)
+    assert rig.watch.contacts == 0 and rig.watch.min_gap > 0.0
+    assert "transport_held" in kinds
+
+
+def test_a_lagging_arm_harvests_a_fresh_bush_without_touching_a_cane(tmp_path) -> None:
+    # The same 1 s / 5 psi plant, uncalibrated, on a bush from the seeds reserved for CI
+    # (docs/architecture.md, "Seeds"): no cane touched, at most one berry of 8 missed.
+    rig, report, _ = _on_a_slow_plant(tmp_path, n_berries=8, seed=90020)
     assert rig.watch.contacts == 0 and rig.watch.min_gap > 0.0
     assert report.success_rate >= 7 / 8
-    assert "transport_held" in kinds
 
 
 def _on_a_slow_plant(tmp_path, n_berries: int, seed: int):  # type: ignore[no-untyped-def]
