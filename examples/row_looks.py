@@ -89,7 +89,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--repeats", type=int, default=5, help="renders per cost figure")
     parser.add_argument("--no-cost", action="store_true", help="pictures only")
     parser.add_argument(
-        "--width", type=int, default=960, help="pictures scaled down to this width (px)"
+        "--width", type=int, default=640, help="pictures scaled down to this width (px)"
     )
     args = parser.parse_args(argv)
     cams = default_cameras()

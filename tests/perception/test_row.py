@@ -237,3 +237,8 @@ def test_culled_renders_keep_the_shadows_of_what_is_out_of_the_picture(row: Any)
             )
     finally:
         full.close()
+
+
+def test_the_docs_print_the_looks_table() -> None:
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "perception.md").read_text()
+    assert look_table() in docs, "docs/perception.md's looks table is stale"
