@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from softarm._core import Gains
+from softarm.config_table import TomlTable, resolve
 from softarm.errors import ConfigError, ParameterError
 from softarm.files import parse_toml, read_text, write_text
 from softarm.hardware.camera import source_problem
@@ -36,7 +37,6 @@ from softarm.hardware.limits import (
     SERIAL_TIMEOUT_S,
     STARTUP_DELAY_S,
     WATCHDOG_TIMEOUT_S,
-    Limit,
 )
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
@@ -119,12 +119,6 @@ class CameraConfig:
         if isinstance(self.source, int) or "://" in self.source or "!" in self.source:
             return self.source
         return resolve(self.source, self.folder)
-
-
-def resolve(path: str, folder: str | Path | None) -> str:
-    """``path`` as written in a config file, resolved against the file's ``folder`` (an
-    absolute path, or no folder, leaves it as it is)."""
-    return path if folder is None else str(Path(folder) / path)
 
 
 @dataclass(frozen=True)
@@ -215,7 +209,7 @@ def load_config(path: str | Path) -> Config:
 def parse_config(text: str, source: str = "<string>", folder: str | Path | None = None) -> Config:
     """Validate TOML text (see :func:`load_config`); the paths it names resolve against
     ``folder`` (None: as written, against the working directory)."""
-    root = _Table(parse_toml(text, source), "", source)
+    root = TomlTable(parse_toml(text, source), "", source)
     root.folder = None if folder is None else str(folder)
     return _build(root)
 
@@ -234,63 +228,7 @@ def save_config(config: Config, path: str | Path) -> None:
 # --- validation -------------------------------------------------------------------------
 
 
-class _Table:
-    """A TOML table plus its key path, so every error can name ``a.b[2].c``."""
-
-    def __init__(self, data: dict[str, Any], path: str, source: str) -> None:
-        self.data, self.path, self.source = data, path, source
-        self.used: set[str] = set()
-        self.folder: str | None = None
-
-    def key(self, name: str) -> str:
-        return f"{self.path}.{name}" if self.path else name
-
-    def error(self, name: str, message: str) -> ConfigError:
-        value = self.data.get(name, "<missing>")
-        return ConfigError(f"{self.source}: {self.key(name)} {message}, got {value!r}")
-
-    def get(self, name: str, default: Any = ...) -> Any:
-        self.used.add(name)
-        if name not in self.data:
-            if default is ...:
-                raise ConfigError(f"{self.source}: {self.key(name)} is required but missing")
-            return default
-        return self.data[name]
-
-    def number(
-        self, name: str, default: Any = ..., *, lo: float = -math.inf, positive: bool = False
-    ) -> float:
-        value = self.get(name, default)
-        if not (
-            isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-        ):
-            raise self.error(name, "must be a finite number")
-        if value < lo or (positive and value <= 0.0):
-            raise self.error(name, "must be > 0" if positive else f"must be >= {lo}")
-        return float(value)
-
-    def within(self, name: str, value: Any, limit: Limit) -> Any:
-        """``value`` if it lies in a safety setting's range (``softarm.hardware.limits``,
-        the same check the drivers make), else a ConfigError saying the range and why."""
-        if not limit.contains(value):
-            raise self.error(name, limit.describe())
-        return value
-
-    def table(self, name: str, required: bool = False) -> _Table:
-        value = self.get(name, ... if required else {})
-        if not isinstance(value, dict):
-            raise self.error(name, "must be a table")
-        child = _Table(value, self.key(name), self.source)
-        child.folder = self.folder
-        return child
-
-    def done(self) -> None:
-        unknown = sorted(set(self.data) - self.used)
-        if unknown:
-            raise ConfigError(f"{self.source}: unknown key {self.key(unknown[0])!r}")
-
-
-def _section(t: _Table) -> SectionConfig:
+def _section(t: TomlTable) -> SectionConfig:
     s = SectionConfig(
         radius=t.number("radius", positive=True),
         rest_length=t.number("rest_length", positive=True),
@@ -305,7 +243,7 @@ def _section(t: _Table) -> SectionConfig:
     return s
 
 
-def _matrix(t: _Table, name: str, rows: int, cols: int | None = None) -> Any:
+def _matrix(t: TomlTable, name: str, rows: int, cols: int | None = None) -> Any:
     value = t.get(name, None)
     if value is None:
         return None
@@ -325,7 +263,7 @@ def _matrix(t: _Table, name: str, rows: int, cols: int | None = None) -> Any:
     return tuple(tuple(float(x) for x in r) for r in value)
 
 
-def _pose(t: _Table, name: str) -> Matrix | None:
+def _pose(t: TomlTable, name: str) -> Matrix | None:
     m: Matrix | None = _matrix(t, name, 4, 4)
     if m is None:
         return None
@@ -347,7 +285,7 @@ def _pose(t: _Table, name: str) -> Matrix | None:
     return m
 
 
-def _camera(t: _Table, default_source: int) -> CameraConfig:
+def _camera(t: TomlTable, default_source: int) -> CameraConfig:
     source = t.get("source", default_source)
     if source_problem(source) is not None:
         raise t.error("source", str(source_problem(source)))
@@ -366,7 +304,7 @@ def _camera(t: _Table, default_source: int) -> CameraConfig:
     return cam
 
 
-def _build(root: _Table) -> Config:
+def _build(root: TomlTable) -> Config:
     """The whole configuration, one table after the other in a fixed order (the first
     bad key in that order is the one reported); the channels are checked against the
     arm's elongation ranges, so they come after it."""
@@ -382,19 +320,21 @@ def _build(root: _Table) -> Config:
     return Config(arm, gains, calibration, channels, serial, plant_model, harvest, perception)
 
 
-def _arm(t: _Table) -> ArmConfig:
+def _arm(t: TomlTable) -> ArmConfig:
     """``[arm]``: its ``sections``, a non-empty array of tables, each named by its index
     in the errors (``arm.sections[1].radius``)."""
     raw = t.get("sections")
     if not isinstance(raw, list) or not raw or not all(isinstance(s, dict) for s in raw):
         raise t.error("sections", "must be a non-empty array of tables")
     key = t.key("sections")
-    arm = ArmConfig(tuple(_section(_Table(s, f"{key}[{i}]", t.source)) for i, s in enumerate(raw)))
+    arm = ArmConfig(
+        tuple(_section(TomlTable(s, f"{key}[{i}]", t.source)) for i, s in enumerate(raw))
+    )
     t.done()
     return arm
 
 
-def _calibration(t: _Table) -> CalibrationConfig:
+def _calibration(t: TomlTable) -> CalibrationConfig:
     """``[calibration]``: the two cameras, the hand-eye poses, the cube mount and the
     berry tag's size; a key not given keeps the default of :class:`CalibrationConfig`."""
     c1_t, c2_t = t.table("c1"), t.table("c2")
@@ -412,7 +352,7 @@ def _calibration(t: _Table) -> CalibrationConfig:
     return calibration
 
 
-def _channel_names(t: _Table, d: ChannelsConfig, arm: ArmConfig) -> tuple[str, ...]:
+def _channel_names(t: TomlTable, d: ChannelsConfig, arm: ArmConfig) -> tuple[str, ...]:
     """``channels.names``: distinct strings, three per section of ``arm``."""
     names = t.get("names", list(d.names))
     if not isinstance(names, list) or not all(isinstance(n, str) and n for n in names):
@@ -424,7 +364,7 @@ def _channel_names(t: _Table, d: ChannelsConfig, arm: ArmConfig) -> tuple[str, .
     return tuple(names)
 
 
-def _channels(t: _Table, arm: ArmConfig) -> ChannelsConfig:
+def _channels(t: TomlTable, arm: ArmConfig) -> ChannelsConfig:
     """``[channels]``: the analog outputs and the pressure map, each safety setting inside
     the range the drivers accept (``softarm.hardware.limits``), and every section's
     elongation range within what ``p_max`` can produce."""
@@ -468,7 +408,7 @@ def _channels(t: _Table, arm: ArmConfig) -> ChannelsConfig:
     return channels
 
 
-def _serial(t: _Table) -> SerialConfig:
+def _serial(t: TomlTable) -> SerialConfig:
     """``[serial]``: the Arduino's port and link settings, each inside the range the
     driver accepts."""
     d = SerialConfig()
@@ -495,7 +435,7 @@ def _serial(t: _Table) -> SerialConfig:
     return serial
 
 
-def _harvest(t: _Table) -> HarvestConfig:
+def _harvest(t: TomlTable) -> HarvestConfig:
     """``[harvest]``: fields of :class:`HarvestConfig`, each checked on its own so that
     the error names ``harvest.<key>``; the keys not given keep their defaults."""
     defaults = HarvestConfig()
@@ -529,7 +469,7 @@ def _harvest(t: _Table) -> HarvestConfig:
 GAIN_KEYS: tuple[str, ...] = tuple(Gains().as_dict())
 
 
-def _gains(t: _Table) -> dict[str, Any]:
+def _gains(t: TomlTable) -> dict[str, Any]:
     """``[gains]``: each key a ``softarm.Gains`` keyword whose value the resolver takes,
     checked here so that the error names ``gains.<key>`` (not only when a rig is built)."""
     for name, value in t.data.items():
@@ -556,7 +496,7 @@ def _gains(t: _Table) -> dict[str, Any]:
     return dict(t.data)
 
 
-def _plant_model(t: _Table, n_channels: int) -> PlantModelConfig | None:
+def _plant_model(t: TomlTable, n_channels: int) -> PlantModelConfig | None:
     """``[plant_model]``: a file name, or the identified lists checked as ``id.json``."""
     if not t.data:
         return None

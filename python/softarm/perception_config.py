@@ -7,21 +7,22 @@ OpenCV devices (``left``, ``right``). ``calibration`` is a ``stereo.yml`` writte
 ``softarm camera calibrate`` (resolved against the config file's folder); ``berries``
 is ``"markerless"`` (found by perception, the default) or ``"tags"`` (ArUco tags);
 ``survey`` (true by default) takes C2 to pairs of views of the bush before the first
-berry, to complete the canes C1 fits (:mod:`softarm.harvest.cane_survey`).
+berry, to complete the canes C1 fits (:mod:`softarm.harvest.cane_survey`); ``detector``
+is the berry detector, ``"colour"`` (the default), ``"net"`` or ``"net+colour"``
+(:mod:`softarm.perception.detector.choice`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from softarm.config_table import TomlTable, resolve
 from softarm.errors import ConfigError
-
-if TYPE_CHECKING:
-    from softarm.config import _Table
 
 __all__ = [
     "BERRY_MODES",
+    "DETECTORS",
     "STEREO_SOURCES",
     "PerceptionConfig",
     "check_perception",
@@ -32,12 +33,16 @@ __all__ = [
 STEREO_SOURCES = ("zed2", "pair")
 #: How the berries are found: by perception, or by their ArUco tags.
 BERRY_MODES = ("markerless", "tags")
+#: The berry detectors (softarm.perception.detector.choice.DETECTORS, listed here so
+#: that reading a config imports no perception).
+DETECTORS = ("colour", "net", "net+colour")
 
 
 @dataclass(frozen=True)
 class PerceptionConfig:
-    """``[perception]``: the stereo source, its calibration file, the berry mode and
-    whether C2 surveys the canes; ``folder`` is the config file's, which paths resolve against."""
+    """``[perception]``: the stereo source, its calibration file, the berry mode,
+    whether C2 surveys the canes and the berry detector; ``folder`` is the config
+    file's, which paths resolve against."""
 
     stereo: str = "zed2"
     calibration: str = "stereo.yml"
@@ -46,13 +51,12 @@ class PerceptionConfig:
     right: int | str | None = None
     berries: str = "markerless"
     survey: bool = True
+    detector: str = "colour"
     folder: str | None = field(default=None, compare=False, repr=False)
 
     @property
     def calibration_path(self) -> str:
         """The ``stereo.yml``, resolved against the config file's folder."""
-        from softarm.config import resolve
-
         return resolve(self.calibration, self.folder)
 
     def devices(self) -> tuple[int | str, ...]:
@@ -63,14 +67,12 @@ class PerceptionConfig:
 
 
 def _device(source: int | str, folder: str | None) -> int | str:
-    from softarm.config import resolve
-
     if isinstance(source, int) or "://" in source or "!" in source:
         return source
     return resolve(source, folder)
 
 
-def parse_perception(t: _Table) -> PerceptionConfig:
+def parse_perception(t: TomlTable) -> PerceptionConfig:
     """``[perception]`` checked key by key; a key not given takes its default (an empty
     table is the ZED2 on device 0 with ``stereo.yml``, not no table)."""
     stereo = _choice(t, "stereo", STEREO_SOURCES, "zed2")
@@ -90,21 +92,23 @@ def parse_perception(t: _Table) -> PerceptionConfig:
     survey = t.get("survey", True)
     if not isinstance(survey, bool):
         raise t.error("survey", "must be true or false")
+    detector = _choice(t, "detector", DETECTORS, "colour")
     config = PerceptionConfig(
-        stereo, calibration, berries=berries, survey=survey, folder=t.folder, **sources
-    )
+        stereo, calibration, berries=berries, survey=survey, detector=detector,
+        folder=t.folder, **sources,
+    )  # fmt: skip
     t.done()
     return config
 
 
-def _choice(t: _Table, name: str, allowed: tuple[str, ...], default: str) -> str:
+def _choice(t: TomlTable, name: str, allowed: tuple[str, ...], default: str) -> str:
     value: Any = t.get(name, default)
     if value not in allowed:
         raise t.error(name, f"must be one of {', '.join(repr(a) for a in allowed)}")
     return str(value)
 
 
-def _source(t: _Table, name: str, default: int | None) -> int | str:
+def _source(t: TomlTable, name: str, default: int | None) -> int | str:
     from softarm.hardware.camera import source_problem
 
     value: Any = t.get(name, ... if default is None else default)
