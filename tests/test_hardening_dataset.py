@@ -102,13 +102,20 @@ class _FakeRay:
         self.waits = 0
         self.kill_at: int | None = None
         self.raised_inside_wait = False
+        self.kill_in_init = False
+        self._private = SimpleNamespace(
+            utils=SimpleNamespace(set_sigterm_handler=lambda h: signal.signal(signal.SIGTERM, h))
+        )
 
     def is_initialized(self) -> bool:
         return self.initialized
 
     def init(self, **kwargs: Any) -> None:
         self.initialized = True
-        signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(signum))
+        # As ray.init does (through this function), and a stop while it starts.
+        self._private.utils.set_sigterm_handler(lambda signum, frame: sys.exit(signum))
+        if self.kill_in_init:
+            os.kill(os.getpid(), signal.SIGTERM)
 
     def shutdown(self) -> None:
         self.initialized = False
@@ -181,6 +188,25 @@ def test_a_sigterm_while_ray_runs_is_the_commands_stop(tmp_path: Path) -> None:
             on_ray(ray, _fake_render(), tmp_path, 3, range(1, 50), None, 2, lambda: None)
         assert not ray.raised_inside_wait and ray.waits == 3
         assert not ray.initialized  # shut down on the way out
+        assert signal.getsignal(signal.SIGTERM) is ours
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def test_a_sigterm_while_ray_starts_is_the_commands_stop(tmp_path: Path) -> None:
+    """Item 17: Ray's own SIGTERM handler (sys.exit) is not installed; a stop while Ray
+    starts is raised once it has started, and Ray is shut down."""
+
+    def ours(signum: int, frame: Any) -> None:
+        raise Interrupted(signum)
+
+    previous = signal.signal(signal.SIGTERM, ours)
+    try:
+        ray = _FakeRay()
+        ray.kill_in_init = True
+        with pytest.raises(Interrupted):
+            on_ray(ray, _fake_render(), tmp_path, 3, range(1, 50), None, 2, lambda: None)
+        assert ray.waits == 0 and not ray.initialized
         assert signal.getsignal(signal.SIGTERM) is ours
     finally:
         signal.signal(signal.SIGTERM, previous)

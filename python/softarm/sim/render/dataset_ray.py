@@ -7,14 +7,15 @@ Two things a plain ``ray.wait`` loop gets wrong:
   submitted at a time, the next one as each finishes. Submitting every task up front
   makes the driver hold a task record per image (``--images 1000000`` grew it by about
   60 MB/s).
-* ``ray.init`` replaces the driver's SIGTERM handler with one that calls ``sys.exit``,
-  and a SIGTERM then tore Ray down mid-call (exit 134, a C++ stack dump). The handler
-  in place before (``softarm dataset``'s: raise :class:`~softarm.commands._signals.
-  Interrupted`) is put back. An exception raised by a handler inside ``ray.wait``
-  (Ray runs the handlers from its C++ loop) comes out as a ``SystemError``, so while
-  the tasks run a stop is only noted (:class:`_Stops`), ``ray.wait`` wakes every
-  :data:`WAKE_S`, and the stop is handed to that handler between two waits: it unwinds
-  through ``ray.shutdown``.
+* Signals. ``ray.init`` installs SIGTERM handlers that call ``sys.exit`` (and the
+  C++ core worker a failure handler that dumps a stack and aborts: exit 134), and Ray
+  runs Python's handlers from inside its C++ calls, where an exception comes out as a
+  ``SystemError``. So while Ray starts and while the tasks run, SIGINT and SIGTERM are
+  only noted (:class:`_Stops`; Ray's own SIGTERM handlers are not installed, nor the
+  C++ failure handler: ``RAY_DISABLE_FAILURE_SIGNAL_HANDLER``), ``ray.wait`` wakes
+  every :data:`WAKE_S`, and a noted stop is handed to the handler that was in place
+  (``softarm dataset``'s raises :class:`~softarm.commands._signals.Interrupted`)
+  between two calls into Ray: it unwinds through ``ray.shutdown``.
 """
 
 from __future__ import annotations
@@ -43,6 +44,8 @@ Render = Callable[[str, int, int, Any], dict[str, Any]]
 
 def ray_or_none() -> Any:
     """The ``ray`` module, or None where it is not installed."""
+    # Read when Ray is imported: no C++ failure handler takes SIGTERM (see above).
+    os.environ.setdefault("RAY_DISABLE_FAILURE_SIGNAL_HANDLER", "1")
     try:
         import ray
     except ImportError:
@@ -53,30 +56,37 @@ def ray_or_none() -> Any:
 @contextmanager
 def _private_ray(ray: Any, workers: int) -> Iterator[None]:
     """A local Ray of ``workers`` CPUs for the block (one already running is used as it
-    is), the SIGTERM handler it replaced put back."""
+    is); a stop while it starts is raised once it has started, and shuts it down."""
     if ray.is_initialized():
         yield
         return
-    handler = signal.getsignal(signal.SIGTERM)
     try:
-        ray.init(
-            address="local", num_cpus=workers, include_dashboard=False, log_to_driver=False,
-            logging_level=logging.ERROR,
-        )  # fmt: skip
+        with _Stops(), _without_ray_sigterm_handlers(ray):
+            ray.init(
+                address="local", num_cpus=workers, include_dashboard=False,
+                log_to_driver=False, logging_level=logging.ERROR,
+            )  # fmt: skip
+        yield
     finally:
-        _restore_sigterm(handler)
+        if ray.is_initialized():
+            ray.shutdown()
+
+
+@contextmanager
+def _without_ray_sigterm_handlers(ray: Any) -> Iterator[None]:
+    """Inside the block Ray installs no SIGTERM handler of its own (``ray.init`` sets one
+    that calls ``sys.exit`` through ``ray._private.utils.set_sigterm_handler``): the
+    handler in place stays, and ``ray.shutdown`` stops Ray's processes."""
+    utils: Any = getattr(getattr(ray, "_private", None), "utils", None)
+    original = getattr(utils, "set_sigterm_handler", None)
+    if original is None:  # another Ray: its handler is replaced by _Stops' restore
+        yield
+        return
+    utils.set_sigterm_handler = lambda handler: None
     try:
         yield
     finally:
-        ray.shutdown()
-
-
-def _restore_sigterm(handler: Any) -> None:
-    if handler is not None:
-        try:
-            signal.signal(signal.SIGTERM, handler)
-        except ValueError:  # not the main thread: Ray set none either
-            pass
+        utils.set_sigterm_handler = original
 
 
 def on_ray(
