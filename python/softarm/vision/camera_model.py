@@ -17,9 +17,10 @@ y down; the camera frame has z along the optical axis, x right, y down.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import cv2
 import numpy as np
@@ -29,8 +30,20 @@ from softarm.errors import ConfigError, ParameterError, ShapeError
 from softarm.files import read_text, write_text
 from softarm.vision._checks import FloatArray, as_array
 
-if TYPE_CHECKING:
-    from softarm.config import CameraConfig
+
+class CameraIntrinsicsSource(Protocol):
+    """Where a configuration keeps one camera's intrinsics (``softarm.config.CameraConfig``,
+    which sits above vision): a file's resolved path, or an inline matrix and distortion."""
+
+    @property
+    def path(self) -> str | None: ...
+
+    @property
+    def matrix(self) -> Sequence[Sequence[float]] | None: ...
+
+    @property
+    def distortion(self) -> Sequence[float] | None: ...
+
 
 FORMAT = "softarm.camera/1"
 _DIST_LENGTHS = (0, 4, 5, 8, 12, 14)
@@ -222,7 +235,7 @@ class CameraModel:
     __hash__ = None  # type: ignore[assignment]
 
 
-def camera_from_config(cam: CameraConfig, name: str) -> CameraModel:
+def camera_from_config(cam: CameraIntrinsicsSource, name: str) -> CameraModel:
     """The intrinsics of camera ``name`` (``c1``, ``c2``) of a configuration: its
     ``file`` (resolved against the config file's folder), else its inline ``matrix``
     and ``distortion``.
