@@ -203,3 +203,14 @@ def test_a_folder_that_is_not_a_recording_is_refused(tmp_path: Path) -> None:
         FrameRecorder(folder)
     assert (folder / "mine.txt").read_text() == "keep me"
     assert [p.name for p in tmp_path.iterdir()] == ["notes"]
+
+
+def test_the_working_directory_is_not_replaced(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Replacing the folder the process stands in would move it away under it."""
+    folder = tmp_path / "rec"
+    _record(folder)
+    monkeypatch.chdir(folder)
+    with pytest.raises(OutputError, match="holds the working directory"):
+        FrameRecorder(".")

@@ -89,6 +89,12 @@ def _check_replaceable(given: Path, target: Path, what: str, marker: str) -> Non
         return
     if not target.is_dir():
         raise OutputError(f"cannot write {what} {str(given)!r}: it exists and is not a folder")
+    cwd = Path(os.path.realpath(os.getcwd()))
+    if cwd == target or target in cwd.parents:  # it would be moved away under us
+        raise OutputError(
+            f"cannot write {what} {str(given)!r}: it holds the working directory; "
+            "give a folder outside it"
+        )
     with contextlib.suppress(OSError):
         if (target / marker).is_file() or not any(target.iterdir()):
             return
