@@ -15,7 +15,7 @@ from softarm.commands.config import template
 from softarm.config import dump_config, load_config, parse_config
 from softarm.errors import ConfigError
 from softarm.vision import CameraModel
-from softarm.vision.stereo_calibration import StereoModel
+from softarm.vision.stereo_camera import StereoCamera
 from softarm.vision.stereo_files import write_stereo
 
 
@@ -29,7 +29,7 @@ def _stereo(path: Path) -> None:
     cam = CameraModel.ideal(700.0, 640, 480)
     T = np.eye(4)
     T[0, 3] = 0.12
-    write_stereo(StereoModel(cam, cam, T), path)
+    write_stereo(StereoCamera.pair(cam, cam, T), path)
 
 
 def test_the_template_section_uncommented_parses() -> None:

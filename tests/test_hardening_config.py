@@ -20,7 +20,7 @@ from softarm.commands.config import template
 from softarm.config import parse_config
 from softarm.errors import ConfigError
 from softarm.vision import CameraModel
-from softarm.vision.stereo_calibration import StereoModel
+from softarm.vision.stereo_camera import StereoCamera
 from softarm.vision.stereo_files import read_stereo, write_stereo
 
 CAMERA = CameraModel.ideal(700.0, 640, 480)
@@ -39,7 +39,7 @@ def good(tmp_path_factory: pytest.TempPathFactory) -> str:
     T = np.eye(4)
     T[0, 3] = 0.12
     path = tmp_path_factory.mktemp("stereo") / "stereo.yml"
-    write_stereo(StereoModel(CAMERA, CAMERA, T), path)
+    write_stereo(StereoCamera.pair(CAMERA, CAMERA, T), path)
     return path.read_text()
 
 
@@ -166,8 +166,8 @@ def test_config_check_refuses_every_pair_the_harvest_refuses() -> None:
     """What StereoCamera refuses when the harvest builds it, read_stereo's pair check
     refuses first, so that `config check` never says ready for it."""
     from softarm.errors import VisionError
-    from softarm.perception.stereo_camera import StereoCamera
     from softarm.vision.calibration_checks import pair_problems
+    from softarm.vision.stereo_camera import StereoCamera
 
     rng = np.random.default_rng(42)
     translations = [*rng.normal(0.0, 0.1, (200, 3)), (0.1, 0.1, 0.0), (0.1, 0.0, -0.1)]

@@ -79,14 +79,14 @@ def test_camera_files_are_written_to_a_name_that_is_not_utf8(tmp_path: Path) -> 
     code = (
         "import sys, numpy as np\n"
         "from softarm.vision import CameraModel\n"
-        "from softarm.vision.stereo_calibration import StereoModel\n"
+        "from softarm.vision.stereo_camera import StereoCamera\n"
         "from softarm.vision.stereo_files import read_stereo, write_stereo\n"
         "cam = CameraModel.ideal(700.0, 640, 480)\n"
         "T = np.eye(4); T[0, 3] = 0.12\n"
         "for name in ('c.yml', 'c.xml', 'c.yaml', 'c.json'):\n"
         "    cam.save(sys.argv[1] + '/' + name)\n"
         "    assert CameraModel.load(sys.argv[1] + '/' + name) == cam\n"
-        "write_stereo(StereoModel(cam, cam, T), sys.argv[1] + '/stereo.yml')\n"
+        "write_stereo(StereoCamera.pair(cam, cam, T), sys.argv[1] + '/stereo.yml')\n"
         "print(round(read_stereo(sys.argv[1] + '/stereo.yml').baseline, 3))\n"
     )
     done = _child(code, folder)

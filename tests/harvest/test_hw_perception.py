@@ -21,7 +21,7 @@ from softarm.perception.bush_vision import BushVision
 from softarm.perception_config import PerceptionConfig
 from softarm.vision import CameraModel
 from softarm.vision.poses import invert
-from softarm.vision.stereo_calibration import StereoModel
+from softarm.vision.stereo_camera import StereoCamera
 from softarm.vision.stereo_files import write_stereo
 
 from .test_hw_rig_config import _config, no_devices  # noqa: F401  (the fixture)
@@ -29,18 +29,18 @@ from .test_hw_rig_config import _config, no_devices  # noqa: F401  (the fixture)
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 
-def _perceiving(folder: Path, model: StereoModel, **kwargs: Any) -> Any:
+def _perceiving(folder: Path, model: StereoCamera, **kwargs: Any) -> Any:
     """The test config with ``[perception]``, its stereo.yml written in ``folder``."""
     write_stereo(model, folder / "stereo.yml")
     perception = PerceptionConfig(folder=str(folder), **kwargs)
     return replace(_config(), perception=perception)
 
 
-def _ideal_pair() -> StereoModel:
+def _ideal_pair() -> StereoCamera:
     cam = CameraModel.ideal(500.0, 320, 240)
     T = np.eye(4)
     T[0, 3] = 0.12
-    return StereoModel(cam, cam, T)
+    return StereoCamera.pair(cam, cam, T)
 
 
 @pytest.fixture
@@ -127,7 +127,7 @@ def test_the_rig_perceives_the_rendered_bush_as_the_simulator_does(
 ) -> None:
     scene = bush.scene
     stereo = scene.c1()
-    model = StereoModel(stereo.left, stereo.right, stereo.T_left_right)
+    model = StereoCamera.pair(stereo.left, stereo.right, stereo.T_left_right)
     config = _perceiving(tmp_path, model, stereo="zed2", device=0)
     pose = tuple(tuple(r) for r in invert(stereo.T_base_left).tolist())
     config = replace(config, calibration=replace(config.calibration, T_C1_base=pose))

@@ -107,7 +107,7 @@ def test_black_views_give_no_points() -> None:
 
 def test_pixel_size_is_distance_over_focal_length() -> None:
     from softarm.perception.cane_views import pixel_size
-    from softarm.perception.stereo_camera import StereoCamera
+    from softarm.vision.stereo_camera import StereoCamera
 
     eye = CameraModel(CAMERA.matrix, np.zeros(5), (640, 480))
     T_left_right = np.eye(4)

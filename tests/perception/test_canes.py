@@ -17,8 +17,8 @@ from softarm.perception.cane_curves import (
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.cane_pixels import stereo_disparity
 from softarm.perception.canes import CaneFit, fit_canes
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.stereo_camera import StereoCamera
 
 KNOWN = [
     np.array([[0.1, 0.2, -0.05, 0.02], [0.5, 0.01, 0.03, -0.01], [0.2, 0.05, 0.04, 0.0]]),

@@ -15,8 +15,8 @@ from softarm.perception.sight_lines import (
     crossing,
     sight_lines,
 )
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.stereo_camera import StereoCamera
 
 K1 = np.array([[900.0, 0, 639.5], [0, 900.0, 359.5], [0, 0, 1]])
 C1 = CameraModel(K1, np.zeros(5), (1280, 720))

@@ -12,11 +12,8 @@ from scipy.spatial.transform import Rotation
 
 from softarm.errors import InputError, ParameterError, VisionError
 from softarm.vision import CameraModel
-from softarm.vision.stereo_calibration import (
-    StereoModel,
-    calibrate_stereo_charuco,
-    split_side_by_side,
-)
+from softarm.vision.stereo_calibration import calibrate_stereo_charuco, split_side_by_side
+from softarm.vision.stereo_camera import StereoCamera
 
 BOARD = ((9, 6), 0.04, 0.03)
 LEFT = CameraModel.ideal(1000.0, 1280, 720, [-0.05, 0.02, 0.0, 0.0, 0.0])
@@ -75,13 +72,17 @@ def test_side_by_side_frames_calibrate_the_same(
     assert model.baseline == pytest.approx(BASELINE, abs=1e-3)
 
 
-def test_builds_the_stereo_camera_of_perception(
+def test_the_calibrated_pair_is_placed_in_the_base_frame(
     views: tuple[list[np.ndarray], list[np.ndarray]],
 ) -> None:
     model, _ = calibrate_stereo_charuco(*views, *BOARD)
-    camera = model.stereo_camera()
-    assert camera.baseline == pytest.approx(model.baseline)
-    np.testing.assert_array_equal(camera.T_left_right, model.T_left_right)
+    np.testing.assert_array_equal(model.T_base_left, np.eye(4))
+    T_base_left = np.eye(4)
+    T_base_left[:3, 3] = [0.1, -1.2, 0.4]
+    placed = model.placed(T_base_left)
+    np.testing.assert_array_equal(placed.T_base_left, T_base_left)
+    np.testing.assert_array_equal(placed.T_left_right, model.T_left_right)
+    assert placed.baseline == model.baseline
 
 
 def test_stereo_files_round_trip(
@@ -118,4 +119,4 @@ def test_the_model_checks_its_pose() -> None:
     from softarm.errors import PoseError
 
     with pytest.raises(PoseError):
-        StereoModel(LEFT, RIGHT, np.zeros((4, 4)))
+        StereoCamera.pair(LEFT, RIGHT, np.zeros((4, 4)))

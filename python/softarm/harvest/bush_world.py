@@ -24,11 +24,11 @@ from softarm.harvest.states import FAULTS_THAT_STOP
 from softarm.perception.bush_map import BushMap, MappedBerry
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.overlay import draw_bush_map
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.plant import ArmPlant
 from softarm.sim.render.world import RenderedBush, arm_sections, polyline_sections
 from softarm.vision.poses import invert
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["BushGripper", "BushScene", "draw_arm", "harvest_bush"]
 

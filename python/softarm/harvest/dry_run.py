@@ -37,11 +37,10 @@ from softarm.harvest.frame_index import BERRY_STATES, COMMANDS, RIPENESS
 from softarm.harvest.report import BerryResult
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.perception_config import PerceptionConfig
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
-from softarm.vision.stereo_calibration import StereoModel
+from softarm.vision.stereo_camera import StereoCamera
 from softarm.vision.stereo_files import write_stereo
 
 __all__ = [
@@ -172,7 +171,7 @@ def write_rig_files(folder: str | Path, rig: RigDescription) -> Path:
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     s = rig.stereo
-    write_stereo(StereoModel(s.left, s.right, s.T_left_right), folder / "stereo.yml")
+    write_stereo(s, folder / "stereo.yml")
     s.left.save(folder / "c1.yml")
     rig.c2.save(folder / "c2.yml")
     save_config(rig.config(), folder / CONFIG)

@@ -20,9 +20,9 @@ from softarm.perception.bush_map import BushMap
 from softarm.perception.canes import CaneFit, cane_points, fit_cane_points
 from softarm.perception.sight_lines import sight_lines
 from softarm.perception.stereo import locate_berries
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.perception_config import PerceptionConfig
 from softarm.vision.stereo_calibration import split_side_by_side
+from softarm.vision.stereo_camera import StereoCamera
 from softarm.vision.stereo_files import read_stereo
 
 __all__ = ["StereoC1", "open_stereo", "stereo_camera"]
@@ -38,7 +38,7 @@ def stereo_camera(perception: PerceptionConfig, T_base_c1: FloatArray) -> Stereo
         ConfigError: the calibration file is missing or broken (the key named).
     """
     try:
-        return read_stereo(perception.calibration_path).stereo_camera(T_base_c1)
+        return read_stereo(perception.calibration_path).placed(T_base_c1)
     except ConfigError as exc:
         raise ConfigError(f"perception.calibration: {exc}") from None
 

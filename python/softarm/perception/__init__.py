@@ -45,7 +45,7 @@ from softarm.perception.detector.choice import detect_berries, fruit_mask, use_d
 from softarm.perception.overlay import draw_bush_map
 from softarm.perception.sight_lines import Placing, SightLine, crossing, sight_lines
 from softarm.perception.stereo import locate_berries
-from softarm.perception.stereo_camera import Rectification, StereoCamera
+from softarm.vision.stereo_camera import Rectification, StereoCamera
 
 __all__ = [
     "MAX_BLOBS",

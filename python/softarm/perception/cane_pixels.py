@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.perception.stereo_camera import Rectification
+from softarm.vision.stereo_camera import Rectification
 
 __all__ = ["CaneLook", "cane_mask", "half_width_px", "stereo_disparity"]
 

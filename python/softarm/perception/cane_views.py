@@ -4,7 +4,7 @@ whose baseline is the move. It sees the bush from nearer and from another side t
 does, so it fills in the canes C1's stereo leaves without depth: those hidden from
 C1's right eye, and those behind the leaves C1 looks through.
 
-The pair is rectified from the two poses (:class:`~softarm.perception.stereo_camera.
+The pair is rectified from the two poses (:class:`~softarm.vision.stereo_camera.
 StereoCamera` with the second view as the right eye), and the cane pixels of the first
 view are matched and lifted to the centre line as C1's are
 (:func:`softarm.perception.canes.cane_points`).
@@ -19,9 +19,9 @@ from softarm.checks import FloatArray
 from softarm.errors import VisionError
 from softarm.perception.cane_pixels import cane_mask, half_width_px, stereo_disparity
 from softarm.perception.canes import CaneSettings, centre_line_points
-from softarm.perception.stereo_camera import Rectification, StereoCamera
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
+from softarm.vision.stereo_camera import Rectification, StereoCamera
 
 __all__ = ["VIEW_DEPTHS", "pixel_size", "view_pair_points"]
 

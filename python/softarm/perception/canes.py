@@ -31,7 +31,7 @@ from softarm.errors import ParameterError, VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
 from softarm.perception.cane_pixels import CaneLook, cane_mask, half_width_px, stereo_disparity
-from softarm.perception.stereo_camera import StereoCamera
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = [
     "CaneFit",

@@ -9,9 +9,9 @@ import numpy.typing as npt
 
 from softarm.perception._inputs import bgr_image, instance
 from softarm.perception.bush_map import BushMap
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["draw_bush_map"]
 

@@ -21,8 +21,8 @@ import numpy as np
 from softarm.checks import FloatArray, as_pose
 from softarm.perception._inputs import instance
 from softarm.perception.berries import BerryDetection, ripe_by_votes
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["Placing", "SightLine", "crossing", "sight_lines"]
 

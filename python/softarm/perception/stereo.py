@@ -37,8 +37,8 @@ from softarm.perception.berries import (
     DetectorSettings,
 )
 from softarm.perception.detector.choice import detect_berries, fruit_mask  # the chosen detector
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["locate_berries", "match_disparity"]
 

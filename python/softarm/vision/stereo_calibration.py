@@ -9,22 +9,21 @@ show the board at the same place (one image given for both eyes) is refused, and
 whose RMS is too large (images that do not pair up), whose baseline is implausible or
 whose right eye is not on the left eye's +x raises :class:`CalibrationNotConverged`
 with every problem found. ``T_left_right`` follows
-:class:`softarm.perception.stereo_camera.StereoCamera`: ``x_left = T_left_right @ x_right``,
+:class:`softarm.vision.stereo_camera.StereoCamera`: ``x_left = T_left_right @ x_right``,
 metres.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, NamedTuple
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import InputError, VisionError
-from softarm.vision._checks import FloatArray, as_gray, as_pose
+from softarm.vision._checks import FloatArray, as_gray
 from softarm.vision._opencv import opencv_errors
 from softarm.vision.calibration import DEFAULT_FLAGS, charuco_board, fit_views
 from softarm.vision.calibration_checks import (
@@ -37,47 +36,27 @@ from softarm.vision.calibration_checks import (
 )
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
+from softarm.vision.stereo_camera import StereoCamera
 
-if TYPE_CHECKING:
-    from softarm.perception.stereo_camera import StereoCamera
-
-__all__ = ["StereoModel", "calibrate_stereo_charuco", "split_side_by_side"]
+__all__ = ["calibrate_stereo_charuco", "split_side_by_side"]
 
 #: Fewest ChArUco corners a view needs (as calibrate_charuco), and fewest usable views.
 MIN_CORNERS = 6
 MIN_VIEWS = 3
 _TERM = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-9)
 
-#: Each view's corners (None: fewer than 6), and the images' common (w, h).
-Detected = tuple[list[Corners | None], tuple[int, int]]
 
-
-@dataclass(frozen=True)
-class StereoModel:
-    """A calibrated pair: each eye's intrinsics and the right eye's pose in the left
-    eye's frame (4×4, m)."""
+class UnjudgedFit(NamedTuple):
+    """What a stereo fit gave when its data says not to use it (the payload of
+    :class:`CalibrationNotConverged`): maybe not a pair a StereoCamera accepts."""
 
     left: CameraModel
     right: CameraModel
     T_left_right: FloatArray
 
-    def __post_init__(self) -> None:
-        pose = as_pose(self.T_left_right, "T_left_right")
-        pose.setflags(write=False)
-        object.__setattr__(self, "T_left_right", pose)
 
-    @property
-    def baseline(self) -> float:
-        """Distance (m) between the two optical centres."""
-        return float(np.linalg.norm(self.T_left_right[:3, 3]))
-
-    def stereo_camera(self, T_base_left: npt.ArrayLike | None = None) -> StereoCamera:
-        """The :class:`~softarm.perception.stereo_camera.StereoCamera` of this pair, its
-        left eye at ``T_base_left`` in the base frame (default: the identity)."""
-        from softarm.perception.stereo_camera import StereoCamera
-
-        pose = np.eye(4) if T_base_left is None else as_pose(T_base_left, "T_base_left")
-        return StereoCamera(self.left, self.right, pose, np.array(self.T_left_right))
+#: Each view's corners (None: fewer than 6), and the images' common (w, h).
+Detected = tuple[list[Corners | None], tuple[int, int]]
 
 
 def split_side_by_side(frame: npt.NDArray[Any], name: str = "frame") -> tuple[Any, Any]:
@@ -99,7 +78,7 @@ def calibrate_stereo_charuco(
     marker_length: float,
     dictionary: str = "DICT_4X4_50",
     flags: int = DEFAULT_FLAGS,
-) -> tuple[StereoModel, float]:
+) -> tuple[StereoCamera, float]:
     """Calibrate a stereo pair from simultaneous views of a ChArUco board of ``squares``
     = (columns, rows) squares: ``left_images[k]`` and ``right_images[k]`` were taken at
     the same moment. Returns the model and the RMS reprojection error (px) of the joint
@@ -122,11 +101,11 @@ def calibrate_stereo_charuco(
     problems: list[str] = []
     model_l = _mono(board, left, "left_images", flags, problems)
     model_r = _mono(board, right, "right_images", flags, problems)
-    model, rms = _stereo(board, left, right, model_l, model_r, flags)
-    problems += rms_problem("stereo", rms) + pair_problems(model.T_left_right)
+    eyes, T_left_right, rms = _stereo(board, left, right, model_l, model_r, flags)
+    problems += rms_problem("stereo", rms) + pair_problems(T_left_right)
     if problems:
-        raise CalibrationNotConverged(model, rms, problems)
-    return model, rms
+        raise CalibrationNotConverged(UnjudgedFit(*eyes, T_left_right), rms, problems)
+    return StereoCamera.pair(*eyes, T_left_right), rms
 
 
 def _detect_pairs(
@@ -204,7 +183,8 @@ def _stereo(
     model_l: CameraModel,
     model_r: CameraModel,
     flags: int,
-) -> tuple[StereoModel, float]:
+) -> tuple[tuple[CameraModel, CameraModel], FloatArray, float]:
+    """Both eyes refined together, the right eye's pose in the left's, and the RMS."""
     if right[1] != left[1]:
         raise VisionError(f"left images are {left[1]} px, right images {right[1]} px")
     usable = _distinct_pairs(left, right)
@@ -224,12 +204,11 @@ def _stereo(
         )  # fmt: skip
     T_right_left = np.eye(4)
     T_right_left[:3, :3], T_right_left[:3, 3] = R, np.ravel(T)
-    model = StereoModel(
+    eyes = (
         CameraModel(np.asarray(k1, dtype=np.float64), np.ravel(d1), left[1]),
         CameraModel(np.asarray(k2, dtype=np.float64), np.ravel(d2), right[1]),
-        invert(T_right_left),
     )
-    return model, float(rms)
+    return eyes, invert(T_right_left), float(rms)
 
 
 def _distinct_pairs(left: Detected, right: Detected) -> list[tuple[Corners, Corners]]:

@@ -34,12 +34,12 @@ from softarm.vision.camera_files import (
 )
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
-from softarm.vision.stereo_calibration import StereoModel
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["read_stereo", "write_ros_stereo", "write_stereo"]
 
 
-def write_stereo(model: StereoModel, path: str | Path) -> None:
+def write_stereo(model: StereoCamera, path: str | Path) -> None:
     """Write ``model`` as one OpenCV FileStorage file (see the module docstring)."""
     T_right_left = invert(model.T_left_right)
     size = model.left.image_size or (0, 0)
@@ -51,7 +51,7 @@ def write_stereo(model: StereoModel, path: str | Path) -> None:
     write_text(path, fs.releaseAndGetString(), "stereo file")
 
 
-def _matrices(model: StereoModel, T_right_left: np.ndarray) -> dict[str, Any]:
+def _matrices(model: StereoCamera, T_right_left: np.ndarray) -> dict[str, Any]:
     return {
         "M1": model.left.matrix,
         "D1": model.left.distortion.reshape(-1, 1),
@@ -63,7 +63,7 @@ def _matrices(model: StereoModel, T_right_left: np.ndarray) -> dict[str, Any]:
     }
 
 
-def read_stereo(path: str | Path) -> StereoModel:
+def read_stereo(path: str | Path) -> StereoCamera:
     """The pair of a ``stereo.yml`` that :func:`write_stereo` wrote, checked as the
     harvest will use it: finite matrices of the right shapes, ``R``/``T`` (when given)
     agreeing with ``T_left_right``, and a plausible pair
@@ -90,7 +90,7 @@ def read_stereo(path: str | Path) -> StereoModel:
     if problems:
         raise ConfigError(f"{where}: T_left_right: {problems[0]}")
     try:
-        return StereoModel(
+        return StereoCamera.pair(
             CameraModel(mats["M1"], mats["D1"].ravel(), size),
             CameraModel(mats["M2"], mats["D2"].ravel(), size),
             mats["T_left_right"],
@@ -147,7 +147,7 @@ def _agree(T_left_right: np.ndarray, extra: dict[str, Any], where: str) -> None:
         )
 
 
-def write_ros_stereo(model: StereoModel, left: str | Path, right: str | Path) -> None:
+def write_ros_stereo(model: StereoCamera, left: str | Path, right: str | Path) -> None:
     """Write each eye as a ROS ``camera_info`` YAML with its rectification and rectified
     projection (``cv2.stereoRectify``), named ``left`` and ``right``."""
     size = model.left.image_size

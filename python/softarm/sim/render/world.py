@@ -18,7 +18,6 @@ import numpy as np
 
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
-from softarm.perception.stereo_camera import StereoCamera
 from softarm.sim.bush import PLUS_Y, Branch, Bush
 from softarm.sim.render.distortion import Distorter
 from softarm.sim.render.labels import GeomLabels
@@ -37,6 +36,7 @@ from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 from softarm.vision.cube import FACE_PER_MARKER
 from softarm.vision.poses import invert
+from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["ZED2_BASELINE", "RenderedBush", "StereoCamera", "arm_sections"]
 

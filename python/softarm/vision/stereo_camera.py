@@ -8,7 +8,7 @@ disparity d along the row, and its depth in the rectified left frame is z = f B 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import cast
 
@@ -63,6 +63,18 @@ class StereoCamera:
                 f"T_left_right puts the right eye at {[float(x), float(y), float(z)]} m: it "
                 "must lie mostly along the left eye's +x axis (eyes swapped?)"
             )
+
+    @classmethod
+    def pair(
+        cls, left: CameraModel, right: CameraModel, T_left_right: npt.ArrayLike
+    ) -> StereoCamera:
+        """The pair alone, as a calibration gives it: its left eye at the base frame's
+        origin (place it with :meth:`placed`)."""
+        return cls(left, right, np.eye(4), np.asarray(T_left_right, dtype=np.float64))
+
+    def placed(self, T_base_left: npt.ArrayLike) -> StereoCamera:
+        """The same pair with its left eye at ``T_base_left`` in the base frame."""
+        return replace(self, T_base_left=np.asarray(T_base_left, dtype=np.float64))
 
     @property
     def baseline(self) -> float:
