@@ -20,6 +20,7 @@ from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.filter import PoseLowPassFilter
 from softarm.vision.fusion import CameraFusion, FusionEstimate
 from softarm.vision.registration import RegistrationResult, register_points
+from softarm.vision.stereo_camera import Rectification, StereoCamera
 from softarm.vision.two_cameras import CameraVision, register_c1
 
 __all__ = [
@@ -38,7 +39,9 @@ __all__ = [
     "MarkerPose",
     "OpenCVBaseline",
     "PoseLowPassFilter",
+    "Rectification",
     "RegistrationResult",
+    "StereoCamera",
     "calibrate_charuco",
     "calibrate_chessboard",
     "estimate_marker_poses",
