@@ -9,6 +9,7 @@ import pytest
 
 from softarm.errors import ParameterError
 from softarm.sim.render.camera_effects import (
+    AUTO_HIGHLIGHT_DN,
     AUTO_TARGET_DN,
     CameraEffects,
     StereoEffects,
@@ -95,6 +96,20 @@ def test_auto_exposure_brings_the_mean_to_its_target_and_the_bias_scales_it() ->
     assert out.mean() == pytest.approx(AUTO_TARGET_DN, abs=0.6)
     biased = CameraEffects(exposure_bias=0.5).exposure_of(_flat(40))
     assert biased == pytest.approx(0.5 * AUTO_TARGET_DN / 40)
+
+
+def test_auto_exposure_keeps_the_highlights_under_their_level() -> None:
+    image = _flat(40)
+    image[:3, :] = 200  # 1.5 % of the frame bright: a sunlit marker
+    exposure = CameraEffects().exposure_of(image)
+    assert exposure == pytest.approx(AUTO_HIGHLIGHT_DN / 200)
+    out = CameraEffects().apply(image, np.random.default_rng(0))
+    assert out.max() < 255  # not clipped, though the frame's mean is far from its target
+    image[:3, :] = 40
+    image[0, :10] = 250  # a few glints (0.005 % of the frame) may clip
+    assert CameraEffects().exposure_of(image) == pytest.approx(
+        AUTO_TARGET_DN / image.mean(), rel=0.01
+    )
 
 
 def test_vignetting_darkens_the_corners_by_its_strength() -> None:

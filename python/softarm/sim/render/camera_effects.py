@@ -30,11 +30,14 @@ from softarm.errors import ParameterError
 
 __all__ = ["CameraEffects", "StereoEffects", "blur_kernel"]
 
-#: What auto-exposure aims the frame's mean luminance at (DN), and how far it may go.
+#: What auto-exposure aims the frame's mean luminance at (DN), and how far it may go;
+#: it keeps the brightest AUTO_HIGHLIGHT_SHARE of the pixels at or under
+#: AUTO_HIGHLIGHT_DN (a camera's metering keeps a bright subject, a sunlit marker, from
+#: clipping because the rest of the frame is dark).
 AUTO_TARGET_DN = 110.0
 AUTO_RANGE = (0.25, 8.0)
-#: BT.601 luminance weights of B, G, R (OpenCV's channel order).
-LUMA_BGR = np.array([0.114, 0.587, 0.299])
+AUTO_HIGHLIGHT_SHARE = 0.005
+AUTO_HIGHLIGHT_DN = 230.0
 
 
 def blur_kernel(velocity_px: tuple[float, float], exposure_s: float) -> npt.NDArray[np.float64]:
@@ -70,7 +73,8 @@ class CameraEffects:
 
     Args:
         exposure: the exposure gain over the render; None: auto-exposure, the frame's
-            mean luminance brought to AUTO_TARGET_DN within AUTO_RANGE.
+            mean luminance brought to AUTO_TARGET_DN, its brightest pixels kept under
+            AUTO_HIGHLIGHT_DN, within AUTO_RANGE.
         exposure_bias: a factor on the exposure (auto or fixed): one eye of a pair
             exposing a little differently, or an auto-exposure that over- or
             under-shoots.
@@ -117,12 +121,17 @@ class CameraEffects:
 
     def exposure_of(self, image: npt.NDArray[np.uint8]) -> float:
         """The exposure this camera gives ``image``: the fixed one, or auto-exposure's
-        (its mean luminance to AUTO_TARGET_DN), times the bias."""
+        (its mean luminance to AUTO_TARGET_DN, its highlights kept under
+        AUTO_HIGHLIGHT_DN), times the bias."""
         if self.exposure is not None:
             return self.exposure * self.exposure_bias
-        mean = float(np.asarray(cv2.mean(image)[:3]) @ LUMA_BGR)
-        auto = float(np.clip(AUTO_TARGET_DN / max(mean, 1e-3), *AUTO_RANGE))
-        return auto * self.exposure_bias
+        grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        mean = float(cv2.mean(grey)[0])
+        counts = cv2.calcHist([grey], [0], None, [256], [0, 256]).ravel()
+        above = np.cumsum(counts[::-1])  # pixels at or above each level, from 255 down
+        highlight = 255 - int(np.searchsorted(above, AUTO_HIGHLIGHT_SHARE * grey.size))
+        auto = min(AUTO_TARGET_DN / max(mean, 1e-3), AUTO_HIGHLIGHT_DN / max(highlight, 1))
+        return float(np.clip(auto, *AUTO_RANGE)) * self.exposure_bias
 
     def apply(
         self,
