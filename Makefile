@@ -48,7 +48,7 @@ test-rust:
 
 # The optional extras whose tests run in CI: Ray sweeps, the Cosserat rod, the rerun view,
 # the rendered bush.
-TEST_EXTRAS := test,sweep,cosserat,viz,render,ros
+TEST_EXTRAS := test,sweep,cosserat,viz,render,ros,foxglove
 
 dev-all: venv
 	$(VENV)/bin/maturin develop --release --extras $(TEST_EXTRAS) -q

@@ -102,6 +102,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="write the run as a ROS 2 bag (rosbag2, MCAP; ros extra; docs/ros.md)",
     )  # fmt: skip
     p.add_argument(
+        "--foxglove", nargs="?", const="127.0.0.1:8765", metavar="HOST:PORT",
+        help="serve the run live to Foxglove on HOST:PORT (alone: 127.0.0.1:8765; "
+        "foxglove extra; docs/ros.md)",
+    )  # fmt: skip
+    p.add_argument(
         "--world", choices=("tags", "bush", "row"), default="tags",
         help="--sim: 'tags', berries tagged and canes mapped (fast); 'bush', the rendered "
         "bush, berries and canes found by the cameras (render extra, MUJOCO_GL=egl); "
@@ -159,6 +164,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("--look: for the rendered row (--sim --world row)")
     check_bag(args.bag)
     check_view(args.view, args.record)
+    check_foxglove(args.foxglove)
     configure_logging(args.quiet)
     options = plant_options(args)
     gains = _gains(args)
@@ -184,6 +190,28 @@ def check_render(bush: bool) -> None:
         from softarm.sim.render.gl_check import require_offscreen_gl
 
         require_offscreen_gl()
+
+
+def check_foxglove(address: str | None) -> None:
+    """Before any work: ``--foxglove`` needs foxglove-sdk, the ``foxglove`` extra, and a
+    HOST:PORT (one line each)."""
+    if address is not None:
+        from softarm.viz.foxglove_live import parse_address, require_foxglove
+
+        require_foxglove()
+        parse_address(address)
+
+
+def live_view(records: list[dict[str, Any]], address: str | None) -> Any:
+    """The Foxglove server streaming the run log's ``records`` (None without
+    ``--foxglove``); its address printed for the user to connect to."""
+    if address is None:
+        return None
+    from softarm.viz.foxglove_live import LiveView
+
+    view = LiveView(records, address)
+    print(f"foxglove: live at {view.url} (Foxglove: Open connection)", flush=True)
+    return view
 
 
 def check_view(view: bool, record: Path | None) -> None:
@@ -239,6 +267,7 @@ def run_sim(
 
         seen = c1_picture(rig.scene, seed)
     viewer = _viewer(rig, view, record)
+    live = live_view(rig.machine.log.records, getattr(args, "foxglove", None))
     try:
         try:
             with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
@@ -246,6 +275,8 @@ def run_sim(
         finally:
             if viewer is not None:
                 viewer.close()  # the recording complete, even after a stop
+            if live is not None:
+                live.close()
         # The run's log is closed; a stop while the outputs are written is recorded in it.
         with records_late_stop(rig.machine.log):
             _sim_outputs(rig, report, report_path, bag, rig_options.record_frames, plot_path, seen)
@@ -381,6 +412,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         log.close()
         raise
     berries = args.berries if devices is None else replay_rounds(devices)
+    live = live_view(log.records, args.foxglove)
     try:
         # The tags 10, 11, ... stuck to the berries (section IV-E), or the map's ripe
         # berries with markerless [perception].
@@ -390,6 +422,8 @@ def _run_hardware(args: argparse.Namespace) -> int:
     finally:
         rig.close()  # vents and releases every device, whatever happened
         log.close()
+        if live is not None:
+            live.close()
     # The log is closed; a stop while the outputs are written is recorded in it.
     with records_late_stop(log):
         report.header = log.records[0]

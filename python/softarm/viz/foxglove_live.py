@@ -1,0 +1,187 @@
+"""A live view of a harvest in Foxglove (``softarm harvest --foxglove [HOST:PORT]``): a
+WebSocket server of Foxglove's own SDK (the ``foxglove`` extra, ``foxglove-sdk``) that
+streams the run log's records as they are written, for Foxglove's desktop or web app
+(Open connection, Foxglove WebSocket, ``ws://HOST:PORT``; docs/ros.md).
+
+Topics (Foxglove's schemas, protobuf; times are the run's own clock):
+
+* ``/joint_states`` (``foxglove.JointStates``): the nine elongations ``q0``..``q8`` (m);
+* ``/tf`` (``foxglove.FrameTransforms``): ``base`` to ``gripper`` (the gripper as the
+  cameras measured it) and ``base`` to ``target`` (the berry being picked);
+* ``/bush_map`` (``foxglove.SceneUpdate``): the map's berries, ripe magenta, unripe green;
+* ``/harvest/events`` (``foxglove.Log``): the state machine's transitions, faults, vents,
+  plans, each as one line;
+* ``/harvest/errors`` (JSON): the measured position and pointing errors of each step.
+
+The control loop only appends records to the log; a thread here reads them and hands
+them to the SDK, which keeps a bounded queue per client and drops the oldest data for
+one that is slow: a client never blocks the loop.
+"""
+
+from __future__ import annotations
+
+import importlib
+import threading
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation  # here, not on the first step: it is slow
+
+from softarm.errors import MissingDependencyError, ParameterError
+
+__all__ = ["LiveView", "parse_address", "require_foxglove"]
+
+#: Where the server listens unless told: this machine only.
+DEFAULT_ADDRESS = "127.0.0.1:8765"
+#: How often (s) the publishing thread reads the new records.
+POLL_S = 0.02
+#: Messages kept per client before the oldest are dropped (the SDK's backlog).
+BACKLOG = 1024
+#: Record kinds sent to /harvest/events, and their Foxglove log level.
+EVENT_LEVELS = {"transition": "Info", "plan": "Info", "survey_done": "Info", "vent": "Warning",
+                "fault": "Error", "crash": "Fatal", "interrupted": "Warning",
+                "berry_result": "Info"}  # fmt: skip
+
+
+def require_foxglove() -> Any:
+    """The ``foxglove`` module (foxglove-sdk), or :class:`MissingDependencyError`."""
+    try:
+        return importlib.import_module("foxglove")
+    except ImportError as exc:
+        raise MissingDependencyError(
+            f"the Foxglove live view needs foxglove-sdk: pip install 'softarm[foxglove]' ({exc})",
+            "foxglove",
+        ) from exc
+
+
+def parse_address(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` (or ``PORT``, on 127.0.0.1) as (host, port); port 0: any free one."""
+    host, _, port = text.rpartition(":")
+    try:
+        number = int(port)
+    except ValueError:
+        raise ParameterError(f"--foxglove: give HOST:PORT, got {text!r}") from None
+    if not 0 <= number <= 65535:
+        raise ParameterError(f"--foxglove: port must be in [0, 65535], got {number}")
+    return host or "127.0.0.1", number
+
+
+class LiveView:
+    """Serves ``records`` (a run log's list, appended to by the run) on ``address`` from
+    a daemon thread until :meth:`close`; :attr:`port` is the port bound."""
+
+    def __init__(self, records: list[dict[str, Any]], address: str = DEFAULT_ADDRESS) -> None:
+        fox = require_foxglove()
+        host, port = parse_address(address)
+        from foxglove import channels
+
+        self._fox, self.records = fox, records
+        self._m = importlib.import_module("foxglove.messages")
+        self.context = fox.Context()
+        try:
+            self.server = fox.start_server(
+                name="softarm harvest", host=host, port=port, context=self.context,
+                message_backlog_size=BACKLOG,
+            )  # fmt: skip
+        except Exception as exc:  # the SDK's own error type: a port in use, a bad host
+            raise ParameterError(f"--foxglove {address}: cannot listen there ({exc})") from None
+        self.port: int = self.server.port
+        self.host = host
+        ctx = self.context
+        self._joints = channels.JointStatesChannel("/joint_states", context=ctx)
+        self._tf = channels.FrameTransformsChannel("/tf", context=ctx)
+        self._map = channels.SceneUpdateChannel("/bush_map", context=ctx)
+        self._events = channels.LogChannel("/harvest/events", context=ctx)
+        self._errors = fox.Channel("/harvest/errors", message_encoding="json", context=ctx)
+        self._sent = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="foxglove", daemon=True)
+        self._thread.start()
+
+    @property
+    def url(self) -> str:
+        """The address a Foxglove app connects to."""
+        return f"ws://{self.host}:{self.port}"
+
+    def close(self) -> None:
+        """Send what is left, then stop the server."""
+        self._stop.set()
+        self._thread.join(timeout=5.0)
+        self._drain()
+        self.server.stop()
+
+    def _run(self) -> None:
+        while not self._stop.wait(POLL_S):
+            self._drain()
+
+    def _drain(self) -> None:
+        while self._sent < len(self.records):
+            record = self.records[self._sent]
+            try:
+                self.publish(record)
+            except Exception:  # a record the view cannot draw must not end the run
+                pass
+            self._sent += 1
+
+    def publish(self, record: dict[str, Any]) -> None:
+        """One run-log record on its topics (most kinds have none)."""
+        m = self._m
+        kind, t = record.get("kind"), float(record.get("t") or 0.0)
+        stamp = m.Timestamp(sec=int(t), nsec=round((t - int(t)) * 1e9) % 1_000_000_000)
+        if kind == "step":
+            self._step(record, stamp)
+        elif kind == "bush_map":
+            self._map.log(_scene(m, record, stamp))
+        if kind in EVENT_LEVELS:
+            text = ", ".join(f"{k}={v}" for k, v in record.items() if k not in ("kind", "t"))
+            level = getattr(m.LogLevel, EVENT_LEVELS[kind])
+            self._events.log(m.Log(timestamp=stamp, level=level, name=kind, message=text[:500]))
+
+    def _step(self, record: dict[str, Any], stamp: Any) -> None:
+        m = self._m
+        q = record.get("q") or []
+        joints = [m.JointState(name=f"q{k}", position=float(v)) for k, v in enumerate(q)]
+        self._joints.log(m.JointStates(timestamp=stamp, joints=joints))
+        frames = []
+        if record.get("pose") is not None:
+            frames.append(_transform(m, stamp, "gripper", np.asarray(record["pose"], float)))
+        if record.get("target") is not None:
+            target = np.asarray(record["target"], float)
+            if target.shape == (3,):
+                pose = np.eye(4)
+                pose[:3, 3] = target
+                target = pose
+            frames.append(_transform(m, stamp, "target", target.reshape(4, 4)))
+        if frames:
+            self._tf.log(m.FrameTransforms(transforms=frames))
+        if record.get("position_error_m") is not None:
+            self._errors.log({
+                "t": record.get("t"), "state": record.get("state"), "berry": record.get("berry"),
+                "position_error_mm": 1e3 * float(record["position_error_m"]),
+                "orientation_error_deg": float(np.degrees(record["orientation_error_rad"] or 0.0)),
+            })  # fmt: skip
+
+
+def _transform(m: Any, stamp: Any, child: str, pose: np.ndarray) -> Any:
+    x, y, z, w = Rotation.from_matrix(pose[:3, :3]).as_quat()
+    return m.FrameTransform(
+        timestamp=stamp, parent_frame_id="base", child_frame_id=child,
+        translation=m.Vector3(x=pose[0, 3], y=pose[1, 3], z=pose[2, 3]),
+        rotation=m.Quaternion(x=x, y=y, z=z, w=w),
+    )  # fmt: skip
+
+
+def _scene(m: Any, record: dict[str, Any], stamp: Any) -> Any:
+    """The map's berries as spheres of their size, ripe magenta, unripe green."""
+    spheres = []
+    for b in record.get("berries", []):
+        x, y, z = (float(v) for v in b["position"])
+        d = 2.0 * float(b.get("radius_m") or 0.01)
+        colour = m.Color(r=1.0, g=0.0, b=1.0, a=0.9) if b.get("ripe") else m.Color(
+            r=0.0, g=0.85, b=0.0, a=0.9)  # fmt: skip
+        spheres.append(m.SpherePrimitive(
+            pose=m.Pose(position=m.Vector3(x=x, y=y, z=z), orientation=m.Quaternion(w=1.0)),
+            size=m.Vector3(x=d, y=d, z=d), color=colour,
+        ))  # fmt: skip
+    entity = m.SceneEntity(timestamp=stamp, frame_id="base", id="berries", spheres=spheres)
+    return m.SceneUpdate(entities=[entity])
