@@ -143,3 +143,47 @@ def test_a_dry_run_stopped_while_it_reads_the_recording_says_so_in_its_log(
     records = [json.loads(line) for line in log.read_text().splitlines()]
     assert [r["kind"] for r in records] == ["interrupted"]
     assert records[0]["signal"] == "SIGTERM"
+
+
+def test_a_stop_waits_for_a_section_that_must_not_be_cut() -> None:
+    from softarm.uninterrupted import uninterrupted
+
+    done: list[str] = []
+
+    @drives_arm("test")
+    def run(args: Any) -> int:
+        with uninterrupted():
+            os.kill(os.getpid(), signal.SIGTERM)
+            done.append("section complete")
+        done.append("after the section")
+        return 0
+
+    assert run(None) == 143
+    assert done == ["section complete"]
+
+
+def test_the_renderers_are_all_freed_before_a_stop_is_raised() -> None:
+    """Item 15: a SIGTERM while the bush harvest freed its renderers cut an EGL context's
+    free in half; the outer close then failed on it (EGL_BAD_CONTEXT, a traceback, exit
+    1). Every renderer is freed, once, and then the stop is raised."""
+    from softarm.commands._signals import Interrupted, raise_on_signals
+    from softarm.sim.render.renderer import BushRenderer
+
+    freed: list[int] = []
+
+    class Renderer:
+        def __init__(self, n: int) -> None:
+            self.n = n
+
+        def close(self) -> None:
+            if self.n == 1:  # the stop arrives half-way through
+                os.kill(os.getpid(), signal.SIGTERM)
+            freed.append(self.n)
+
+    renderer = BushRenderer.__new__(BushRenderer)
+    renderer._renderers = {n: Renderer(n) for n in range(3)}  # type: ignore[assignment]
+    with pytest.raises(Interrupted), raise_on_signals():
+        renderer.close()
+    assert sorted(freed) == [0, 1, 2]
+    renderer.close()  # nothing left to free twice
+    assert sorted(freed) == [0, 1, 2]

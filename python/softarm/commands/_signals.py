@@ -29,6 +29,8 @@ from contextlib import contextmanager
 from types import FrameType
 from typing import Any, Protocol
 
+from softarm.uninterrupted import defer
+
 __all__ = [
     "Interrupted",
     "drives_arm",
@@ -65,6 +67,12 @@ def _raise(signum: int, frame: FrameType | None) -> None:
     # the venting short. SIGKILL still ends everything.
     for s in SIGNALS:
         signal.signal(s, signal.SIG_IGN)
+    if defer(functools.partial(_stop, signum)):  # inside a section that must not be cut
+        return
+    raise Interrupted(signum)
+
+
+def _stop(signum: int) -> None:
     raise Interrupted(signum)
 
 

@@ -29,6 +29,7 @@ from softarm.sim.render.mjcf import (
     SceneSpec,
     scene_xml,
 )
+from softarm.uninterrupted import uninterrupted
 
 #: Where what is out of the picture is put.
 FAR_AWAY = np.array([0.0, -50.0, 0.0])
@@ -291,10 +292,11 @@ class BushRenderer:
             m.geom_group[:] = self._groups
 
     def close(self) -> None:
-        """Free the OpenGL contexts."""
-        for r in self._renderers.values():
-            r.close()
-        self._renderers.clear()
+        """Free the OpenGL contexts; a stop waits until they are freed (a context left
+        half-destroyed fails its next free). Harmless twice."""
+        with uninterrupted():
+            while self._renderers:
+                self._renderers.popitem()[1].close()
 
     def _renderer(self, spec: CameraSpec) -> Any:
         w, h = spec.size
