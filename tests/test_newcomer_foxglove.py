@@ -183,3 +183,33 @@ def test_without_the_extra_the_line_names_it_before_the_banner(tmp_path: Any) ->
                           cwd=tmp_path, timeout=120)  # fmt: skip
     assert done.returncode == 2 and done.stdout == ""
     assert "pip install 'softarm[foxglove]'" in done.stderr and len(done.stderr.splitlines()) == 1
+
+
+def test_replay_serves_a_log_at_its_pace_once_a_client_subscribes(tmp_path: Any) -> None:
+    import threading
+
+    from softarm.harvest.log import HarvestLog
+    from softarm.viz.foxglove_live import serve_log
+
+    log = HarvestLog(tmp_path / "run.jsonl")
+    for k in range(5):
+        log.event("step", **{**{f: v for f, v in STEP.items() if f != "kind"}, "t": 0.1 * k})
+    log.close()
+    urls: list[str] = []
+    served: list[int] = []
+    thread = threading.Thread(
+        target=lambda: served.append(
+            serve_log(tmp_path / "run.jsonl", "127.0.0.1:0", lambda line: urls.append(line))
+        )
+    )
+    thread.start()
+    end = time.monotonic() + 10.0
+    while not urls and time.monotonic() < end:
+        time.sleep(0.02)
+    url = urls[0].split(" at ")[1].split(";")[0]
+    client = Client(url)
+    client.subscribe({"/joint_states"})
+    got = client.collect({"/joint_states"}, deadline_s=3.0)
+    thread.join(timeout=10.0)
+    client.close()
+    assert served == [5] and got["/joint_states"], got

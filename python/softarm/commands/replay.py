@@ -51,6 +51,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "once (1 = the first); needed when the log holds more than one run",
     )  # fmt: skip
     p.add_argument(
+        "--foxglove", nargs="?", const="127.0.0.1:8765", metavar="HOST:PORT",
+        help="serve the log to Foxglove on HOST:PORT at the run's own pace, from the moment "
+        "a client subscribes (alone: 127.0.0.1:8765; foxglove extra; docs/ros.md)",
+    )  # fmt: skip
+    p.add_argument(
         "--view",
         action="store_true",
         help="also start the rerun viewer (the default without --record)",
@@ -73,7 +78,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 @stops_on_signals  # a stop removes the half-written bag and its temporary folder
 def run(args: argparse.Namespace) -> int:
-    """Write the bag and/or the recording; returns 0."""
+    """Write the bag and/or the recording, or serve the log to Foxglove; returns 0."""
+    if args.foxglove is not None:
+        from softarm.viz.foxglove_live import serve_log
+
+        n = serve_log(args.log, args.foxglove)
+        print(f"{plural(n, 'record')} of {args.log} served to Foxglove")
+        return 0
     check_bag(args.bag)
     if args.frames is not None and args.bag is None:
         raise ParameterError("--frames: adds the recorded frames to a bag; give --bag too")

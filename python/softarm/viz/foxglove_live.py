@@ -22,6 +22,9 @@ from __future__ import annotations
 
 import importlib
 import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -29,7 +32,7 @@ from scipy.spatial.transform import Rotation  # here, not on the first step: it 
 
 from softarm.errors import MissingDependencyError, ParameterError
 
-__all__ = ["LiveView", "parse_address", "require_foxglove"]
+__all__ = ["LiveView", "parse_address", "require_foxglove", "serve_log"]
 
 #: Where the server listens unless told: this machine only.
 DEFAULT_ADDRESS = "127.0.0.1:8765"
@@ -70,7 +73,9 @@ class LiveView:
     """Serves ``records`` (a run log's list, appended to by the run) on ``address`` from
     a daemon thread until :meth:`close`; :attr:`port` is the port bound."""
 
-    def __init__(self, records: list[dict[str, Any]], address: str = DEFAULT_ADDRESS) -> None:
+    def __init__(
+        self, records: list[dict[str, Any]], address: str = DEFAULT_ADDRESS, listener: Any = None
+    ) -> None:
         fox = require_foxglove()
         host, port = parse_address(address)
         from foxglove import channels
@@ -81,7 +86,7 @@ class LiveView:
         try:
             self.server = fox.start_server(
                 name="softarm harvest", host=host, port=port, context=self.context,
-                message_backlog_size=BACKLOG,
+                message_backlog_size=BACKLOG, server_listener=listener,
             )  # fmt: skip
         except Exception as exc:  # the SDK's own error type: a port in use, a bad host
             raise ParameterError(f"--foxglove {address}: cannot listen there ({exc})") from None
@@ -185,3 +190,40 @@ def _scene(m: Any, record: dict[str, Any], stamp: Any) -> Any:
         ))  # fmt: skip
     entity = m.SceneEntity(timestamp=stamp, frame_id="base", id="berries", spheres=spheres)
     return m.SceneUpdate(entities=[entity])
+
+
+class _Subscribed:
+    """A server listener that notes the first subscription of any client."""
+
+    def __init__(self) -> None:
+        self.event = threading.Event()
+
+    def on_subscribe(self, client: Any, channel: Any) -> None:
+        self.event.set()
+
+    def on_unsubscribe(self, client: Any, channel: Any) -> None:
+        return None
+
+
+def serve_log(path: str | Path, address: str, announce: Callable[[str], None] = print) -> int:
+    """``softarm replay LOG --foxglove``: serve the run log at ``path`` at the run's own
+    pace (its records' ``t``), from the moment a Foxglove client subscribes; the number
+    of records served."""
+    from softarm.harvest.log import read_log
+
+    records: list[dict[str, Any]] = []
+    listener = _Subscribed()
+    view = LiveView(records, address, listener)
+    try:
+        announce(f"foxglove: serving {path} at {view.url}; waiting for a client to subscribe")
+        listener.event.wait()
+        start, first = time.monotonic(), None
+        for record in read_log(path):
+            t = record.get("t")
+            if isinstance(t, int | float):
+                first = t if first is None else first
+                time.sleep(max(0.0, (t - first) - (time.monotonic() - start)))
+            records.append(record)
+    finally:
+        view.close()
+    return len(records)
