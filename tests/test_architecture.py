@@ -119,6 +119,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "geometry.py": ("softarm.",),
     "checks.py": ("softarm.",),
     "errors.py": ("softarm.",),
+    "uninterrupted.py": ("softarm.",),
     "files": ("softarm.",),
     "hardware": (*_SIM_UP, "softarm.vision", "softarm.config"),
     "config.py": (*_SIM_UP, "softarm.vision"),
