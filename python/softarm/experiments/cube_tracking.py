@@ -30,20 +30,27 @@ from typing import Any
 
 import numpy as np
 
+from softarm.commands._looks import LOOKS
+
 __all__ = ["track_cubes"]
 
 #: The cube is in full view when this share of its faces' pixels is not hidden.
 UNHIDDEN = 0.99
 
 
-def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -> dict[str, Any]:
+def track_cubes(
+    seeds: Iterable[int], poses: int = 8, side: int | None = None, look: str | None = None
+) -> dict[str, Any]:
     """Position errors (mm) of the cube tracked in C1 over ``poses`` arm poses per seed,
     the share of poses where the cube was found, the mean time (ms) to render a window
-    (its renderer made; the harvest makes one per size once) and its mean side (px)."""
+    (its renderer made; the harvest makes one per size once) and its mean side (px);
+    ``look``: in the daylight row with that look family (``--world row``), drawn from
+    each seed."""
     import softarm
     from softarm.harvest.sim_rig import default_cameras
     from softarm.harvest.sim_vision import BASE_TAG_ID
     from softarm.sim.bush import Bush
+    from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import arm_sections, world_for
     from softarm.vision import MarkerCube
     from softarm.vision.detector import MarkerDetector
@@ -59,7 +66,8 @@ def track_cubes(seeds: Iterable[int], poses: int = 8, side: int | None = None) -
     trusted: list[float] = []  # from markers consistent on their own (the tracker's)
     for seed in seeds:
         bush = Bush.generate(arm, 8, seed, view_point=cams.T_base_c1[:3, 3])
-        world = world_for(bush, cams, BASE_TAG_ID)
+        row = None if look is None else RowLook.named(look, seed)
+        world = world_for(bush, cams, BASE_TAG_ID, look=row)
         faces = [g for g in range(world.renderer.model.ngeom) if _is_cube_face(world, g)]
         rng = np.random.default_rng(seed)
         T_c1_base = invert(world.stereo.T_base_left)
@@ -128,8 +136,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("seeds", type=int, nargs="+")
     p.add_argument("--poses", type=int, default=8)
     p.add_argument("--side", type=int, help="fixed window side (px)")
+    p.add_argument("--look", choices=LOOKS, help="in the daylight row with this look")
     args = p.parse_args(argv)
-    result = track_cubes(args.seeds, args.poses, args.side)
+    result = track_cubes(args.seeds, args.poses, args.side, args.look)
     fields = (f"{k}={v:.3f}" if isinstance(v, float) else f"{k}={v}" for k, v in result.items())
     print(" ".join(fields))
     return 0
