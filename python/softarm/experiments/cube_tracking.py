@@ -15,7 +15,8 @@ where every marker used is consistent on its own (``CubePose.consistent``; the o
 are the least bent marker's pose). ``--side N``
 renders fixed N-pixel
 windows instead (the harvest's window before it was fitted to the cube), for
-comparison on the same poses.
+comparison on the same poses. ``--look L`` measures it in the daylight row
+(``--world row``) with the look family L.
 
 It lives above :mod:`softarm.perception` (which may not import the simulation).
 """
