@@ -30,7 +30,7 @@ STEP = {
 MAP = {"kind": "bush_map", "t": 0.5, "berries": [
     {"id": 0, "position": [0.0, 0.4, 0.4], "radius_m": 0.012, "ripe": True},
     {"id": 1, "position": [0.1, 0.4, 0.4], "radius_m": 0.012, "ripe": False},
-]}  # fmt: skip
+], "canes": [{"coeffs": [[0.1, 0.05], [0.4, 0.0], [0.3, 0.2]], "radius_m": 0.004}]}  # fmt: skip
 TRANSITION = {"kind": "transition", "t": 1.0, "berry": 2, "old": "initial_placement",
               "new": "fine_positioning", "why": "berry within reach"}  # fmt: skip
 
@@ -113,6 +113,8 @@ def test_a_client_receives_and_decodes_every_topic_within_a_second() -> None:
         assert frames["target"].translation.z == pytest.approx(0.39)
         spheres = got["/bush_map"][0].entities[0].spheres
         assert len(spheres) == 2 and spheres[0].color.r == 1.0 and spheres[1].color.g > 0.5
+        (cane,) = got["/bush_map"][0].entities[1].lines
+        assert cane.points[-1].z == pytest.approx(0.5) and len(cane.points) == 40
         assert "fine_positioning" in got["/harvest/events"][0].message
         assert got["/harvest/errors"][0]["position_error_mm"] == pytest.approx(0.4)
     finally:
@@ -213,3 +215,16 @@ def test_replay_serves_a_log_at_its_pace_once_a_client_subscribes(tmp_path: Any)
     thread.join(timeout=10.0)
     client.close()
     assert served == [5] and got["/joint_states"], got
+
+
+def test_the_layout_shows_only_topics_the_view_serves() -> None:
+    import re
+    from pathlib import Path
+
+    layout = json.loads((Path(__file__).parents[1] / "docs" / "foxglove_layout.json").read_text())
+    text = json.dumps(layout["configById"])
+    used = set(re.findall(r'"(/[a-z_/]+)', text))
+    assert used and used <= TOPICS, used - TOPICS
+    panels = set(layout["configById"])
+    placed = set(re.findall(r'"([A-Za-z0-9]+![a-z]+)"', json.dumps(layout["layout"])))
+    assert placed == panels

@@ -8,7 +8,8 @@ Topics (Foxglove's schemas, protobuf; times are the run's own clock):
 * ``/joint_states`` (``foxglove.JointStates``): the nine elongations ``q0``..``q8`` (m);
 * ``/tf`` (``foxglove.FrameTransforms``): ``base`` to ``gripper`` (the gripper as the
   cameras measured it) and ``base`` to ``target`` (the berry being picked);
-* ``/bush_map`` (``foxglove.SceneUpdate``): the map's berries, ripe magenta, unripe green;
+* ``/bush_map`` (``foxglove.SceneUpdate``): the map's berries, ripe magenta, unripe
+  green, and its fitted canes, amber;
 * ``/harvest/events`` (``foxglove.Log``): the state machine's transitions, faults, vents,
   plans, each as one line;
 * ``/harvest/errors`` (JSON): the measured position and pointing errors of each step.
@@ -188,8 +189,24 @@ def _scene(m: Any, record: dict[str, Any], stamp: Any) -> Any:
             pose=m.Pose(position=m.Vector3(x=x, y=y, z=z), orientation=m.Quaternion(w=1.0)),
             size=m.Vector3(x=d, y=d, z=d), color=colour,
         ))  # fmt: skip
-    entity = m.SceneEntity(timestamp=stamp, frame_id="base", id="berries", spheres=spheres)
-    return m.SceneUpdate(entities=[entity])
+    canes = [_cane(m, c) for c in record.get("canes", [])]
+    berries = m.SceneEntity(timestamp=stamp, frame_id="base", id="berries", spheres=spheres)
+    fitted = m.SceneEntity(timestamp=stamp, frame_id="base", id="canes", lines=canes)
+    return m.SceneUpdate(entities=[berries, fitted])
+
+
+def _cane(m: Any, cane: dict[str, Any]) -> Any:
+    """A fitted cane (its polynomial's coefficients, (3, degree + 1), over u in [0, 1])
+    as an amber line of its thickness."""
+    coeffs = np.asarray(cane["coeffs"], float)
+    u = np.linspace(0.0, 1.0, 40)
+    points = coeffs @ np.vander(u, coeffs.shape[1], increasing=True).T
+    return m.LinePrimitive(
+        type=m.LinePrimitiveLineType.LineStrip,
+        thickness=2.0 * float(cane.get("radius_m") or 0.004), scale_invariant=False,
+        points=[m.Point3(x=x, y=y, z=z) for x, y, z in points.T],
+        color=m.Color(r=1.0, g=0.78, b=0.0, a=1.0),
+    )  # fmt: skip
 
 
 class _Subscribed:
