@@ -12,7 +12,7 @@ import json
 import sys
 
 from softarm.commands._args import Parser, non_negative_int, output_dir
-from softarm.commands._format import rounded
+from softarm.formatting import rounded
 
 
 def main(argv: list[str] | None = None) -> int:

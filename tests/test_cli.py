@@ -17,7 +17,7 @@ import pytest
 import softarm
 from softarm import _core, cli
 from softarm.commands._args import output_dir, output_file
-from softarm.commands._format import rounded
+from softarm.formatting import rounded
 
 
 def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:

@@ -79,7 +79,7 @@ class _FakeMachine:
         self.vents.append(reason)
 
     def run(self, berries: object) -> object:
-        from softarm.commands._signals import Interrupted
+        from softarm.stops import Interrupted
 
         raise Interrupted(signal.SIGTERM)  # as the handler does, mid-run
 

@@ -3,8 +3,8 @@ errors, a berry grasped outside tolerance flagged, and counts in the singular fo
 
 from __future__ import annotations
 
-from softarm.commands._format import plural
 from softarm.commands.harvest import Tolerance, line, summary
+from softarm.formatting import plural
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.states import HarvestState
 

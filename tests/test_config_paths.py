@@ -141,7 +141,8 @@ def test_a_stop_during_set_up_is_in_the_log(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """SIGTERM while the config is read: the log, opened first, records it."""
-    from softarm.commands import _signals, harvest
+    from softarm import stops as _signals
+    from softarm.commands import harvest
 
     def stopped(args: object) -> None:
         _signals._raise(signal.SIGTERM, None)
@@ -159,7 +160,8 @@ def test_the_exit_message_names_no_log_it_did_not_write(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A stop before the log is opened (reading --gains) must not name the log."""
-    from softarm.commands import _signals, harvest
+    from softarm import stops as _signals
+    from softarm.commands import harvest
 
     def stopped(args: object) -> None:
         _signals._raise(signal.SIGINT, None)

@@ -16,10 +16,10 @@ from typing import Any
 
 import pytest
 
-from softarm.commands._signals import Interrupted
 from softarm.errors import OutputError
 from softarm.sim.render import dataset
 from softarm.sim.render.dataset_ray import IN_FLIGHT_PER_WORKER, on_ray
+from softarm.stops import Interrupted
 
 #: What write_dataset reads of its rig once the images are rendered (the bush world).
 RIG = SimpleNamespace(world_kind="bush")

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from softarm.cli import main
-from softarm.commands._signals import drives_arm
+from softarm.stops import drives_arm
 
 
 @pytest.fixture(autouse=True)
@@ -166,8 +166,8 @@ def test_the_renderers_are_all_freed_before_a_stop_is_raised() -> None:
     """Item 15: a SIGTERM while the bush harvest freed its renderers cut an EGL context's
     free in half; the outer close then failed on it (EGL_BAD_CONTEXT, a traceback, exit
     1). Every renderer is freed, once, and then the stop is raised."""
-    from softarm.commands._signals import Interrupted, raise_on_signals
     from softarm.sim.render.renderer import BushRenderer
+    from softarm.stops import Interrupted, raise_on_signals
 
     freed: list[int] = []
 

@@ -1,5 +1,5 @@
 """Every command that can pressurise the arm takes SIGINT/SIGTERM the same way, from
-``softarm.commands._signals``: the arm vented, the stop logged, exit status 130/143, one
+``softarm.stops``: the arm vented, the stop logged, exit status 130/143, one
 line on stderr and no traceback (issue 26, item 1). ``softarm calibrate`` had no handling
 at all: SIGTERM killed it where it stood, skipping the ``finally`` that vents."""
 
@@ -18,7 +18,7 @@ import pytest
 from child_signals import default_signals
 from softarm import cli
 from softarm.commands import calibrate, demo, harvest, identify
-from softarm.commands._signals import Interrupted, stop_arm
+from softarm.stops import Interrupted, stop_arm
 
 
 @pytest.fixture(autouse=True)

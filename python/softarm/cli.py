@@ -17,8 +17,8 @@ from collections.abc import Sequence
 
 import softarm
 from softarm.commands._args import Parser
-from softarm.commands._signals import Interrupted
 from softarm.errors import SoftarmError
+from softarm.stops import Interrupted
 
 #: Subcommand name -> module implementing it.
 COMMANDS: dict[str, str] = {

@@ -4,7 +4,7 @@ the next close, or its finalizer at exit, then fails (``EGL_BAD_CONTEXT``) and t
 traceback replaces the stop.
 
 :func:`uninterrupted` marks such a section; the command's signal handler
-(:mod:`softarm.commands._signals`) asks :func:`defer` first, and a stop that arrives
+(:mod:`softarm.stops`) asks :func:`defer` first, and a stop that arrives
 inside is raised when the section ends. A leaf: any layer may use it.
 """
 

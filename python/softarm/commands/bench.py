@@ -14,7 +14,7 @@ from collections.abc import Callable
 import numpy as np
 
 from softarm.commands._args import float_range
-from softarm.commands._format import rounded
+from softarm.formatting import rounded
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

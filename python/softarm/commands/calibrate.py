@@ -9,8 +9,8 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from softarm.commands._args import add_quiet, config_file, int_range, non_negative_int, output_file
-from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
+from softarm.stops import drives_arm
 
 if TYPE_CHECKING:
     from softarm.calibration import Calibration

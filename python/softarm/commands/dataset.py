@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING
 
 from softarm.commands._args import add_quiet, float_range, int_range, output_dir, positive_int
 from softarm.commands._looks import LOOKS
-from softarm.commands._signals import stops_on_signals
 from softarm.errors import ParameterError
+from softarm.stops import stops_on_signals
 
 if TYPE_CHECKING:
     from softarm.sim.render.dataset import DatasetRig

@@ -6,8 +6,8 @@ import argparse
 
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
 from softarm.commands._plant import add_plant_options, plant_options
-from softarm.commands._signals import drives_arm
 from softarm.commands.harvest import MAX_BERRIES
+from softarm.stops import drives_arm
 
 #: What the demo writes into --out.
 OUTPUTS = ("harvest.png", "harvest_report.json", "harvest_log.jsonl")

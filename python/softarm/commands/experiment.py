@@ -11,8 +11,8 @@ import time
 from typing import Any
 
 from softarm.commands._args import add_quiet, non_negative_int, output_dir, output_file
-from softarm.commands._format import rounded
 from softarm.commands._progress import Progress
+from softarm.formatting import rounded
 
 NAMES = ("position", "orientation", "hybrid", "schedule")
 

@@ -32,7 +32,6 @@ from softarm.commands._dry_run import (
     replay_devices,
     replay_rounds,
 )
-from softarm.commands._format import plural
 from softarm.commands._looks import LOOKS
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
@@ -43,9 +42,10 @@ from softarm.commands._run_info import (
     start_log,
     write_run_bag,
 )
-from softarm.commands._signals import drives_arm, records_late_stop, vents_on_stop
 from softarm.errors import ConfigError, HardwareUnavailableError, ParameterError
+from softarm.formatting import plural
 from softarm.harvest_config import HarvestConfig
+from softarm.stops import drives_arm, records_late_stop, vents_on_stop
 
 if TYPE_CHECKING:
     from softarm.config import Config

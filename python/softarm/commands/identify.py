@@ -14,8 +14,8 @@ import sys
 from typing import TYPE_CHECKING
 
 from softarm.commands._args import add_quiet, config_file, non_negative_int, output_file
-from softarm.commands._signals import drives_arm
 from softarm.errors import HardwareUnavailableError
+from softarm.stops import drives_arm
 
 if TYPE_CHECKING:
     from softarm.commands._progress import Progress

@@ -7,7 +7,7 @@ import argparse
 import json
 
 from softarm.commands._args import image_file, int_range
-from softarm.commands._format import rounded
+from softarm.formatting import rounded
 from softarm.planning.scenarios import SCENARIOS
 
 

@@ -13,11 +13,11 @@ from softarm.commands._args import (
     output_file,
     positive_int,
 )
-from softarm.commands._format import plural
 from softarm.commands._run_info import check_bag, write_log_bag
-from softarm.commands._signals import stops_on_signals
 from softarm.commands.harvest import MAX_BERRIES
 from softarm.errors import ParameterError
+from softarm.formatting import plural
+from softarm.stops import stops_on_signals
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

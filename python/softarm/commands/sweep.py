@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from softarm.commands._args import add_quiet
-from softarm.commands._format import plural
+from softarm.formatting import plural
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

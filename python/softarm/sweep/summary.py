@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from softarm.commands._format import plural
+from softarm.formatting import plural
 
 __all__ = ["GroupStats", "axis_label", "group_stats", "markdown_summary", "plot_summary"]
 

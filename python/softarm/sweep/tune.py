@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from softarm.commands._format import plural
 from softarm.errors import ConfigError
+from softarm.formatting import plural
 from softarm.sweep._deps import require
 from softarm.sweep.gains_file import gains_from, write_gains
 from softarm.sweep.runner import init_ray

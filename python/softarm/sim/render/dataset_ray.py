@@ -14,7 +14,7 @@ Two things a plain ``ray.wait`` loop gets wrong:
   only noted (:class:`_Stops`; Ray's own SIGTERM handlers are not installed, nor the
   C++ failure handler: ``RAY_DISABLE_FAILURE_SIGNAL_HANDLER``), ``ray.wait`` wakes
   every :data:`WAKE_S`, and a noted stop is handed to the handler that was in place
-  (``softarm dataset``'s raises :class:`~softarm.commands._signals.Interrupted`)
+  (``softarm dataset``'s raises :class:`~softarm.stops.Interrupted`)
   between two calls into Ray: it unwinds through ``ray.shutdown``.
 """
 
