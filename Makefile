@@ -47,8 +47,8 @@ test-rust:
 	cargo test --release -p softarm-core
 
 # The optional extras whose tests run in CI: Ray sweeps, the Cosserat rod, the rerun view,
-# the rendered bush.
-TEST_EXTRAS := test,sweep,cosserat,viz,render,ros,foxglove
+# the rendered bush, the detector's training (JAX CPU: installs in ~15 s, its tests ~1 min).
+TEST_EXTRAS := test,sweep,cosserat,viz,render,ros,foxglove,train
 
 dev-all: venv
 	$(VENV)/bin/maturin develop --release --extras $(TEST_EXTRAS) -q

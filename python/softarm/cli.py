@@ -36,6 +36,8 @@ COMMANDS: dict[str, str] = {
     "replay": "softarm.commands.replay",
     "dataset": "softarm.commands.dataset",
     "camera": "softarm.commands.camera",
+    "detect": "softarm.commands.detect",
+    "detector": "softarm.commands.detector",
 }
 
 

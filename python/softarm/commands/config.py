@@ -65,6 +65,7 @@ PERCEPTION = """\
 # calibration = "stereo.yml"  # from `softarm camera calibrate`, next to this file
 # berries = "markerless"  # or "tags"
 # survey = true  # false: no C2 views of the bush before the first berry (C1's canes only)
+# detector = "colour"  # the berry detector: "colour", "net" or "net+colour" (docs/perception.md)
 """
 
 HEADER = """\

@@ -39,6 +39,7 @@ from softarm.harvest.states import FAULTS_THAT_STOP
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_vision import BushVision
+from softarm.perception.detector.choice import use_detector
 from softarm.vision import MarkerCube
 from softarm.vision.camera_model import camera_from_config
 from softarm.vision.poses import invert
@@ -182,6 +183,7 @@ def _stereo_c1(config: Config, devices: Devices, stack: ExitStack) -> StereoC1 |
     perception = config.perception
     if perception is None:
         return None
+    use_detector(perception.detector)  # [perception] detector: read its weights now
     T_base_c1 = invert(np.array(config.calibration.T_C1_base))
     stereo = stereo_camera(perception, T_base_c1)
     c1 = StereoC1(stereo, devices.stereo(perception, stack))

@@ -1,0 +1,75 @@
+"""``softarm detect IMAGE``: the berries a detector finds in one photo, printed and drawn."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import cast
+
+from softarm.commands._args import image_file
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Register the ``detect`` subcommand."""
+    from softarm.perception.detector.choice import DEFAULT_DETECTOR, DETECTORS
+
+    p = sub.add_parser(
+        "detect",
+        help="find the berries in one photo (printed, and drawn with --out)",
+        description="Runs the berry detector on IMAGE (any format OpenCV reads) and prints "
+        "each berry: its stage, score, centre and radius in pixels, and with --depth its "
+        "position in the camera frame. --depth is a 16-bit PNG in millimetres or a .npy in "
+        "metres, aligned with IMAGE; --camera a camera file (softarm JSON, OpenCV or ROS "
+        "YAML; default: an ideal camera whose focal length is the image's longer side). "
+        "See docs/perception.md.",
+    )
+    p.add_argument("image", type=Path, help="the photo")
+    p.add_argument("--depth", type=Path, help="aligned depth image (16-bit PNG mm, or .npy m)")
+    p.add_argument("--camera", type=Path, help="camera file of the photo")
+    p.add_argument("--out", type=image_file, help="write the annotated picture here")
+    p.add_argument("--detector", choices=DETECTORS, default=DEFAULT_DETECTOR, help="detector")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Exit 0 once the berries are printed (none found is no error)."""
+    import cv2
+    import numpy as np
+    import numpy.typing as npt
+
+    from softarm.errors import InputError
+    from softarm.perception.detector.choice import detector
+    from softarm.perception.detector.draw import draw_detections, write_image
+    from softarm.perception.detector.evaluate import read_depth
+    from softarm.perception.detector.scoring import stage_of_detection
+    from softarm.vision.camera_model import CameraModel
+
+    image = cast(npt.NDArray[np.uint8] | None, cv2.imread(str(args.image), cv2.IMREAD_COLOR))
+    if image is None:
+        raise InputError(f"IMAGE {args.image}: not an image OpenCV can read")
+    h, w = image.shape[:2]
+    camera = (
+        CameraModel.load(args.camera) if args.camera is not None
+        else CameraModel.ideal(float(max(w, h)), w, h)
+    )  # fmt: skip
+    depth = None
+    if args.depth is not None:
+        depth = read_depth(args.depth.parent, args.depth, (h, w))
+        if depth is None:
+            raise InputError(
+                f"--depth {args.depth}: not a 16-bit PNG or .npy of the image's size {w}x{h}"
+            )
+    dets = list(detector(args.detector).detect_berries(image, camera, depth))
+    stages = [stage_of_detection(d) for d in dets]
+    for d, stage in zip(dets, stages, strict=True):
+        where = "" if d.position is None else " at ({:.3f}, {:.3f}, {:.3f}) m".format(*d.position)
+        print(
+            f"{stage:8s} score {d.score:.2f}  centre ({d.center[0]:.1f}, {d.center[1]:.1f}) px"
+            f"  radius {d.radius:.1f} px{where}"
+        )
+    counts = ", ".join(f"{stages.count(s)} {s}" for s in ("ripe", "turning", "unripe"))
+    print(f"detect: {len(dets)} berries ({counts}) by {args.detector} in {args.image}")
+    if args.out is not None:
+        write_image(args.out, draw_detections(image, dets))
+        print(f"detect: annotated picture -> {args.out}")
+    return 0

@@ -1,0 +1,115 @@
+"""``softarm detector evaluate|train``: the berry detector measured on labelled images, and
+the learned one trained (the ``train`` extra) on rendered or labelled images."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from softarm.commands._args import add_quiet, int_range, output_dir, output_file
+
+#: Most epochs a user may ask for (a typo's extra zeros, not a real run).
+MAX_EPOCHS = 10_000
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Register the ``detector`` subcommand and its two actions."""
+    p = sub.add_parser(
+        "detector",
+        help="evaluate the berry detector on labelled images, or train the learned one",
+        description="evaluate: precision, recall, ripeness, a confusion table by stage and "
+        "one annotated picture per image, against COCO labels (softarm dataset, CVAT or "
+        "Label Studio exports). train: the learned detector from softarm dataset output or "
+        "labelled photos (needs the train extra). See docs/perception.md.",
+    )
+    actions = p.add_subparsers(dest="action", required=True, metavar="ACTION")
+    _add_evaluate(actions)
+    _add_train(actions)
+
+
+def _add_evaluate(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    from softarm.perception.detector.choice import DEFAULT_DETECTOR, DETECTORS
+
+    e = actions.add_parser(
+        "evaluate",
+        help="score a detector against COCO labels",
+        description="A detection matches a labelled fruit at mask IoU >= 0.3; recall and "
+        "stage count fruit at least half visible (or of unknown share). --depth: a folder "
+        "of depth images named as the images (16-bit PNG mm or .npy m) adds the "
+        "localisation error; --camera: the camera file (default: each image's camera in "
+        "the COCO file, else an ideal one).",
+    )
+    e.add_argument("--images", type=Path, required=True, help="folder of the images")
+    e.add_argument("--labels", type=Path, required=True, help="COCO file")
+    e.add_argument("--depth", type=Path, help="folder of aligned depth images")
+    e.add_argument("--camera", type=Path, help="camera file")
+    e.add_argument("--out", type=output_dir, help="folder for metrics.json and the pictures")
+    e.add_argument("--detector", choices=DETECTORS, default=DEFAULT_DETECTOR, help="detector")
+    add_quiet(e)
+    e.set_defaults(run=run_evaluate)
+
+
+def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    t = actions.add_parser(
+        "train",
+        help="train the learned detector (the train extra: JAX, optax, onnx)",
+        description="Trains the segmentation network on augmented crops of the images of "
+        "each --data folder (softarm dataset output, or a folder with one COCO file of "
+        "labelled photos; --data may be given more than once, to mix photos with renders) "
+        "and writes it as ONNX, with OUT's name and .json for the training record. "
+        "Deterministic for a seed. --from default fine-tunes the shipped weights.",
+    )
+    t.add_argument("--data", type=Path, action="append", required=True, help="data folder")
+    t.add_argument("--out", type=output_file, required=True, help="ONNX file to write")
+    t.add_argument("--epochs", type=int_range(1, MAX_EPOCHS), default=30, help="epochs")
+    t.add_argument("--seed", type=int_range(0, 2**31 - 1), default=0, help="seed")
+    t.add_argument(
+        "--from", dest="start", metavar="WEIGHTS",
+        help="start from these weights ('default': the shipped ones) instead of fresh ones",
+    )  # fmt: skip
+    add_quiet(t)
+    t.set_defaults(run=run_train)
+
+
+def run_evaluate(args: argparse.Namespace) -> int:
+    """Exit 0 with the figures printed (and written with --out)."""
+    from softarm.commands._progress import Progress
+    from softarm.perception.detector.choice import detector
+    from softarm.perception.detector.evaluate import evaluate
+    from softarm.vision.camera_model import CameraModel
+
+    det = detector(args.detector)
+    camera = None if args.camera is None else CameraModel.load(args.camera)
+    with Progress(None, "evaluate", "image", args.quiet) as progress:
+        figures = evaluate(
+            det, args.labels, args.images, args.depth, camera, args.out, progress.advance
+        )
+    shown = {k: v for k, v in figures.items() if k != "per_image"}
+    print(json.dumps(shown, indent=1))
+    if args.out is not None:
+        print(f"detector evaluate: {figures['images']} images -> {args.out}")
+    return 0
+
+
+def run_train(args: argparse.Namespace) -> int:
+    """Exit 0 once the weights and their record are written."""
+    from softarm.perception.detector.network import DEFAULT_WEIGHTS
+    from softarm.perception.detector.train import require_train_extra, train
+
+    require_train_extra()
+    start = DEFAULT_WEIGHTS if args.start == "default" else args.start
+
+    def on_epoch(epoch: int, loss: float, seconds: float) -> None:
+        if not args.quiet:
+            print(f"epoch {epoch}/{args.epochs}: loss {loss:.4f} ({seconds:.1f} s)", flush=True)
+
+    record = train(args.data, args.out, args.epochs, args.seed, start, on_epoch)
+    print(
+        f"detector train: {args.epochs} epochs in {record['seconds']} s on "
+        f"{record['device']} -> {args.out} (record {Path(args.out).with_suffix('.json')})"
+    )
+    return 0
+
+
+__all__ = ["add_parser"]

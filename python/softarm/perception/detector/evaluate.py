@@ -1,0 +1,126 @@
+"""``softarm detector evaluate``'s work: a detector run over labelled images (COCO from
+``softarm dataset``, CVAT or Label Studio), scored (:mod:`.scoring`) and drawn
+(:mod:`.draw`), with depth where the user gives it.
+
+Depth: a folder with, for each image, a file of the same stem: a 16-bit PNG in
+millimetres (as ``softarm dataset`` and RealSense tools write it) or a ``.npy`` in metres,
+aligned with the colour image. The camera: a file (``CameraModel.load``'s formats), else
+each image record's ``camera`` (``softarm dataset``), else an ideal camera whose focal
+length is the image's longer side (only the physical-size check and positions use it)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, cast
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import InputError
+from softarm.perception.berries import _position
+from softarm.perception.detector.choice import BerryDetector
+from softarm.perception.detector.draw import draw_detections, write_image
+from softarm.perception.detector.labels import LabelledImage, LabelledObject, read_coco
+from softarm.perception.detector.scoring import Tally
+from softarm.vision.camera_model import CameraModel
+
+__all__ = ["evaluate", "read_depth"]
+
+
+def read_depth(folder: Path, image: Path, shape: tuple[int, int]) -> npt.NDArray[np.float32] | None:
+    """The depth (m, NaN unknown) of ``image`` in ``folder``, None when there is none of
+    its size."""
+    for suffix in (".png", ".npy"):
+        path = folder / (image.stem + suffix)
+        if not path.is_file():
+            continue
+        if suffix == ".npy":
+            depth = np.load(path).astype(np.float32)
+        else:
+            raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+            if raw is None or raw.dtype != np.uint16:
+                continue
+            depth = raw.astype(np.float32) / 1000.0
+        if depth.shape != shape:
+            return None
+        depth[~np.isfinite(depth) | (depth <= 0)] = np.nan
+        return cast(npt.NDArray[np.float32], depth)
+    return None
+
+
+def _camera(item: LabelledImage, camera: CameraModel | None) -> CameraModel:
+    if camera is not None:
+        return camera
+    record = item.record.get("camera")
+    if isinstance(record, dict) and "matrix" in record:
+        try:
+            distortion = np.asarray(record.get("distortion") or np.zeros(5), float)
+            return CameraModel(np.asarray(record["matrix"], float), distortion)
+        except (ValueError, TypeError):
+            pass
+    return CameraModel.ideal(float(max(item.width, item.height)), item.width, item.height)
+
+
+def _truth(
+    fruit: list[LabelledObject], camera: CameraModel, depth: npt.NDArray[np.float32] | None
+) -> list[np.ndarray[Any, Any] | None] | None:
+    """Each fruit's true position: the labels' where they give it, else its mask and the
+    depth placed as the detector places a berry."""
+    if depth is None:
+        return None
+    out: list[np.ndarray[Any, Any] | None] = []
+    for f in fruit:
+        if f.position is not None:
+            out.append(f.position)
+            continue
+        rows, cols = np.nonzero(f.mask)
+        radius = float(np.sqrt(rows.size / np.pi))
+        out.append(_position(f.mask, (cols.mean(), rows.mean()), radius, camera, depth))
+    return out
+
+
+def evaluate(
+    detector: BerryDetector,
+    labels: str | Path,
+    images: str | Path,
+    depth: str | Path | None = None,
+    camera: CameraModel | None = None,
+    out: str | Path | None = None,
+    on_image: Callable[[], None] = lambda: None,
+) -> dict[str, Any]:
+    """The figures of ``detector`` on the labelled images (also written to
+    OUT/metrics.json with one annotated picture per image when ``out`` is given).
+
+    Raises:
+        InputError: the labels cannot be read, or name no image found in ``images``.
+    """
+    items = read_coco(labels, images)
+    if not items:
+        raise InputError(f"labels {labels}: none of its images is in {images}")
+    tally, per_image = Tally(), list[dict[str, Any]]()
+    for item in items:
+        image = cast(npt.NDArray[np.uint8] | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
+        if image is None:
+            per_image.append({"image": item.path.name, "error": "unreadable"})
+            continue
+        cam = _camera(item, camera)
+        d = None if depth is None else read_depth(Path(depth), item.path, image.shape[:2])
+        dets = list(detector.detect_berries(image, cam, d))
+        fruit = [o for o in item.objects() if o.is_fruit]
+        pairs = tally.add(dets, fruit, _truth(fruit, cam, d))
+        per_image.append({"image": item.path.name, "detections": len(dets), "matched": len(pairs)})
+        if out is not None:
+            write_image(
+                Path(out) / (item.path.stem + ".png"), draw_detections(image, dets, fruit, pairs)
+            )
+        on_image()
+    figures = tally.figures()
+    figures["per_image"] = per_image
+    if out is not None:
+        from softarm.files import write_text
+
+        write_text(Path(out) / "metrics.json", json.dumps(figures, indent=1) + "\n", "metrics")
+    return figures

@@ -1,0 +1,192 @@
+"""From the network's per-pixel output to berries: fruit pixels (ripe, turning and unripe
+together) split into connected parts; a part with two or more peaks of the centre
+heatmap (fruit that touch) is split between them, each pixel going to its nearest peak;
+each instance's stage is the stage most of its pixels' probability says. Everything runs
+at the network's resolution; each instance's mask is then resized to the image, and
+placed and sized as :mod:`softarm.perception.berries` places and sizes its blobs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import cast
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.perception.berries import (
+    MAX_BLOBS,
+    BerryDetection,
+    DetectorSettings,
+    Ripeness,
+    _fruit_sized,
+    _position,
+)
+from softarm.perception.detector.network import NetworkOutput
+from softarm.vision.camera_model import CameraModel
+
+__all__ = ["FRUIT_THRESHOLD", "StagedDetection", "instances"]
+
+#: A pixel is fruit where the three stages' probabilities sum to more than this.
+FRUIT_THRESHOLD = 0.5
+#: A centre-heatmap peak must reach this to seed an instance.
+PEAK_THRESHOLD = 0.35
+#: Fewest network pixels an instance may have (two or three image pixels across at the
+#: network's scale: smaller parts are speckle, not fruit C1 could place).
+MIN_PIXELS = 6
+#: Two peaks closer than this (network px) are one fruit's: touching fruit of C1's
+#: size are 6 or more apart at the network's scale.
+PEAK_SEPARATION = 3.0
+_STAGES = ("ripe", "turning", "unripe")
+_U8 = npt.NDArray[np.uint8]
+
+
+@dataclass(frozen=True)
+class StagedDetection(BerryDetection):
+    """A :class:`BerryDetection` with the fruit's ``stage`` ("ripe", "turning" or
+    "unripe"; ``ripeness`` is "ripe" only for ripe, since turning fruit is not ripe)."""
+
+    stage: str = "ripe"
+
+
+def _peaks(centres: npt.NDArray[np.float32], part: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """(row, col) of the heatmap's local maxima inside ``part``."""
+    grown = cv2.dilate(centres, np.ones((3, 3), np.uint8))
+    rows, cols = np.nonzero(part & (centres >= grown) & (centres >= PEAK_THRESHOLD))
+    order = np.argsort(-centres[rows, cols], kind="stable")
+    kept: list[tuple[int, int]] = []
+    for r, c in zip(rows[order].tolist(), cols[order].tolist(), strict=True):
+        # A plateau or a ragged peak gives neighbours of one centre: keep the strongest.
+        if all((r - kr) ** 2 + (c - kc) ** 2 > PEAK_SEPARATION**2 for kr, kc in kept):
+            kept.append((r, c))
+    return kept
+
+
+def _split(
+    part: npt.NDArray[np.bool_], peaks: list[tuple[int, int]]
+) -> list[npt.NDArray[np.bool_]]:
+    """``part`` divided between its ``peaks`` (each pixel to the nearest)."""
+    if len(peaks) < 2:
+        return [part]
+    rows, cols = np.nonzero(part)
+    seeds = np.asarray(peaks, float)
+    d = (rows[:, None] - seeds[None, :, 0]) ** 2 + (cols[:, None] - seeds[None, :, 1]) ** 2
+    owner = np.argmin(d, axis=1)
+    out = []
+    for k in range(len(peaks)):
+        m = np.zeros_like(part)
+        m[rows[owner == k], cols[owner == k]] = True
+        out.append(m)
+    return out
+
+
+#: An instance at the network's resolution: its mask over its window, and the window's
+#: (x, y) in the network's map.
+Piece = tuple[npt.NDArray[np.bool_], int, int]
+
+
+def instance_masks(output: NetworkOutput, fruit: npt.NDArray[np.float32]) -> list[Piece]:
+    """The fruit instances at the network's resolution (``fruit``: output.fruit())."""
+    binary = cast(_U8, (fruit > FRUIT_THRESHOLD).astype(np.uint8))
+    binary = cast(_U8, cv2.morphologyEx(binary, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)))
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+    out = []
+    for k in range(1, n):
+        x, y, w, h, area = (int(v) for v in stats[k])
+        if area < MIN_PIXELS:
+            continue
+        part = labels[y : y + h, x : x + w] == k
+        for piece in _split(part, _peaks(output.centres[y : y + h, x : x + w], part)):
+            if np.count_nonzero(piece) >= MIN_PIXELS:
+                out.append((piece, x, y))
+    return out
+
+
+def instances(
+    output: NetworkOutput,
+    camera: CameraModel,
+    depth: npt.NDArray[np.floating] | None,
+    settings: DetectorSettings,
+) -> list[StagedDetection]:
+    """The berries of ``output`` (for an image of ``output.size``), placed with ``depth``
+    where it is given (and then only those of a fruit's physical size)."""
+    out = []
+    fruit = output.fruit()
+    pieces = instance_masks(output, fruit)
+    if len(pieces) > MAX_BLOBS:  # a patterned frame of specks: the largest, bounded time
+        pieces = sorted(pieces, key=lambda p: -int(np.count_nonzero(p[0])))[:MAX_BLOBS]
+    for piece in pieces:
+        det = _detection(output, fruit, piece, camera, depth, settings)
+        if det is not None:
+            out.append(det)
+    return out
+
+
+def _upsampled(output: NetworkOutput, piece: Piece) -> Piece | None:
+    """``piece`` at the image's resolution: the mask over its box and the box's (x, y),
+    resizing only the instance's own window (with a pixel to spare) as
+    :meth:`NetworkOutput.upsample` resizes the whole map."""
+    small, px, py = piece
+    x, y, w, h = cv2.boundingRect(small.astype(np.uint8))
+    net_h, net_w = output.centres.shape
+    x0, y0 = max(px + x - 1, 0), max(py + y - 1, 0)
+    x1, y1 = min(px + x + w + 1, net_w), min(py + y + h + 1, net_h)
+    window = np.zeros((y1 - y0, x1 - x0), np.float32)
+    wy, wx = py + y - y0, px + x - x0
+    window[wy : wy + h, wx : wx + w] = small[y : y + h, x : x + w]
+    width, height = output.size
+    sx, sy = width / net_w, height / net_h
+    ox, oy = round(x0 * sx), round(y0 * sy)
+    size = (min(round(x1 * sx), width) - ox, min(round(y1 * sy), height) - oy)
+    up = cv2.resize(window, size, interpolation=cv2.INTER_LINEAR) >= 0.5
+    if not up.any():
+        return None
+    bx, by, bw, bh = cv2.boundingRect(up.astype(np.uint8))
+    return np.ascontiguousarray(up[by : by + bh, bx : bx + bw]), ox + bx, oy + by
+
+
+def _detection(
+    output: NetworkOutput,
+    fruit: npt.NDArray[np.float32],
+    piece: Piece,
+    camera: CameraModel,
+    depth: npt.NDArray[np.floating] | None,
+    s: DetectorSettings,
+) -> StagedDetection | None:
+    small, px, py = piece
+    window = (slice(py, py + small.shape[0]), slice(px, px + small.shape[1]))
+    stage_mass = output.probabilities[window][small][:, 1:4].sum(axis=0)
+    stage = _STAGES[int(np.argmax(stage_mass))]
+    p_ripe = float(stage_mass[0] / max(float(stage_mass.sum()), 1e-9))
+    score = float(np.clip(fruit[window][small].mean(), 0.0, 1.0))
+    upsampled = _upsampled(output, piece)
+    if upsampled is None:
+        return None
+    # The instance's own box only, as berries.py keeps its blobs' masks.
+    mask, bx, by = upsampled
+    bh, bw = mask.shape
+    box = (slice(by, by + bh), slice(bx, bx + bw))
+    m = cv2.moments(mask.astype(np.uint8), binaryImage=True)
+    cx, cy = bx + m["m10"] / m["m00"], by + m["m01"] / m["m00"]
+    radius = float(np.sqrt(m["m00"] / np.pi))
+    position = None
+    if depth is not None:
+        position = _position(mask, (cx, cy), radius, camera, depth[box])
+        if position is not None and not _fruit_sized(radius, float(position[2]), camera, s):
+            return None
+    ripeness: Ripeness = "ripe" if stage == "ripe" else "unripe"
+    return StagedDetection(
+        center=(float(cx), float(cy)),
+        radius=radius,
+        box=(int(bx), int(by), int(bw), int(bh)),
+        mask=mask,
+        score=score,
+        ripeness=ripeness,
+        probability=p_ripe if ripeness == "ripe" else 1.0 - p_ripe,
+        position=position,
+        radius_m=None
+        if position is None
+        else radius * float(np.linalg.norm(position)) / camera.focal,
+        mask_offset=(int(bx), int(by)),
+        stage=stage,
+    )

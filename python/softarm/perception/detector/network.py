@@ -1,0 +1,135 @@
+"""The learned berry detector's network at run time: an ONNX segmentation net run through
+OpenCV's DNN module (``cv2.dnn.readNetFromONNX``), so that inference needs nothing beyond
+softarm's runtime dependencies; the training code (``softarm detector train``, the
+``train`` extra) writes the file.
+
+The convention both sides share: the input ``image`` is (1, 3, H, W) float32, the BGR
+image divided by 255, less 0.5, over 0.25, with H and W multiples of :data:`STRIDE`; the
+output is (1, :data:`N_OUTPUTS`, H, W): one logit per class of :data:`CLASSES` at each
+pixel and, last, the logit of the fruit-centre heatmap (a peak at each fruit's centre).
+Images are resized so that their longer side is at most :data:`MAX_SIDE` pixels (the
+scale the training renders were drawn at: C1's 1280 × 720 eye at half size).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import cast
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import VisionError
+
+__all__ = [
+    "CLASSES",
+    "DEFAULT_WEIGHTS",
+    "MAX_SIDE",
+    "N_OUTPUTS",
+    "STRIDE",
+    "Network",
+    "NetworkOutput",
+    "normalise",
+]
+
+#: Per-pixel classes, in the order of the network's first outputs.
+CLASSES = ("background", "ripe", "turning", "unripe", "cane")
+#: Class logits and the centre heatmap's logit.
+N_OUTPUTS = len(CLASSES) + 1
+#: The network pools three times: input sides must be multiples of 8.
+STRIDE = 8
+#: The longer side (px) an image is shrunk to before the network sees it.
+MAX_SIDE = 640
+#: The weights that ship in the package.
+DEFAULT_WEIGHTS = Path(__file__).parent / "weights" / "berries.onnx"
+
+_F32 = npt.NDArray[np.float32]
+_U8 = npt.NDArray[np.uint8]
+
+
+def normalise(image: _U8) -> _F32:
+    """The network's input scaling of a BGR uint8 image (any shape), as float32."""
+    return cast(_F32, (image.astype(np.float32) * np.float32(1 / 255.0) - 0.5) * 4.0)
+
+
+class NetworkOutput:
+    """The network's output for one image, at the network's resolution: ``probabilities``
+    (h, w, len(CLASSES)) float32 summing to 1 per pixel and ``centres`` (h, w) float32 in
+    [0, 1]; ``size`` (W, H) is the image's, :meth:`upsample` brings a map to it."""
+
+    def __init__(self, probabilities: _F32, centres: _F32, size: tuple[int, int]) -> None:
+        self.probabilities = probabilities
+        self.centres = centres
+        self.size = size
+
+    @property
+    def scale(self) -> float:
+        """Image pixels per network pixel (1 or more)."""
+        return float(self.size[0] / self.probabilities.shape[1])
+
+    def fruit(self) -> _F32:
+        """(h, w) probability that a pixel is fruit of any stage."""
+        return cast(_F32, self.probabilities[..., 1:4].sum(axis=2))
+
+    def upsample(self, values: _F32) -> _F32:
+        """A (h, w) map resized to the image (bilinear)."""
+        if values.shape[::-1] == self.size:
+            return values
+        return cast(_F32, cv2.resize(values, self.size, interpolation=cv2.INTER_LINEAR))
+
+
+class Network:
+    """An ONNX segmentation network of this module's convention, read from ``path``.
+
+    Raises:
+        VisionError: the file is missing, is not an ONNX network, or gives outputs of
+            the wrong shape (the message names the file).
+    """
+
+    def __init__(self, path: str | Path = DEFAULT_WEIGHTS) -> None:
+        self.path = Path(path)
+        if not self.path.is_file():
+            raise VisionError(f"detector weights {self.path}: no such file")
+        try:
+            net = cv2.dnn.readNetFromONNX(str(self.path))
+        except cv2.error as exc:
+            reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else "unreadable"
+            raise VisionError(
+                f"detector weights {self.path}: not a readable ONNX network ({reason})"
+            ) from None
+        if net.empty():
+            raise VisionError(f"detector weights {self.path}: the ONNX network is empty")
+        self._net = net
+        probe = self._forward(np.zeros((1, 3, STRIDE * 2, STRIDE * 2), np.float32))
+        if probe.shape != (1, N_OUTPUTS, STRIDE * 2, STRIDE * 2):
+            raise VisionError(
+                f"detector weights {self.path}: the network gives {probe.shape}, not "
+                f"(1, {N_OUTPUTS}, H, W)"
+            )
+
+    def _forward(self, blob: _F32) -> _F32:
+        try:
+            self._net.setInput(blob)
+            return cast(_F32, np.asarray(self._net.forward(), np.float32))
+        except cv2.error as exc:
+            raise VisionError(f"detector weights {self.path}: the network failed: {exc}") from None
+
+    def run(self, image: _U8) -> NetworkOutput:
+        """The class probabilities and centre heatmap of a BGR uint8 (H, W, 3) image, at
+        the network's resolution (the image shrunk to MAX_SIDE)."""
+        h, w = image.shape[:2]
+        scale = min(1.0, MAX_SIDE / max(h, w))
+        sw, sh = max(1, round(w * scale)), max(1, round(h * scale))
+        small = image if scale == 1.0 else cv2.resize(image, (sw, sh), interpolation=cv2.INTER_AREA)
+        pw, ph = -sw % STRIDE, -sh % STRIDE
+        padded = cast(_U8, cv2.copyMakeBorder(small, 0, ph, 0, pw, cv2.BORDER_REFLECT))
+        blob = normalise(padded).transpose(2, 0, 1)[None]
+        out = self._forward(np.ascontiguousarray(blob))[0, :, :sh, :sw]
+        logits = out[: len(CLASSES)]
+        e = np.exp(logits - logits.max(axis=0, keepdims=True))
+        probs = (e / e.sum(axis=0, keepdims=True)).transpose(1, 2, 0)
+        centres = 1.0 / (1.0 + np.exp(-out[len(CLASSES)]))
+        return NetworkOutput(
+            np.ascontiguousarray(probs, np.float32), centres.astype(np.float32), (w, h)
+        )

@@ -1,0 +1,94 @@
+"""Training the learned berry detector (``softarm detector train``): JAX and optax, in the
+``train`` extra, imported only here, so that the runtime never needs them.
+
+:func:`train` reads ``softarm dataset`` output (or any COCO with masks: labelled photos),
+trains the U-Net of :mod:`.unet` on augmented crops (:mod:`.augment`) and writes it as
+ONNX (:mod:`.onnx_export`) with a JSON record of the run beside it. docs/perception.md
+("The learned detector") has the recipe.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import platform
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from softarm.errors import SoftarmError
+
+__all__ = ["TrainExtraMissing", "require_train_extra", "train"]
+
+_MODULES = ("jax", "optax", "onnx")
+
+
+class TrainExtraMissing(SoftarmError, ImportError):
+    """A module of the ``train`` extra is not installed."""
+
+
+def require_train_extra() -> None:
+    """Raise one line naming the extra when JAX, optax or onnx is missing.
+
+    Raises:
+        TrainExtraMissing: a module of the ``train`` extra is not installed.
+    """
+    missing = [m for m in _MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        raise TrainExtraMissing(
+            f"training needs {', '.join(missing)}: pip install 'softarm[train]'"
+        )
+
+
+def train(
+    data: list[str | Path],
+    out: str | Path,
+    epochs: int = 30,
+    seed: int = 0,
+    start: str | Path | None = None,
+    on_epoch: Callable[[int, float, float], None] = lambda e, loss, s: None,
+) -> dict[str, Any]:
+    """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
+    and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
+    this architecture to fine-tune (the shipped weights for ``--from default``).
+    Returns the record.
+
+    Raises:
+        TrainExtraMissing: the ``train`` extra is not installed.
+        InputError: a data folder holds no labelled image, or ``start`` is not a network
+            of this architecture.
+    """
+    require_train_extra()
+    import jax
+
+    from softarm.perception.detector.train.loop import TrainSettings, fit
+    from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
+    from softarm.perception.detector.train.samples import describe, load_samples
+    from softarm.perception.detector.train.unet import WIDTHS
+
+    samples, notes = load_samples(list(data))
+    settings = TrainSettings(epochs=epochs, seed=seed)
+    params = None if start is None else params_from_onnx(start)
+    began = time.perf_counter()
+    params = fit(samples, settings, params, on_epoch)
+    export_onnx(params, out)
+    record = {
+        "weights": Path(out).name,
+        "data": notes,
+        "pixels": json.loads(describe(samples)),
+        "from": None if start is None else str(start),
+        "epochs": epochs,
+        "seed": seed,
+        "batch": settings.batch,
+        "learning_rate": settings.learning_rate,
+        "widths": list(WIDTHS),
+        "losses": [round(v, 5) for v in settings.losses],
+        "seconds": round(time.perf_counter() - began, 1),
+        "device": str(jax.devices()[0].platform),
+        "machine": platform.machine(),
+    }
+    from softarm.files import write_text
+
+    write_text(Path(out).with_suffix(".json"), json.dumps(record, indent=1) + "\n", "record")
+    return record

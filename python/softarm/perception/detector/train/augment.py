@@ -1,0 +1,138 @@
+"""Augmentation of training crops, deterministic in the random generator it is given:
+scale, crop (most of them centred near a fruit), mirror, then colour (white balance,
+hue, saturation), exposure and gamma, blur (Gaussian or motion), sensor noise, JPEG
+compression and cut-outs (a rectangle of flat colour hides what is under it, which the
+labels then call background)."""
+
+from __future__ import annotations
+
+from typing import cast
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.perception.detector.train.samples import IGNORE, Sample
+
+__all__ = ["CROP", "crop_batch"]
+
+#: Side (px) of the square training crops.
+CROP = 160
+#: Log-uniform range of the scale applied before cropping.
+SCALE = (0.6, 1.7)
+#: Share of crops centred on a fruit pixel (else anywhere).
+ON_FRUIT = 0.7
+_U8 = npt.NDArray[np.uint8]
+_F32 = npt.NDArray[np.float32]
+
+
+def _scaled(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
+    f = float(np.exp(rng.uniform(np.log(SCALE[0]), np.log(SCALE[1]))))
+    h, w = s.classes.shape
+    size = (max(CROP // 4, round(w * f)), max(CROP // 4, round(h * f)))
+    mode = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
+    image = cast(_U8, cv2.resize(s.image, size, interpolation=mode))
+    classes = cast(_U8, cv2.resize(s.classes, size, interpolation=cv2.INTER_NEAREST))
+    centres = cast(_F32, cv2.resize(s.centres, size, interpolation=cv2.INTER_LINEAR))
+    return image, classes, centres
+
+
+def _crop(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
+    image, classes, centres = _scaled(s, rng)
+    h, w = classes.shape
+    pad_y, pad_x = max(0, CROP - h), max(0, CROP - w)
+    if pad_y or pad_x:
+        image = cast(
+            _U8, cv2.copyMakeBorder(image, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=0)
+        )
+        classes = cast(
+            _U8, cv2.copyMakeBorder(classes, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=IGNORE)
+        )
+        centres = cast(
+            _F32, cv2.copyMakeBorder(centres, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=0)
+        )
+        h, w = classes.shape
+    fruit = np.flatnonzero((classes >= 1) & (classes <= 3))
+    if fruit.size and rng.uniform() < ON_FRUIT:
+        cy, cx = divmod(int(fruit[rng.integers(fruit.size)]), w)
+        y0 = int(np.clip(cy - CROP // 2 + rng.integers(-CROP // 4, CROP // 4 + 1), 0, h - CROP))
+        x0 = int(np.clip(cx - CROP // 2 + rng.integers(-CROP // 4, CROP // 4 + 1), 0, w - CROP))
+    else:
+        y0, x0 = int(rng.integers(h - CROP + 1)), int(rng.integers(w - CROP + 1))
+    window = np.s_[y0 : y0 + CROP, x0 : x0 + CROP]
+    image, classes, centres = image[window], classes[window], centres[window]
+    if rng.uniform() < 0.5:
+        image, classes, centres = image[:, ::-1], classes[:, ::-1], centres[:, ::-1]
+    return np.ascontiguousarray(image), np.ascontiguousarray(classes), np.ascontiguousarray(centres)
+
+
+def _colour(image: _U8, rng: np.random.Generator) -> _U8:
+    hsv = cv2.cvtColor(image, cv2.COLOR_BGR2HSV).astype(np.float32)
+    hsv[..., 0] = (hsv[..., 0] + rng.uniform(-6, 6)) % 180
+    hsv[..., 1] *= rng.uniform(0.7, 1.3)
+    out = cv2.cvtColor(np.clip(hsv, 0, 255).astype(np.uint8), cv2.COLOR_HSV2BGR)
+    x = out.astype(np.float32) / 255.0
+    x *= rng.uniform(0.85, 1.15, 3).astype(np.float32)  # white balance
+    x *= float(np.exp(rng.uniform(np.log(0.5), np.log(1.7))))  # exposure, clipping in sun
+    x = np.clip(x, 0.0, 1.0) ** float(rng.uniform(0.75, 1.35))
+    return cast(_U8, (x * 255.0 + 0.5).astype(np.uint8))
+
+
+def _blur(image: _U8, rng: np.random.Generator) -> _U8:
+    u = rng.uniform()
+    if u < 0.25:
+        return cast(_U8, cv2.GaussianBlur(image, (0, 0), float(rng.uniform(0.4, 1.3))))
+    if u < 0.4:
+        n = int(rng.integers(3, 8))
+        kernel = np.zeros((n, n), np.float32)
+        kernel[n // 2] = 1.0 / n
+        rot = cv2.getRotationMatrix2D(((n - 1) / 2, (n - 1) / 2), float(rng.uniform(0, 180)), 1.0)
+        kernel = cast(_F32, cv2.warpAffine(kernel, rot, (n, n)))
+        return cast(_U8, cv2.filter2D(image, -1, kernel / max(float(kernel.sum()), 1e-6)))
+    return image
+
+
+def _sensor(image: _U8, rng: np.random.Generator) -> _U8:
+    sigma = rng.uniform(0.0, 8.0)
+    noisy = image.astype(np.float32) + rng.normal(0.0, sigma, image.shape).astype(np.float32)
+    out = cast(_U8, np.clip(noisy, 0, 255).astype(np.uint8))
+    if rng.uniform() < 0.5:
+        quality = int(rng.integers(30, 91))
+        ok, buf = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, quality])
+        if ok:
+            out = cast(_U8, cv2.imdecode(buf, cv2.IMREAD_COLOR))
+    return out
+
+
+def _cut_outs(image: _U8, classes: _U8, centres: _F32, rng: np.random.Generator) -> None:
+    if rng.uniform() >= 0.4:
+        return
+    for _ in range(int(rng.integers(1, 4))):
+        hh, ww = (int(v) for v in rng.integers(8, 41, 2))
+        y, x = int(rng.integers(0, CROP - hh + 1)), int(rng.integers(0, CROP - ww + 1))
+        image[y : y + hh, x : x + ww] = rng.integers(0, 256, 3).astype(np.uint8)
+        classes[y : y + hh, x : x + ww] = 0
+        centres[y : y + hh, x : x + ww] = 0.0
+
+
+def augmented(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
+    """One augmented CROP × CROP (image, classes, centres) of ``s``."""
+    image, classes, centres = _crop(s, rng)
+    image = _sensor(_blur(_colour(image, rng), rng), rng)
+    image, classes, centres = image.copy(), classes.copy(), centres.copy()
+    _cut_outs(image, classes, centres, rng)
+    return image, classes, centres
+
+
+def crop_batch(
+    samples: list[Sample], indices: npt.NDArray[np.int64], seed: int, step: int
+) -> tuple[_U8, _U8, _F32]:
+    """A batch of augmented crops of ``samples[indices]``, the same for the same
+    ``seed`` and ``step``: (N, CROP, CROP, 3), (N, CROP, CROP), (N, CROP, CROP)."""
+    out = [
+        augmented(samples[int(i)], np.random.default_rng([seed, step, k]))
+        for k, i in enumerate(indices)
+    ]
+    return (
+        np.stack([o[0] for o in out]), np.stack([o[1] for o in out]), np.stack([o[2] for o in out])
+    )  # fmt: skip

@@ -1,0 +1,100 @@
+"""The training loop (JAX + optax): class-weighted cross-entropy over the pixels' classes
+plus a weighted logistic loss on the centre heatmap, AdamW with a cosine schedule, on
+batches of augmented crops; deterministic in the seed (the same crops, the same order,
+the same initial weights). JAX runs on a GPU where it sees one, else on the CPU."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+
+from softarm.perception.detector.network import CLASSES, normalise
+from softarm.perception.detector.train.augment import crop_batch
+from softarm.perception.detector.train.samples import IGNORE, Sample
+from softarm.perception.detector.train.unet import Params, apply, init_params
+
+__all__ = ["CLASS_WEIGHTS", "TrainSettings", "fit"]
+
+#: Loss weight of each class's pixels (fruit and canes are few pixels of a frame).
+CLASS_WEIGHTS = (1.0, 2.5, 3.0, 2.5, 1.5)
+#: Weight of the centre heatmap's loss, and how much more a peak's pixels count.
+CENTRE_WEIGHT = 1.0
+CENTRE_POSITIVE = 20.0
+
+
+@dataclass(frozen=True)
+class TrainSettings:
+    """Epochs (one crop of every image each), batch size, peak learning rate, seed."""
+
+    epochs: int = 30
+    batch: int = 16
+    learning_rate: float = 3e-3
+    seed: int = 0
+    losses: list[float] = field(default_factory=list, compare=False)
+
+
+def _loss(params: Params, x: Any, classes: Any, centres: Any) -> Any:
+    out = apply(params, x)
+    logits, centre = out[..., : len(CLASSES)], out[..., len(CLASSES)]
+    valid = classes != IGNORE
+    target = jnp.where(valid, classes, 0)
+    ce = optax.softmax_cross_entropy_with_integer_labels(logits, target)
+    w = jnp.asarray(CLASS_WEIGHTS)[target] * valid
+    class_loss = jnp.sum(ce * w) / jnp.maximum(jnp.sum(w), 1.0)
+    bce = optax.sigmoid_binary_cross_entropy(centre, centres)
+    cw = 1.0 + CENTRE_POSITIVE * centres
+    centre_loss = jnp.sum(bce * cw) / jnp.sum(cw)
+    return class_loss + CENTRE_WEIGHT * centre_loss
+
+
+def fit(
+    samples: list[Sample],
+    settings: TrainSettings,
+    params: Params | None = None,
+    on_epoch: Callable[[int, float, float], None] = lambda e, loss, s: None,
+) -> Params:
+    """Train from ``params`` (default: fresh, from the seed) on ``samples``; calls
+    ``on_epoch(epoch, mean loss, seconds)`` after each epoch."""
+    params = init_params(settings.seed) if params is None else params
+    per_epoch = max(1, int(np.ceil(len(samples) / settings.batch)))
+    total = settings.epochs * per_epoch
+    schedule = optax.warmup_cosine_decay_schedule(
+        0.0, settings.learning_rate, min(50, max(1, total // 10)), max(total, 2)
+    )
+    optimiser = optax.adamw(schedule, weight_decay=1e-4)
+    state = optimiser.init(params)
+
+    @jax.jit
+    def step(p: Params, s: Any, x: Any, c: Any, h: Any) -> tuple[Params, Any, Any]:
+        loss, grads = jax.value_and_grad(_loss)(p, x, c, h)
+        updates, s = optimiser.update(grads, s, p)
+        return optax.apply_updates(p, updates), s, loss
+
+    order_rng = np.random.default_rng([settings.seed, 1])
+    n = 0
+    for epoch in range(settings.epochs):
+        start = time.perf_counter()
+        order = order_rng.permutation(len(samples))
+        losses = []
+        for b in range(per_epoch):
+            idx = order[b * settings.batch : (b + 1) * settings.batch]
+            if idx.size < settings.batch:  # a full batch keeps one compiled shape
+                idx = np.concatenate([idx, order[: settings.batch - idx.size]])
+            images, classes, centres = crop_batch(samples, idx, settings.seed, n)
+            params, state, loss = step(
+                params, state, jnp.asarray(normalise(images)), jnp.asarray(classes),
+                jnp.asarray(centres),
+            )  # fmt: skip
+            losses.append(float(loss))
+            n += 1
+        mean = float(np.mean(losses))
+        settings.losses.append(mean)
+        on_epoch(epoch + 1, mean, time.perf_counter() - start)
+    return params

@@ -1,0 +1,123 @@
+"""Training samples: each labelled image (:mod:`..labels`) as the network sees it (shrunk
+to MAX_SIDE), its class map (an index into CLASSES per pixel, IGNORE where a fruit has no
+known stage) and its centre heatmap (a Gaussian peak of height 1 at each fruit's centre,
+its width a third of the fruit's radius)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import cast
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.errors import InputError
+from softarm.perception.detector.labels import LabelledImage, read_coco
+from softarm.perception.detector.network import CLASSES, MAX_SIDE
+
+__all__ = ["IGNORE", "Sample", "find_labels", "load_samples"]
+
+#: Class-map value of pixels the loss leaves out.
+IGNORE = 255
+_U8 = npt.NDArray[np.uint8]
+_F32 = npt.NDArray[np.float32]
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One training image: ``image`` (H, W, 3) BGR uint8, ``classes`` (H, W) uint8 and
+    ``centres`` (H, W) float32."""
+
+    image: _U8
+    classes: _U8
+    centres: _F32
+
+
+def find_labels(data: str | Path) -> Path:
+    """The COCO file of a data folder (its ``annotations.json``, else its one ``.json``),
+    or ``data`` itself when it is a file.
+
+    Raises:
+        InputError: no COCO file there.
+    """
+    path = Path(data)
+    if path.is_file():
+        return path
+    if not path.is_dir():
+        raise InputError(f"--data {path}: no such folder or file")
+    if (path / "annotations.json").is_file():
+        return path / "annotations.json"
+    found = sorted(path.glob("*.json"))
+    if len(found) != 1:
+        raise InputError(
+            f"--data {path}: expected annotations.json or one COCO .json file, found {len(found)}"
+        )
+    return found[0]
+
+
+def _sample(item: LabelledImage) -> Sample | None:
+    image = cast(_U8 | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
+    if image is None or image.shape[:2] != (item.height, item.width):
+        return None
+    h, w = image.shape[:2]
+    scale = min(1.0, MAX_SIDE / max(h, w))
+    size = (max(1, round(w * scale)), max(1, round(h * scale)))
+    if scale < 1.0:
+        image = cast(_U8, cv2.resize(image, size, interpolation=cv2.INTER_AREA))
+    classes = np.zeros(image.shape[:2], np.uint8)
+    centres = np.zeros(image.shape[:2], np.float32)
+    objects = sorted(item.objects(), key=lambda o: o.is_fruit)  # fruit painted over canes
+    for obj in objects:
+        mask = obj.mask
+        if scale < 1.0:
+            mask = cv2.resize(mask.astype(np.uint8), size, interpolation=cv2.INTER_NEAREST) > 0
+        if not mask.any():
+            continue
+        classes[mask] = CLASSES.index(obj.stage) if obj.stage in CLASSES else IGNORE
+        if obj.is_fruit:
+            _add_peak(centres, mask)
+    return Sample(image, classes, centres)
+
+
+def _add_peak(centres: _F32, mask: npt.NDArray[np.bool_]) -> None:
+    rows, cols = np.nonzero(mask)
+    cy, cx = rows.mean(), cols.mean()
+    sigma = max(1.0, np.sqrt(rows.size / np.pi) / 3.0)
+    r = int(np.ceil(3 * sigma))
+    y0, y1 = max(0, int(cy) - r), min(centres.shape[0], int(cy) + r + 1)
+    x0, x1 = max(0, int(cx) - r), min(centres.shape[1], int(cx) + r + 1)
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    g = np.exp(-((yy - cy) ** 2 + (xx - cx) ** 2) / (2 * sigma**2)).astype(np.float32)
+    np.maximum(centres[y0:y1, x0:x1], g, out=centres[y0:y1, x0:x1])
+
+
+def load_samples(folders: list[str | Path]) -> tuple[list[Sample], list[str]]:
+    """The samples of every data folder (or COCO file), and a line per folder saying
+    what it held.
+
+    Raises:
+        InputError: a folder has no COCO file, or none of its images could be read.
+    """
+    out: list[Sample] = []
+    notes = []
+    for folder in folders:
+        labels = find_labels(folder)
+        items = read_coco(labels, labels.parent)
+        samples = [s for s in map(_sample, items) if s is not None]
+        if not samples:
+            raise InputError(f"--data {folder}: no readable labelled image in {labels}")
+        notes.append(f"{folder}: {len(samples)} images ({labels.name})")
+        out += samples
+    return out, notes
+
+
+def describe(samples: list[Sample]) -> str:
+    """Pixel counts per class, as one JSON line (the training record's)."""
+    counts = {name: 0 for name in CLASSES}
+    for s in samples:
+        for k, name in enumerate(CLASSES):
+            counts[name] += int(np.count_nonzero(s.classes == k))
+    return json.dumps(counts)
