@@ -100,6 +100,8 @@ class Parser(argparse.ArgumentParser):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("formatter_class", DefaultsFormatter)
+        if sys.version_info >= (3, 14):  # error() says "did you mean" itself, on every version
+            kwargs.setdefault("suggest_on_error", False)
         super().__init__(*args, **kwargs)
 
     def _add_action(self, action: _A) -> _A:
