@@ -124,6 +124,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "bush and fit the canes with them (on by default: more of the canes mapped, "
         "docs/perception.md); --no-survey: C1's canes only",
     )  # fmt: skip
+    p.add_argument(
+        "--detector", choices=("colour", "net", "net+colour"), default=None,
+        help="--world bush or row: the berry detector (default colour; docs/perception.md, "
+        "'Which detector'); on the arm, [perception] detector",
+    )  # fmt: skip
     add_plant_options(p)
     add_dry_run_options(p)
     p.add_argument(
@@ -162,6 +167,10 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.look is not None and not (args.sim and args.world == "row"):
         raise ParameterError("--look: for the rendered row (--sim --world row)")
+    if args.detector is not None and not (args.sim and args.world != "tags"):
+        raise ParameterError(
+            "--detector: for the rendered worlds; on the arm, [perception] detector"
+        )
     check_bag(args.bag)
     check_view(args.view, args.record)
     check_foxglove(args.foxglove)
@@ -173,6 +182,7 @@ def run(args: argparse.Namespace) -> int:
         if args.world in RENDERED:
             options.update(world=args.world, unripe_fraction=BUSH_UNRIPE_FRACTION)
             options.update(survey=args.survey is not False, record_frames=args.record_frames)
+            options.update(detector=args.detector or "colour")
         if args.world == "row":
             options.update(look=args.look)
         return run_sim(

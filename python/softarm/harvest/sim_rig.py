@@ -48,6 +48,7 @@ from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_map import BushMap
 from softarm.perception.bush_vision import BushVision
+from softarm.perception.detector.choice import use_detector
 from softarm.sim.arm import PlantConfig, SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.plant import ArmPlant
@@ -106,6 +107,9 @@ class SimRigOptions:
     #: (:mod:`softarm.harvest.cane_survey`; ``--no-survey`` turns it off), as the
     #: hardware does unless ``[perception] survey = false``.
     survey: bool = True
+    #: The rendered worlds' berry detector (softarm.perception.detector.choice.DETECTORS),
+    #: as ``[perception] detector`` sets the hardware's.
+    detector: str = "colour"
     #: Resolver gain keywords (``--gains``) over every controller resolver's own.
     gains: Mapping[str, Any] = field(default_factory=dict)
     #: A folder to record the rendered bush's frames, the ripeness readings and the
@@ -409,6 +413,7 @@ def _bush_world(
     the clearance avoid: fitted from C1 without the rig's own ``parts``. With ``recorder``
     every frame is recorded, and the rig's hardware configuration written beside."""
     cfg = o.config
+    use_detector(o.detector)
     scene = _bush_scene(bush, plant, cams, clock, recorder, _look(o, bush))
     canes = scene.fit_canes(parts, CANE_REACH)
     vision = _bush_vision(scene, cams, cfg.grasp_offset, recorder)

@@ -15,8 +15,9 @@ import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.perception.approach import RayCrossing
-from softarm.perception.berries import BerryDetection, DetectorSettings, detect_berries
+from softarm.perception.berries import BerryDetection, DetectorSettings
 from softarm.perception.bush_map import BushMap
+from softarm.perception.detector.choice import detect_berries  # the chosen detector
 from softarm.perception.sight_lines import crossing
 from softarm.vision.detector import Detection
 from softarm.vision.observation import BerryTarget
