@@ -66,6 +66,7 @@ pub trait SectionModel {
 
 /// Checks a configuration vector: length, finiteness, and magnitude at most
 /// [`MAX_COORDINATE`] (beyond it products in the kinematics could overflow).
+#[inline]
 pub fn check_q<M: SectionModel + ?Sized>(model: &M, q: &[f64]) -> Result<()> {
     check_len("q", q, model.n_dofs())?;
     check_bounded("q", q, MAX_COORDINATE)
@@ -103,7 +104,7 @@ pub fn check_point_args<M: SectionModel + ?Sized>(model: &M, section: usize, s: 
     check_range("s", s, 0.0, 1.0)
 }
 
-#[inline]
+#[inline(always)]
 fn state<M: SectionModel + ?Sized>(model: &M, q: &[f64], i: usize) -> SectionState {
     model.section_state(i, &q[3 * i..3 * i + 3])
 }
@@ -151,21 +152,37 @@ fn sweep<M: SectionModel + ?Sized>(
     jac: &mut DMatrix<f64>,
 ) -> Frame {
     let mut f = Frame::identity();
+    // Column-major 6×n: column j is the slice [6j, 6j + 6).
+    let mut cols = jac.as_mut_slice().chunks_exact_mut(6);
     for i in 0..upto {
         let st = state(model, q, i);
         let (tip, d_pos, d_rot) = st.arc.frame_with_derivatives(1.0);
-        let v_local = d_pos * st.d_arc;
-        let z_tip = tip.rot.column(2).into_owned();
-        let w_local = d_rot * st.d_arc + z_tip * st.d_twist.transpose();
+        let next = f.compose(&st.tip_then_tail(&tip));
         let p_tip = f.pos + f.rot * tip.pos;
-        for k in 0..3 {
-            let w = f.rot * w_local.column(k);
-            let v = f.rot * v_local.column(k) - w.cross(&p_tip);
-            let col = 3 * i + k;
-            jac.fixed_view_mut::<3, 1>(0, col).copy_from(&v);
-            jac.fixed_view_mut::<3, 1>(3, col).copy_from(&w);
+        // The tip's derivatives along (L, ux, uy), rotated into the base frame once;
+        // ∂ω/∂L = 0, so the angular part has two columns.
+        let dp = f.rot * d_pos;
+        let (w_ux, w_uy) = (f.rot * d_rot.column(1), f.rot * d_rot.column(2));
+        // The velocity of the point at the base origin, v_tip + p_tip × w, per parameter.
+        let v = Mat3::from_columns(&[
+            dp.column(0).into_owned(),
+            dp.column(1) + p_tip.cross(&w_ux),
+            dp.column(2) + p_tip.cross(&w_uy),
+        ]);
+        // The tip's z axis: the twist after the arc turns about it.
+        let z = next.rot.column(2);
+        for (k, col) in cols.by_ref().take(3).enumerate() {
+            let a = st.d_arc.column(k);
+            let (mut vk, mut wk) = (v * a, w_ux * a[1] + w_uy * a[2]);
+            // A model's twist either varies with a coordinate or not; the test is decided
+            // at compile time for each model, and a constant twist costs nothing.
+            if st.d_twist[k] != 0.0 {
+                wk += z * st.d_twist[k];
+                vk += p_tip.cross(&z) * st.d_twist[k];
+            }
+            col.copy_from_slice(&[vk.x, vk.y, vk.z, wk.x, wk.y, wk.z]);
         }
-        f = f.compose(&st.tip_then_tail(&tip));
+        f = next;
     }
     f
 }
@@ -179,10 +196,12 @@ pub fn forward_jacobian_into<M: SectionModel + ?Sized>(
     jac: &mut DMatrix<f64>,
 ) -> Frame {
     let f = sweep(model, q, model.n_sections(), jac);
-    for col in 0..jac.ncols() {
-        let w = jac.fixed_view::<3, 1>(3, col).into_owned();
-        let mut v = jac.fixed_view_mut::<3, 1>(0, col);
-        v += w.cross(&f.pos);
+    // Move each twist's reference point from the base origin to the end effector.
+    for col in jac.as_mut_slice().chunks_exact_mut(6) {
+        let dv = Vec3::new(col[3], col[4], col[5]).cross(&f.pos);
+        col[0] += dv.x;
+        col[1] += dv.y;
+        col[2] += dv.z;
     }
     f
 }

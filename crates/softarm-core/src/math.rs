@@ -21,6 +21,7 @@ pub struct Frame {
 
 impl Frame {
     /// The identity transform.
+    #[inline]
     pub fn identity() -> Self {
         Frame {
             rot: Mat3::identity(),
@@ -38,6 +39,7 @@ impl Frame {
     }
 
     /// The 4×4 homogeneous matrix.
+    #[inline]
     pub fn to_matrix(&self) -> Mat4 {
         let mut m = Mat4::identity();
         m.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.rot);
@@ -69,9 +71,99 @@ pub fn skew(v: &Vec3) -> Mat3 {
     Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
-/// Below this value of `x = t²` the closed forms lose digits to cancellation, so the
-/// Taylor series (accurate to machine precision there) is used instead.
-const SERIES_BELOW: f64 = 0.25;
+/// Below this value of `x = t²` (bends under 1.5 rad, every bend the blackberry arm
+/// reaches inside its limits) the arc functions come from their Maclaurin series, which
+/// needs no `sqrt`, `sin_cos` or division; above it the closed forms, which lose no digits
+/// there. At `x = 2.25` the first omitted term is below 1e-18.
+const SERIES_BELOW: f64 = 2.25;
+
+/// Number of series coefficients kept (powers `x⁰ … x¹⁰`).
+const TERMS: usize = 11;
+
+/// `(−1)ᵏ / (2k + first)!` for k = 0 … 11: the series in `x = t²` of `sin t / t`
+/// (first = 1), `(1 − cos t)/t²` (2) and `(t − sin t)/t³` (3), one term beyond
+/// [`TERMS`] for the derivatives.
+const fn series_long(first: u32) -> [f64; TERMS + 1] {
+    let mut c = [0.0; TERMS + 1];
+    let mut fact = 1.0;
+    let mut m = 2;
+    while m <= first {
+        fact *= m as f64;
+        m += 1;
+    }
+    let mut k = 0;
+    while k <= TERMS {
+        c[k] = if k % 2 == 0 { 1.0 / fact } else { -1.0 / fact };
+        let n = (2 * k as u32 + first) as f64;
+        fact *= (n + 1.0) * (n + 2.0);
+        k += 1;
+    }
+    c
+}
+
+/// The first [`TERMS`] coefficients of [`series_long`].
+const fn series(first: u32) -> [f64; TERMS] {
+    let long = series_long(first);
+    let mut c = [0.0; TERMS];
+    let mut k = 0;
+    while k < TERMS {
+        c[k] = long[k];
+        k += 1;
+    }
+    c
+}
+
+/// The series of the derivative with respect to `x`: term by term `(k + 1) c_{k+1}`.
+const fn derivative(first: u32) -> [f64; TERMS] {
+    let long = series_long(first);
+    let mut c = [0.0; TERMS];
+    let mut k = 0;
+    while k < TERMS {
+        c[k] = (k + 1) as f64 * long[k + 1];
+        k += 1;
+    }
+    c
+}
+
+const F1: [f64; TERMS] = series(1);
+const F2: [f64; TERMS] = series(2);
+const F3: [f64; TERMS] = series(3);
+const G1: [f64; TERMS] = derivative(1);
+const G2: [f64; TERMS] = derivative(2);
+
+/// Powers of `x` shared by every polynomial evaluated at it.
+#[derive(Clone, Copy)]
+struct Powers {
+    x: f64,
+    x2: f64,
+    x4: f64,
+    x8: f64,
+}
+
+impl Powers {
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        let x2 = x * x;
+        let x4 = x2 * x2;
+        Powers {
+            x,
+            x2,
+            x4,
+            x8: x4 * x4,
+        }
+    }
+
+    /// `Σ c[k] xᵏ` by Estrin's scheme: a tree four multiply-adds deep instead of
+    /// Horner's chain of ten, so that the arc's pose does not wait on a long latency chain.
+    #[inline(always)]
+    fn poly(&self, c: &[f64; TERMS]) -> f64 {
+        let Powers { x, x2, x4, x8 } = *self;
+        let q0 = (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2;
+        let q1 = (c[4] + c[5] * x) + (c[6] + c[7] * x) * x2;
+        let q2 = (c[8] + c[9] * x) + c[10] * x2;
+        (q0 + q1 * x4) + q2 * x8
+    }
+}
 
 /// Values of the even functions of `t` used by the arc, all as functions of `x = t²`:
 /// `f1 = sin t / t`, `f2 = (1 − cos t)/t²`, `f3 = (t − sin t)/t³`,
@@ -94,15 +186,8 @@ pub struct ArcFunctions {
 #[inline]
 pub fn f1_f2(x: f64) -> (f64, f64) {
     if x < SERIES_BELOW {
-        let f1 = 1.0
-            + x * (-1.0 / 6.0
-                + x * (1.0 / 120.0
-                    + x * (-1.0 / 5040.0 + x * (1.0 / 362_880.0 - x / 39_916_800.0))));
-        let f2 = 0.5
-            + x * (-1.0 / 24.0
-                + x * (1.0 / 720.0
-                    + x * (-1.0 / 40_320.0 + x * (1.0 / 3_628_800.0 - x / 479_001_600.0))));
-        (f1, f2)
+        let p = Powers::of(x);
+        (p.poly(&F1), p.poly(&F2))
     } else {
         let t = x.sqrt();
         let (s, c) = t.sin_cos();
@@ -115,24 +200,14 @@ impl ArcFunctions {
     #[inline]
     pub fn at(x: f64) -> Self {
         if x < SERIES_BELOW {
-            // Horner forms of the Maclaurin series in x; at x < 0.25 the first omitted
-            // term is below 1e-17 relative.
-            let (f1, f2) = f1_f2(x);
-            let f3 = 1.0 / 6.0
-                + x * (-1.0 / 120.0
-                    + x * (1.0 / 5040.0
-                        + x * (-1.0 / 362_880.0 + x * (1.0 / 39_916_800.0 - x / 6_227_020_800.0))));
-            let g1 = -1.0 / 6.0
-                + x * (2.0 / 120.0
-                    + x * (-3.0 / 5040.0
-                        + x * (4.0 / 362_880.0
-                            + x * (-5.0 / 39_916_800.0 + 6.0 * x / 6_227_020_800.0))));
-            let g2 = -1.0 / 24.0
-                + x * (2.0 / 720.0
-                    + x * (-3.0 / 40_320.0
-                        + x * (4.0 / 3_628_800.0
-                            + x * (-5.0 / 479_001_600.0 + 6.0 * x / 87_178_291_200.0))));
-            ArcFunctions { f1, f2, f3, g1, g2 }
+            let p = Powers::of(x);
+            ArcFunctions {
+                f1: p.poly(&F1),
+                f2: p.poly(&F2),
+                f3: p.poly(&F3),
+                g1: p.poly(&G1),
+                g2: p.poly(&G2),
+            }
         } else {
             let t = x.sqrt();
             let (s, c) = t.sin_cos();
@@ -166,7 +241,7 @@ mod tests {
 
     #[test]
     fn series_matches_closed_form_at_the_switch() {
-        for &x in &[0.2, 0.249_999, 0.25] {
+        for &x in &[0.2, 0.25, 2.0, 2.249_999, 2.25] {
             let a = ArcFunctions::at(x);
             let b = closed(x);
             assert_relative_eq!(a.f1, b.f1, max_relative = 1e-13);

@@ -5,7 +5,7 @@ use crate::chain::{self, SectionModel, SectionState};
 use crate::error::{check_len, check_parameter, Error, Result};
 use crate::kinematics::Kinematics;
 use crate::math::{Mat3, Vec3};
-use crate::pneumatic::{arc_params, arc_params_jacobian, polar_config, PolarConfig};
+use crate::pneumatic::{arc_params_jacobian, polar_config, PolarConfig};
 
 /// Geometry and limits of one pneumatic section.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -191,7 +191,7 @@ impl SoftArm {
             .sections
             .iter()
             .enumerate()
-            .map(|(i, s)| arc_params(s.radius, s.rest_length, &q[3 * i..3 * i + 3]))
+            .map(|(i, _)| self.arc(i, &q[3 * i..3 * i + 3]))
             .collect())
     }
 
@@ -207,6 +207,19 @@ impl SoftArm {
             .enumerate()
             .map(|(i, s)| polar_config(s.radius, s.rest_length, &q[3 * i..3 * i + 3]))
             .collect())
+    }
+
+    /// Eq. (1) for section `i` in its linear form `(L − L0, ux, uy) = ∂(L, ux, uy)/∂l · l`
+    /// (see [`crate::pneumatic`]): the cached constant Jacobian multiplies where
+    /// [`crate::pneumatic::arc_params`] divides, which matters in the kinematics' hot loop.
+    #[inline]
+    fn arc(&self, i: usize, qi: &[f64]) -> ArcParams {
+        let u = self.d_arc[i] * Vec3::new(qi[0], qi[1], qi[2]);
+        ArcParams {
+            length: self.sections[i].rest_length + u.x,
+            ux: u.y,
+            uy: u.z,
+        }
     }
 
     /// Clamps `q` into the limits in place; returns whether anything was clamped.
@@ -230,11 +243,11 @@ impl SectionModel for SoftArm {
         self.sections.len()
     }
 
-    #[inline]
+    #[inline(always)]
     fn section_state(&self, i: usize, qi: &[f64]) -> SectionState {
         let s = &self.sections[i];
         SectionState {
-            arc: arc_params(s.radius, s.rest_length, qi),
+            arc: self.arc(i, qi),
             d_arc: self.d_arc[i],
             offset: s.offset,
             twist: self.twist_cs[i],
