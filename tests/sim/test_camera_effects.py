@@ -100,11 +100,14 @@ def test_auto_exposure_brings_the_mean_to_its_target_and_the_bias_scales_it() ->
 
 def test_auto_exposure_keeps_the_highlights_under_their_level() -> None:
     image = _flat(40)
-    image[:3, :] = 200  # 1.5 % of the frame bright: a sunlit marker
+    image[:3, :] = 120  # 1.5 % of the frame bright: a sunlit marker
     exposure = CameraEffects().exposure_of(image)
-    assert exposure == pytest.approx(AUTO_HIGHLIGHT_DN / 200)
+    assert exposure == pytest.approx(AUTO_HIGHLIGHT_DN / 120)
     out = CameraEffects().apply(image, np.random.default_rng(0))
     assert out.max() < 255  # not clipped, though the frame's mean is far from its target
+    image[:3, :] = 250  # brighter still: half the mean's exposure, and it clips
+    mean = float(image.mean())
+    assert CameraEffects().exposure_of(image) == pytest.approx(0.5 * AUTO_TARGET_DN / mean)
     image[:3, :] = 40
     image[0, :10] = 250  # a few glints (0.005 % of the frame) may clip
     assert CameraEffects().exposure_of(image) == pytest.approx(

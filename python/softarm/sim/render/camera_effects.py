@@ -33,11 +33,14 @@ __all__ = ["CameraEffects", "StereoEffects", "blur_kernel"]
 #: What auto-exposure aims the frame's mean luminance at (DN), and how far it may go;
 #: it keeps the brightest AUTO_HIGHLIGHT_SHARE of the pixels at or under
 #: AUTO_HIGHLIGHT_DN (a camera's metering keeps a bright subject, a sunlit marker, from
-#: clipping because the rest of the frame is dark).
+#: clipping because the rest of the frame is dark), but gives up at most
+#: AUTO_HIGHLIGHT_GIVE of the mean's exposure for it (a sky in the frame still clips
+#: rather than the whole frame going dark).
 AUTO_TARGET_DN = 110.0
 AUTO_RANGE = (0.25, 8.0)
 AUTO_HIGHLIGHT_SHARE = 0.005
 AUTO_HIGHLIGHT_DN = 230.0
+AUTO_HIGHLIGHT_GIVE = 0.5
 
 
 def blur_kernel(velocity_px: tuple[float, float], exposure_s: float) -> npt.NDArray[np.float64]:
@@ -74,7 +77,7 @@ class CameraEffects:
     Args:
         exposure: the exposure gain over the render; None: auto-exposure, the frame's
             mean luminance brought to AUTO_TARGET_DN, its brightest pixels kept under
-            AUTO_HIGHLIGHT_DN, within AUTO_RANGE.
+            AUTO_HIGHLIGHT_DN at the cost of up to half of that, within AUTO_RANGE.
         exposure_bias: a factor on the exposure (auto or fixed): one eye of a pair
             exposing a little differently, or an auto-exposure that over- or
             under-shoots.
@@ -130,7 +133,9 @@ class CameraEffects:
         counts = cv2.calcHist([grey], [0], None, [256], [0, 256]).ravel()
         above = np.cumsum(counts[::-1])  # pixels at or above each level, from 255 down
         highlight = 255 - int(np.searchsorted(above, AUTO_HIGHLIGHT_SHARE * grey.size))
-        auto = min(AUTO_TARGET_DN / max(mean, 1e-3), AUTO_HIGHLIGHT_DN / max(highlight, 1))
+        by_mean = AUTO_TARGET_DN / max(mean, 1e-3)
+        by_highlight = AUTO_HIGHLIGHT_DN / max(highlight, 1)
+        auto = max(min(by_mean, by_highlight), (1 - AUTO_HIGHLIGHT_GIVE) * by_mean)
         return float(np.clip(auto, *AUTO_RANGE)) * self.exposure_bias
 
     def apply(
