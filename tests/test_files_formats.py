@@ -167,7 +167,7 @@ def test_a_complete_log_gets_no_mark(tmp_path: Path) -> None:
     [
         (["--seed", "-5000"], "--seed"),
         (["--poses", "5"], "--poses"),
-        (["--out", "{tmp}/missing/m.toml"], "--out"),
+        (["--out", "/proc/nope/m.toml"], "--out"),  # a folder that cannot be made
         (["--out", "{tmp}"], "--out"),
         (["--plant", "{tmp}/absent.toml"], "--plant"),
     ],

@@ -144,7 +144,7 @@ def test_not_json(tmp_path: Path) -> None:
     [
         (["--sim", "--budget", "500"], "argument --budget: must be in [30, 120]"),
         (["--sim", "--seed", "-1"], "argument --seed"),
-        (["--sim", "--out", "nofolder/i.json"], "argument --out: cannot write"),
+        (["--sim", "--out", "/proc/nope/i.json"], "argument --out: cannot write"),
         (["--config", "absent.toml"], "no such file"),
     ],
 )
