@@ -166,11 +166,12 @@ def test_harvest_serves_the_run_live(tmp_path: Any) -> None:
         assert first.startswith("foxglove: live at ws://127.0.0.1:"), first
         url = first.split()[3]
         client = Client(url)
-        client.subscribe({"/joint_states", "/harvest/events"})
-        got = client.collect({"/joint_states", "/harvest/events"}, deadline_s=10.0)
+        topics = {"/joint_states", "/harvest/events", "/c1/image/compressed", "/c1/camera_info"}
+        client.subscribe(topics)
+        got = client.collect(topics, deadline_s=10.0)
         client.close()
         rest = run.communicate(timeout=300)[0]
-    assert {"/joint_states", "/harvest/events"} <= set(got)
+    assert topics <= set(got), sorted(got)
     assert len(got["/joint_states"][0].joints) == 9
     assert "harvested" in rest and run.returncode in (0, 1)
 
@@ -223,8 +224,43 @@ def test_the_layout_shows_only_topics_the_view_serves() -> None:
 
     layout = json.loads((Path(__file__).parents[1] / "docs" / "foxglove_layout.json").read_text())
     text = json.dumps(layout["configById"])
-    used = set(re.findall(r'"(/[a-z_/]+)', text))
-    assert used and used <= TOPICS, used - TOPICS
+    used = set(re.findall(r'"(/[a-z0-9_/]+)', text))
+    served = TOPICS | {f"/c{k}/{t}" for k in (1, 2) for t in ("image/compressed", "camera_info")}
+    assert used and used <= served, used - served
     panels = set(layout["configById"])
-    placed = set(re.findall(r'"([A-Za-z0-9]+![a-z]+)"', json.dumps(layout["layout"])))
+    placed = set(re.findall(r'"([A-Za-z0-9]+![a-z0-9]+)"', json.dumps(layout["layout"])))
     assert placed == panels
+
+
+def test_tapped_camera_frames_arrive_as_jpeg_with_their_calibration() -> None:
+    import types
+
+    import cv2
+    import numpy as np
+
+    from softarm.vision import CameraModel
+
+    model = CameraModel.ideal(500.0, 64, 48, [0.01, 0.0, 0.0, 0.0, 0.0])
+    image = np.zeros((48, 64, 3), np.uint8)
+    image[10:20, 10:30] = (0, 0, 255)
+    vision = types.SimpleNamespace(frame1=lambda t: image, model1=model)
+    records: list[dict[str, Any]] = []
+    view = LiveView(records, "127.0.0.1:0")
+    client = Client(view.url)
+    try:
+        view.attach_cameras(vision)
+        topics = {"/c1/image/compressed", "/c1/camera_info"}
+        client.subscribe(topics)
+        time.sleep(0.3)
+        assert vision.frame1(0.5) is image  # the rig gets its frame as before
+        got = client.collect(topics, deadline_s=2.0)
+        assert topics <= set(got), sorted(got)
+        sent = got["/c1/image/compressed"][0]
+        assert sent.format == "jpeg" and sent.frame_id == "c1"
+        decoded = cv2.imdecode(np.frombuffer(sent.data, np.uint8), cv2.IMREAD_COLOR)
+        assert decoded.shape == image.shape and decoded[15, 20, 2] > 200
+        info = got["/c1/camera_info"][0]
+        assert (info.width, info.height) == (64, 48) and info.K[0] == pytest.approx(500.0)
+    finally:
+        client.close()
+        view.close()

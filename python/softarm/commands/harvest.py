@@ -212,14 +212,16 @@ def check_foxglove(address: str | None) -> None:
         parse_address(address)
 
 
-def live_view(records: list[dict[str, Any]], address: str | None) -> Any:
-    """The Foxglove server streaming the run log's ``records`` (None without
-    ``--foxglove``); its address printed for the user to connect to."""
+def live_view(records: list[dict[str, Any]], address: str | None, vision: Any = None) -> Any:
+    """The Foxglove server streaming the run log's ``records`` and the camera frames of
+    ``vision`` (None without ``--foxglove``); its address printed for the user."""
     if address is None:
         return None
     from softarm.viz.foxglove_live import LiveView
 
     view = LiveView(records, address)
+    if vision is not None:
+        view.attach_cameras(vision)
     print(f"foxglove: live at {view.url} (Foxglove: Open connection)", flush=True)
     return view
 
@@ -277,7 +279,7 @@ def run_sim(
 
         seen = c1_picture(rig.scene, seed)
     viewer = _viewer(rig, view, record)
-    live = live_view(rig.machine.log.records, getattr(args, "foxglove", None))
+    live = live_view(rig.machine.log.records, getattr(args, "foxglove", None), rig.vision)
     try:
         try:
             with vents_on_stop(rig.machine.actuator.vent, rig.machine.log):
@@ -422,7 +424,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         log.close()
         raise
     berries = args.berries if devices is None else replay_rounds(devices)
-    live = live_view(log.records, args.foxglove)
+    live = live_view(log.records, args.foxglove, getattr(rig, "vision", None))
     try:
         # The tags 10, 11, ... stuck to the berries (section IV-E), or the map's ripe
         # berries with markerless [perception].

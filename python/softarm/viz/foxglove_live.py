@@ -12,11 +12,16 @@ Topics (Foxglove's schemas, protobuf; times are the run's own clock):
   green, and its fitted canes, amber;
 * ``/harvest/events`` (``foxglove.Log``): the state machine's transitions, faults, vents,
   plans, each as one line;
-* ``/harvest/errors`` (JSON): the measured position and pointing errors of each step.
+* ``/harvest/errors`` (JSON): the measured position and pointing errors of each step;
+* ``/c1/image/compressed``, ``/c2/image/compressed`` (``foxglove.CompressedImage``, JPEG)
+  with ``/c1/camera_info``, ``/c2/camera_info`` (``foxglove.CameraCalibration``): the
+  cameras' frames as the rig's vision took them, where :meth:`LiveView.attach_cameras`
+  tapped them (the simulated rigs' ``frame1``/``frame2``).
 
-The control loop only appends records to the log; a thread here reads them and hands
-them to the SDK, which keeps a bounded queue per client and drops the oldest data for
-one that is slow: a client never blocks the loop.
+The control loop only appends records to the log (and a tapped frame to a short queue
+that drops the oldest); a thread here reads them, encodes the frames and hands all to
+the SDK, which keeps a bounded queue per client and drops the oldest data for one that
+is slow: a client never blocks the loop.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from __future__ import annotations
 import importlib
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -37,6 +43,10 @@ __all__ = ["LiveView", "parse_address", "require_foxglove", "serve_log"]
 
 #: Where the server listens unless told: this machine only.
 DEFAULT_ADDRESS = "127.0.0.1:8765"
+#: Camera frames kept for the view's thread; older ones are dropped, never waited for.
+FRAMES_KEPT = 4
+#: JPEG quality of the frames sent.
+JPEG_QUALITY = 80
 #: How often (s) the publishing thread reads the new records.
 POLL_S = 0.02
 #: Messages kept per client before the oldest are dropped (the SDK's backlog).
@@ -99,6 +109,15 @@ class LiveView:
         self._map = channels.SceneUpdateChannel("/bush_map", context=ctx)
         self._events = channels.LogChannel("/harvest/events", context=ctx)
         self._errors = fox.Channel("/harvest/errors", message_encoding="json", context=ctx)
+        self._image_channels = {
+            k: (
+                channels.CompressedImageChannel(f"/c{k}/image/compressed", context=ctx),
+                channels.CameraCalibrationChannel(f"/c{k}/camera_info", context=ctx),
+            )
+            for k in (1, 2)
+        }
+        #: Frames handed over by the tapped cameras: (camera, t, image, model).
+        self._images: deque[tuple[int, float, Any, Any]] = deque(maxlen=FRAMES_KEPT)
         self._sent = 0
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="foxglove", daemon=True)
@@ -116,6 +135,24 @@ class LiveView:
         self._drain()
         self.server.stop()
 
+    def attach_cameras(self, vision: Any) -> None:
+        """Tap ``vision``'s camera frames (``frame1``/``frame2`` with their ``model1``/
+        ``model2``, where it has them): each frame is handed over as it is, and this
+        view's thread encodes and sends it with its calibration."""
+        for k in (1, 2):
+            frame, model = getattr(vision, f"frame{k}", None), getattr(vision, f"model{k}", None)
+            if callable(frame) and model is not None:
+                setattr(vision, f"frame{k}", self._tap(frame, k, model))
+
+    def _tap(self, frame: Callable[..., Any], k: int, model: Any) -> Callable[..., Any]:
+        def tapped(t: float, *args: Any, **kwargs: Any) -> Any:
+            image = frame(t, *args, **kwargs)
+            if image is not None:
+                self._images.append((k, float(t), image, model))
+            return image
+
+        return tapped
+
     def _run(self) -> None:
         while not self._stop.wait(POLL_S):
             self._drain()
@@ -128,6 +165,12 @@ class LiveView:
             except Exception:  # a record the view cannot draw must not end the run
                 pass
             self._sent += 1
+        while self._images:
+            k, t, image, model = self._images.popleft()
+            try:
+                self._image(k, t, image, model)
+            except Exception:  # a frame the view cannot encode must not end the run
+                pass
 
     def publish(self, record: dict[str, Any]) -> None:
         """One run-log record on its topics (most kinds have none)."""
@@ -142,6 +185,28 @@ class LiveView:
             text = ", ".join(f"{k}={v}" for k, v in record.items() if k not in ("kind", "t"))
             level = getattr(m.LogLevel, EVENT_LEVELS[kind])
             self._events.log(m.Log(timestamp=stamp, level=level, name=kind, message=text[:500]))
+
+    def _image(self, k: int, t: float, image: Any, model: Any) -> None:
+        """Camera ``k``'s frame as JPEG, and its calibration, on its two topics."""
+        import cv2
+
+        m = self._m
+        ok, jpeg = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
+        if not ok:
+            return
+        stamp = m.Timestamp(sec=int(t), nsec=round((t - int(t)) * 1e9) % 1_000_000_000)
+        frame_id = f"c{k}"
+        images, infos = self._image_channels[k]
+        images.log(m.CompressedImage(timestamp=stamp, frame_id=frame_id, data=jpeg.tobytes(),
+                                     format="jpeg"))  # fmt: skip
+        K = np.asarray(model.matrix, float)
+        P = np.hstack([K, np.zeros((3, 1))])
+        infos.log(m.CameraCalibration(
+            timestamp=stamp, frame_id=frame_id, width=int(image.shape[1]),
+            height=int(image.shape[0]), distortion_model="plumb_bob",
+            D=[float(v) for v in np.ravel(model.distortion)[:5]], K=K.ravel().tolist(),
+            R=np.eye(3).ravel().tolist(), P=P.ravel().tolist(),
+        ))  # fmt: skip
 
     def _step(self, record: dict[str, Any], stamp: Any) -> None:
         m = self._m
