@@ -45,6 +45,9 @@ __all__ = ["LiveView", "parse_address", "require_foxglove", "serve_log"]
 DEFAULT_ADDRESS = "127.0.0.1:8765"
 #: Camera frames kept for the view's thread; older ones are dropped, never waited for.
 FRAMES_KEPT = 4
+#: Most frames sent per second of wall time, per camera: a simulated run takes frames
+#: far faster than a camera does, and each costs a JPEG encoding.
+IMAGE_HZ = 5.0
 #: JPEG quality of the frames sent.
 JPEG_QUALITY = 80
 #: How often (s) the publishing thread reads the new records.
@@ -145,9 +148,13 @@ class LiveView:
                 setattr(vision, f"frame{k}", self._tap(frame, k, model))
 
     def _tap(self, frame: Callable[..., Any], k: int, model: Any) -> Callable[..., Any]:
+        last = [-np.inf]  # wall time of the last frame handed over
+
         def tapped(t: float, *args: Any, **kwargs: Any) -> Any:
             image = frame(t, *args, **kwargs)
-            if image is not None:
+            now = time.monotonic()
+            if image is not None and now - last[0] >= 1.0 / IMAGE_HZ:
+                last[0] = now
                 self._images.append((k, float(t), image, model))
             return image
 
