@@ -4,6 +4,7 @@ a ChArUco board, written as the OpenCV and ROS camera files that hw.toml names.
 softarm camera calibrate shots/ --squares 7 5 --square 0.04 --marker 0.03 --out c2
 softarm camera calibrate zed/ --stereo --squares 7 5 --square 0.04 --marker 0.03 --out c1
 softarm camera calibrate left/ --right right/ --squares 7 5 ... --out c1
+softarm camera board --out charuco_board.png   # the board those commands expect, to print
 
 Mono writes ``OUT/camera.yml`` (OpenCV) and ``OUT/camera.yaml`` (ROS). Stereo (``--stereo``:
 side-by-side frames, the ZED2 over USB video; ``--right``: a second camera's images, paired
@@ -43,7 +44,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     """Register ``camera calibrate``."""
     p = sub.add_parser(
         "camera",
-        help="calibrate a camera or a stereo pair from ChArUco images (calibrate)",
+        help="calibrate a camera or a stereo pair from ChArUco images (calibrate); write "
+        "the board to print (board)",
         description=__doc__,
         formatter_class=RawDefaultsFormatter,
     )
