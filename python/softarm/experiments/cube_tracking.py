@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from softarm.commands._looks import LOOKS
+from softarm.sim.render.row_look import LOOKS
 
 __all__ = ["track_cubes"]
 
