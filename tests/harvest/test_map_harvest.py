@@ -52,3 +52,19 @@ def test_a_berry_lost_from_view_is_tried_once_more_after_the_others() -> None:
 def test_other_faults_are_not_retried_and_a_stopping_fault_ends_the_run() -> None:
     assert _run({0: [FaultReason.UNREACHABLE]}) == [1, 0, 2]
     assert _run({0: [FaultReason.SAFETY_STOP]}, stop_on=(FaultReason.SAFETY_STOP,)) == [1, 0]
+
+
+def test_a_berry_beyond_the_arms_reach_is_never_tried() -> None:
+    order: list[int] = []
+
+    def run_berry(target: BerryTarget) -> BerryResult:
+        order.append(target.tag_id)
+        return BerryResult(target.tag_id, harvested=True)
+
+    bush = _Map([0.1, -0.2, 0.3])
+    bush.entries[1].position = np.array([-0.2, 0.9, 0.3])  # along the row, 0.97 m out
+    harvest_map(lambda: None, bush, run_berry, 10)  # type: ignore[arg-type]
+    assert order == [0, 2]
+    order.clear()
+    harvest_map(lambda: None, bush, run_berry, 10, reach=1.0)  # type: ignore[arg-type]
+    assert order == [1, 0, 2]
