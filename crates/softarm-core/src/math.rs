@@ -197,7 +197,8 @@ pub fn f1_f2(x: f64) -> (f64, f64) {
 
 impl ArcFunctions {
     /// Evaluates all functions at `x = t² ≥ 0`. Exact limits at `x = 0`, no NaN.
-    #[inline]
+    /// Always inlined, as [`crate::arc::ArcParams::frame_with_derivatives`] is.
+    #[inline(always)]
     pub fn at(x: f64) -> Self {
         if x < SERIES_BELOW {
             let p = Powers::of(x);
