@@ -316,6 +316,10 @@ def _sim_outputs(
     plot (with what C1 saw at IDLE, ``seen``) where asked for."""
     report.header = rig.machine.log.records[0]
     print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
+    if "rate" in report.extra:  # berries per hour and the time by stage (issue 40 item 4)
+        from softarm.harvest.rate import rate_line
+
+        print(rate_line(report.extra["rate"]))
     if report_path is not None:
         report.save(report_path)
         print(f"report: {report_path}")

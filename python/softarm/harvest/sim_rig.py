@@ -38,6 +38,7 @@ from softarm.harvest.frame_files import FrameRecorder
 from softarm.harvest.interfaces import BerryTarget, Controller
 from softarm.harvest.log import HarvestLog
 from softarm.harvest.machine import HarvestMachine
+from softarm.harvest.rate import rate_record
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
 from softarm.harvest.rig_parts import CANE_REACH, rig_parts
@@ -222,6 +223,7 @@ class SimRig:
             min_branch_gap_m=self.watch.min_gap,
             branch_contact_steps=self.watch.contacts,
             sim_time_s=self.clock.now(),
+            rate=rate_record(self.machine.log.records, report.harvested, self.clock.now()),
         )
         self.machine.log.close()
         if self.recorder is not None:
