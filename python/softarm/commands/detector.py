@@ -62,7 +62,7 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
     )
     t.add_argument("--data", type=Path, action="append", required=True, help="data folder")
     t.add_argument("--out", type=output_file, required=True, help="ONNX file to write")
-    t.add_argument("--epochs", type=int_range(1, MAX_EPOCHS), default=30, help="epochs")
+    t.add_argument("--epochs", type=int_range(1, MAX_EPOCHS), default=150, help="epochs")
     t.add_argument("--seed", type=int_range(0, 2**31 - 1), default=0, help="seed")
     t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",

@@ -44,7 +44,7 @@ def require_train_extra() -> None:
 def train(
     data: list[str | Path],
     out: str | Path,
-    epochs: int = 30,
+    epochs: int = 150,
     seed: int = 0,
     start: str | Path | None = None,
     on_epoch: Callable[[int, float, float], None] = lambda e, loss, s: None,

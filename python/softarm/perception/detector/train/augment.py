@@ -17,7 +17,7 @@ from softarm.perception.detector.train.samples import IGNORE, Sample
 __all__ = ["CROP", "crop_batch"]
 
 #: Side (px) of the square training crops.
-CROP = 160
+CROP = 128
 #: Log-uniform range of the scale applied before cropping.
 SCALE = (0.6, 1.7)
 #: Share of crops centred on a fruit pixel (else anywhere).

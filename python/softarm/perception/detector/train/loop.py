@@ -33,8 +33,8 @@ CENTRE_POSITIVE = 20.0
 class TrainSettings:
     """Epochs (one crop of every image each), batch size, peak learning rate, seed."""
 
-    epochs: int = 30
-    batch: int = 16
+    epochs: int = 150
+    batch: int = 12
     learning_rate: float = 3e-3
     seed: int = 0
     losses: list[float] = field(default_factory=list, compare=False)
