@@ -36,7 +36,8 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "--seed",
         str(SEED),
     ]
-    status = main([*args, "--record-frames", str(folder), "-q"])
+    log = folder.parent / "sim.jsonl"
+    status = main([*args, "--record-frames", str(folder), "--log", str(log), "-q"])
     if not (folder / INDEX).is_file():
         unavailable("the rendered bush is unavailable here (EGL)")
     assert status == 0
@@ -74,6 +75,31 @@ def test_the_hardware_path_sends_the_recorded_commands(recording: Path, tmp_path
     # recorded, and refit the canes.
     done = [r for r in records if r["kind"] == "survey_done"]
     assert len(done) == 1 and done[0]["used"] >= 1
+
+
+def _run_events(path: Path) -> list[tuple[object, ...]]:
+    """The state machine's story of a run's log: each transition, each berry's result
+    and the run's end, without times."""
+    records = [json.loads(line) for line in path.read_text().splitlines()]
+    story: list[tuple[object, ...]] = []
+    for r in records:
+        if r["kind"] == "transition":
+            story.append(("transition", r["berry"], r["old"], r["new"]))
+        elif r["kind"] == "berry_result":
+            story.append(("berry_result", r["tag_id"], r["final_state"], r["fault"]))
+        elif r["kind"] in ("run_done", "run_stopped"):
+            story.append((r["kind"],))
+    return story
+
+
+def test_both_rigs_run_the_recorded_harvest_by_one_policy(recording: Path, tmp_path: Path) -> None:
+    """The simulator's run and the hardware rig's replay of it tell the same story:
+    the same transitions, berry results and end of run (softarm.harvest.run_policy)."""
+    _replay(recording, tmp_path)
+    sim = _run_events(recording.parent / "sim.jsonl")
+    arm = _run_events(tmp_path / "replay.jsonl")
+    assert sim[-1] == ("run_done",)
+    assert arm == sim
 
 
 def test_a_different_ripeness_reading_is_not_the_recording(recording: Path, tmp_path: Path) -> None:

@@ -35,6 +35,7 @@ from softarm.harvest.map_harvest import harvest_map
 from softarm.harvest.report import HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
 from softarm.harvest.rig_parts import CANE_REACH, rig_parts
+from softarm.harvest.run_policy import finish_run
 from softarm.harvest.states import FAULTS_THAT_STOP
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
@@ -81,10 +82,7 @@ class HardwareRig:
             c1.look, c1.bush_map, machine.run_berry, berries, stop_on=FAULTS_THAT_STOP,
             on_look=lambda: machine.log_map(c1.bush_map),
         )  # fmt: skip
-        last = report.berries[-1].fault if report.berries else None
-        report.stopped = last if last in FAULTS_THAT_STOP else None
-        machine.log.event("run_done", success_rate=report.success_rate)
-        return report
+        return finish_run(report, machine.log)
 
 
 def build_hardware_rig(

@@ -49,8 +49,9 @@ from softarm.harvest.map_harvest import map_record
 from softarm.harvest.observe import BerryWatch
 from softarm.harvest.outcome import Fault
 from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.run_policy import run_targets
 from softarm.harvest.servo import Servo
-from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+from softarm.harvest.states import FaultReason, HarvestState
 from softarm.harvest.survey import SurveyPlan
 from softarm.harvest_config import HarvestConfig
 from softarm.perception.bush_map import BushMap
@@ -131,18 +132,10 @@ class HarvestMachine:
         return self.actuator.sent
 
     def run(self, berries: Sequence[BerryTarget]) -> HarvestReport:
-        """Harvest ``berries`` in order; stop early after a fault in FAULTS_THAT_STOP."""
-        report = HarvestReport()
-        for i, berry in enumerate(berries):
-            result = self.run_berry(berry)
-            report.berries.append(result)
-            if result.fault in FAULTS_THAT_STOP:
-                report.stopped = result.fault
-                self.log.event("run_stopped", reason=result.fault, remaining=len(berries) - i - 1)
-                report.berries += [BerryResult(b.tag_id) for b in berries[i + 1 :]]
-                break
-        self.log.event("run_done", success_rate=report.success_rate)
-        return report
+        """Harvest ``berries`` by the run policy both rigs follow
+        (:func:`~softarm.harvest.run_policy.run_targets`: in order, those lost from view
+        once more, a fault in FAULTS_THAT_STOP ends the run)."""
+        return run_targets(self.run_berry, berries, self.log)
 
     def run_berry(self, berry: BerryTarget, grasp: bool = True) -> BerryResult:
         """Take one berry through the whole workflow; never raises for a device fault.

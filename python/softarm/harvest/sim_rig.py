@@ -42,9 +42,9 @@ from softarm.harvest.rate import rate_record
 from softarm.harvest.report import BerryResult, HarvestReport
 from softarm.harvest.rig import ControlInputs, build_control_stack
 from softarm.harvest.rig_parts import CANE_REACH, rig_parts
+from softarm.harvest.run_policy import finish_run, run_targets
 from softarm.harvest.sim_devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.sim_vision import BASE_TAG_ID, SimCameras, look_at, sim_vision
-from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_map import BushMap
@@ -166,12 +166,9 @@ class SimRig:
     survey: CaneSurvey | None = None
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
-        """Harvest every berry of the bush in order; ``on_berry(i, result)`` after each.
-
-        A berry lost from view (MARKER_LOST) is tried once more after the others: from the
-        eye-to-hand camera a berry tag can hide behind another berry's until that one is
-        picked. The report keeps each berry's last attempt.
-        """
+        """Harvest every berry of the bush by the run policy both rigs follow
+        (:mod:`softarm.harvest.run_policy`); ``on_berry(i, result)`` after each attempt.
+        The report keeps each berry's last attempt."""
         if self.scene is not None:
             try:
                 return self._finish(self._harvest_bush(on_berry))
@@ -179,23 +176,10 @@ class SimRig:
                 if self.recorder is not None:  # an unfinished recording is not left behind
                     self.recorder.discard()
                 raise
-        report = HarvestReport()
-        order = [b.tag_id for b in self.bush.berries]
-        results: dict[int, BerryResult] = {}
-        for tags in (order, None):
-            if tags is None:  # second pass: the berries lost from view
-                tags = [t for t in order if results[t].fault is FaultReason.MARKER_LOST]
-            for tag in tags:
-                results[tag] = self.machine.run_berry(BerryTarget(tag))
-                if on_berry is not None:
-                    on_berry(order.index(tag), results[tag])
-                if results[tag].fault in FAULTS_THAT_STOP:
-                    report.stopped = results[tag].fault
-                    break
-            if report.stopped is not None:
-                break
-        report.berries = [results.get(t, BerryResult(t)) for t in order]
-        return self._finish(report)
+        targets = [BerryTarget(b.tag_id) for b in self.bush.berries]
+        return self._finish(
+            run_targets(self.machine.run_berry, targets, self.machine.log, on_berry)
+        )
 
     def _harvest_bush(self, on_berry: Callable[[int, BerryResult], None] | None) -> HarvestReport:
         """The markerless harvest of the rendered bush, the survey first."""
@@ -203,10 +187,11 @@ class SimRig:
         scene = self.scene
         if self.survey is not None:
             self.survey.run()
-        return harvest_bush(
+        report = harvest_bush(
             scene, self.machine.run_berry, self.gripper.delivered, on_berry,
             on_look=lambda: self.machine.log_map(scene.bush_map),
         )  # fmt: skip
+        return finish_run(report, self.machine.log)
 
     def close(self) -> None:
         """Free the rendered bush's OpenGL contexts (if any) now, rather than in
