@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import ast
 import functools
+import re
+import textwrap
 from pathlib import Path
 from types import ModuleType
 
@@ -29,6 +31,14 @@ def _signature(fn: ast.FunctionDef) -> str:
     return f"({args}){returns}"
 
 
+def _summary(doc: str) -> str:
+    """The first sentence of a docstring's first paragraph, however many lines it spans
+    (its first line alone was often cut mid-sentence)."""
+    paragraph = " ".join(doc.split("\n\n")[0].split())
+    end = re.search(r"(?<!Eq)(?<!eq)(?<!e\.g)(?<!i\.e)\.(\s+[A-Z(`]|$)", paragraph)
+    return paragraph if end is None else paragraph[: end.start() + 1]
+
+
 def _class_doc(node: ast.ClassDef) -> str | None:
     doc = ast.get_docstring(node)
     if not doc:
@@ -43,7 +53,10 @@ def _class_doc(node: ast.ClassDef) -> str | None:
             continue
         member_doc = ast.get_docstring(item)
         if member_doc and not item.name.startswith("_"):
-            members.append(f"    {item.name}: {member_doc.splitlines()[0]}")
+            members += textwrap.wrap(
+                f"{item.name}: {_summary(member_doc)}", 88, initial_indent="    ",
+                subsequent_indent="        ",
+            )  # fmt: skip
     if members:
         lines += ["", "Members:", *members]
     return "\n".join(lines)
