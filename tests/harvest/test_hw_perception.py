@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from softarm.errors import ConfigError
+from softarm._core import PolynomialCurve
+from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.simulated import SimulatedCamera
 from softarm.harvest import hw_devices, hw_rig, rig
 from softarm.perception.bush_vision import BushVision
@@ -141,3 +142,13 @@ def test_the_rig_perceives_the_rendered_bush_as_the_simulator_does(
         assert len(canes_given[0]) >= len(scene.bush_map.canes) > 0
     finally:
         built.close()
+
+
+@pytest.mark.usefixtures("no_devices")
+def test_given_canes_with_the_survey_on_are_refused_not_a_silent_survey_off(
+    tmp_path: Path,
+) -> None:
+    config = _perceiving(tmp_path, _ideal_pair(), stereo="zed2", device=3)
+    cane = PolynomialCurve(np.array([[0.0, 0.1, 0, 0], [0.4, 0, 0, 0], [0.3, 0, 0, 0]]), (0, 1))
+    with pytest.raises(ParameterError, match=r"canes: .*survey = false"):
+        hw_rig.build_hardware_rig(config, canes=[cane])

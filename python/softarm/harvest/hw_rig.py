@@ -18,7 +18,7 @@ from softarm._core import PolynomialCurve, Section, SoftArm
 from softarm.calibration.result import Calibration
 from softarm.checks import FloatArray
 from softarm.config import Config
-from softarm.errors import ConfigError
+from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.arduino_devices import ArduinoGripper, ArduinoRipenessSensor
 from softarm.hardware.clock import MonotonicClock
 from softarm.hardware.pressure_map import ElongationMap
@@ -110,11 +110,18 @@ def build_hardware_rig(
     Raises:
         HardwareUnavailableError: a device (or its driver) is absent.
         ConfigError: the calibration needed by the vision loop is missing.
+        ParameterError: ``canes`` are given while ``[perception]`` asks for the survey,
+            which refines the canes C1 fits (it was silently left out).
     """
     cfg = harvest or config.harvest
     cal = config.calibration
     if cal.T_C1_base is None or cal.T_C2_EE is None:
         raise ConfigError("calibration.T_C1_base and calibration.T_C2_EE must be set to harvest")
+    if canes and config.perception is not None and config.perception.survey:
+        raise ParameterError(
+            "canes: given canes replace the ones C1 fits, which [perception] survey "
+            "refines; set survey = false in [perception] to harvest with them"
+        )
     inputs = hardware_inputs(config, identified, calibration, seed)
     dev = devices or DeviceDrivers()
     with ExitStack() as stack:
