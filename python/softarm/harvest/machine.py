@@ -58,7 +58,6 @@ from softarm.perception.bush_map import BushMap
 
 __all__ = ["HarvestMachine"]
 
-S = HarvestState
 
 #: The survey's steps and transitions are logged under this target (no berry's id).
 SURVEY = BerryTarget(-1)
@@ -114,7 +113,7 @@ class HarvestMachine:
         self.config = config or HarvestConfig()
         self.log = log or HarvestLog()
         self.ground_truth = ground_truth
-        self.state = S.IDLE
+        self.state = HarvestState.IDLE
         #: The ready pose between berries: straight, every actuator at ``home_elongation``,
         #: away from the lower limits where the resolver's steps would be clipped.
         self.home: FloatArray = np.full(n_actuators, self.config.home_elongation)
@@ -148,27 +147,29 @@ class HarvestMachine:
         watch = BerryWatch(self.vision, self.clock, berry, self.log, self.config.marker_timeout)
         self.axis = self.config.approach_axis
         servo = self.servo
-        self._transition(S.IDLE, berry, "new berry")
+        self._transition(HarvestState.IDLE, berry, "new berry")
         try:
             self.vision.select(berry)
             idle_deadline = self.clock.now() + self.config.idle_timeout
             servo.ramp(watch, self.state, self.q, self.home, idle_deadline)
             servo.wait_visible(watch, self.state, self.q)
-            self._transition(S.INITIAL_PLACEMENT, berry, "cube and berry in view")
+            self._transition(HarvestState.INITIAL_PLACEMENT, berry, "cube and berry in view")
             waypoints = self._reach(watch, berry)
             self._record_grasp_errors(berry, result)
             if not grasp:
-                self._transition(S.DONE, berry, "positioned; no grasp requested")
+                self._transition(HarvestState.DONE, berry, "positioned; no grasp requested")
                 return self._finish(result, watch, start)
-            self._transition(S.GRASP, berry, "berry within the grasp workspace")
+            self._transition(HarvestState.GRASP, berry, "berry within the grasp workspace")
             self._grasp(result)
-            self._transition(S.RETURN_HOME, berry, "grasp finished")
+            self._transition(HarvestState.RETURN_HOME, berry, "grasp finished")
             servo.go_home(
                 watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
             )
             if result.harvested:
                 self.gripper.open()  # drop the berry at the rest pose
-            self._transition(S.DONE, berry, "harvested" if result.harvested else "skipped")
+            self._transition(
+                HarvestState.DONE, berry, "harvested" if result.harvested else "skipped"
+            )
         except STAGE_ERRORS as exc:
             self._fault(berry, result, _reason(exc), _detail(exc))
         except BaseException as exc:
@@ -184,7 +185,7 @@ class HarvestMachine:
         A fault ends the survey where it is, vented and logged like a berry's, with the
         pairs taken before it; the harvest goes on from IDLE."""
         watch = BerryWatch(self.vision, self.clock, SURVEY, self.log, self.config.marker_timeout)
-        self._transition(S.SURVEY, SURVEY, f"{len(plan.pairs)} pairs of views planned")
+        self._transition(HarvestState.SURVEY, SURVEY, f"{len(plan.pairs)} pairs of views planned")
         pairs: list[tuple[View, View]] = []
         try:
             for first, second in plan.pairs:
@@ -193,7 +194,7 @@ class HarvestMachine:
                     pairs.append((views[0], views[1]))
             deadline = self.clock.now() + self.config.idle_timeout
             self.servo.ramp(watch, self.state, self.q, self.home, deadline)
-            self._transition(S.IDLE, SURVEY, f"survey done: {len(pairs)} pairs of views")
+            self._transition(HarvestState.IDLE, SURVEY, f"survey done: {len(pairs)} pairs of views")
         except STAGE_ERRORS as exc:
             self._fault(SURVEY, BerryResult(SURVEY.tag_id), _reason(exc), _detail(exc))
         except BaseException as exc:
@@ -240,7 +241,7 @@ class HarvestMachine:
                 grasp_within = c.grasp_workspace
             try:
                 self.servo.place(watch, self.state, self.q, self.axis, waypoints)
-                self._transition(S.FINE_POSITIONING, berry, "pre-grasp pose reached")
+                self._transition(HarvestState.FINE_POSITIONING, berry, "pre-grasp pose reached")
                 self.servo.fine(watch, self.state, self.q, self.axis, grasp_within)
                 return waypoints
             except Fault as fault:
@@ -257,7 +258,7 @@ class HarvestMachine:
                     again, why, back_to = True, "back to the nearest attempt", nearest
                 else:
                     again, why = False, "backing out before the fault"
-                self._transition(S.RETURN_HOME, berry, f"{why}: {fault}")
+                self._transition(HarvestState.RETURN_HOME, berry, f"{why}: {fault}")
                 try:
                     self.servo.go_home(
                         watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
@@ -271,7 +272,7 @@ class HarvestMachine:
                     tried.append(self.axis)
                 self.servo.wait_visible(watch, self.state, self.q)
                 self._transition(
-                    S.INITIAL_PLACEMENT,
+                    HarvestState.INITIAL_PLACEMENT,
                     berry,
                     f"re-approach {len(tried)}: another axis"
                     if back_to is None
@@ -354,7 +355,7 @@ class HarvestMachine:
         self.log.event(
             "fault", t=self.clock.now(), berry=berry.tag_id, reason=reason, detail=detail
         )
-        self._transition(S.FAULT, berry, f"{reason.value}: {detail}")
+        self._transition(HarvestState.FAULT, berry, f"{reason.value}: {detail}")
 
     def log_map(self, bush_map: BushMap) -> None:
         """Log the bush map as it is now (a ``bush_map`` record: the berries perception
