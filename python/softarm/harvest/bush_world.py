@@ -159,8 +159,16 @@ class BushGripper(SimGripper):
     """:class:`SimGripper` whose selected berry is a map entry: it closes on the true
     berry that entry stands for (ground truth, :meth:`BushScene.truth_of`)."""
 
-    def __init__(self, scene: BushScene, *args: object, **kwargs: object) -> None:
-        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+    def __init__(
+        self,
+        scene: BushScene,
+        plant: ArmPlant,
+        vision: object,
+        on_bush: list[Berry],
+        offset: float,
+        workspace: float,
+    ) -> None:
+        super().__init__(plant, vision, on_bush, offset, workspace)
         self.scene = scene
 
     def _berry(self, tag_id: int) -> Berry | None:
