@@ -6,6 +6,10 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
 import cv2
@@ -166,37 +170,76 @@ def test_train_without_the_extra_is_one_line_naming_it(
     assert not out.exists()
 
 
-@pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
+#: JAX starts thread pools when imported: the tests that train run it in a child process,
+#: so that the suite's own later forks (Ray, subprocess) never happen beside them.
+NEEDS_JAX = pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
+TESTS = Path(__file__).parent
+
+
+def _in_child(code: str, *args: str) -> subprocess.CompletedProcess[str]:
+    """Run ``code`` (with the tests' helpers importable) in a fresh interpreter."""
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")]),
+    }
+    return subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code), *args],
+        capture_output=True, text=True, env=env, timeout=600, check=False,
+    )  # fmt: skip
+
+
+def _softarm(*args: str) -> subprocess.CompletedProcess[str]:
+    return _in_child(
+        "import sys; from softarm.cli import main; sys.exit(main(sys.argv[1:]))", *args
+    )
+
+
+@NEEDS_JAX
 def test_onnx_export_round_trips_the_parameters(tmp_path: Path) -> None:
-    from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
-    from softarm.perception.detector.train.unet import init_params
+    done = _in_child(
+        """
+        import sys
+        import numpy as np
+        from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
+        from softarm.perception.detector.train.unet import init_params
 
-    params = init_params(3)
-    export_onnx(params, tmp_path / "w.onnx")
-    back = params_from_onnx(tmp_path / "w.onnx")
-    for name, (w, b) in params.items():
-        np.testing.assert_array_equal(np.asarray(back[name][0]), np.asarray(w))
-        np.testing.assert_array_equal(np.asarray(back[name][1]), np.asarray(b))
+        params = init_params(3)
+        export_onnx(params, sys.argv[1])
+        back = params_from_onnx(sys.argv[1])
+        for name, (w, b) in params.items():
+            np.testing.assert_array_equal(np.asarray(back[name][0]), np.asarray(w))
+            np.testing.assert_array_equal(np.asarray(back[name][1]), np.asarray(b))
+        """,
+        str(tmp_path / "w.onnx"),
+    )
+    assert done.returncode == 0, done.stderr
 
 
-@pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
+@NEEDS_JAX
 def test_crops_are_the_same_for_the_same_seed(tmp_path: Path) -> None:
-    from softarm.perception.detector.train.augment import crop_batch
-    from softarm.perception.detector.train.samples import load_samples
-
     write_folder(tmp_path, training_scenes(3, seed=1))
-    samples, _ = load_samples([tmp_path])
-    a, b = (crop_batch(samples, np.array([0, 1, 2, 0]), 5, 2) for _ in range(2))
-    c = crop_batch(samples, np.array([0, 1, 2, 0]), 6, 2)
-    for x, y in zip(a, b, strict=True):
-        np.testing.assert_array_equal(x, y)
-    assert not np.array_equal(a[0], c[0])
+    done = _in_child(
+        """
+        import sys
+        from pathlib import Path
+        import numpy as np
+        from softarm.perception.detector.train.augment import crop_batch
+        from softarm.perception.detector.train.samples import load_samples
+
+        samples, _ = load_samples([Path(sys.argv[1])])
+        a, b = (crop_batch(samples, np.array([0, 1, 2, 0]), 5, 2) for _ in range(2))
+        c = crop_batch(samples, np.array([0, 1, 2, 0]), 6, 2)
+        for x, y in zip(a, b, strict=True):
+            np.testing.assert_array_equal(x, y)
+        assert not np.array_equal(a[0], c[0])
+        """,
+        str(tmp_path),
+    )
+    assert done.returncode == 0, done.stderr
 
 
-@pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
-def test_train_end_to_end_on_a_tiny_dataset(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+@NEEDS_JAX
+def test_train_end_to_end_on_a_tiny_dataset(tmp_path: Path) -> None:
     from softarm.perception.detector.learned import LearnedDetector
     from softarm.vision.camera_model import CameraModel
 
@@ -204,8 +247,9 @@ def test_train_end_to_end_on_a_tiny_dataset(
     write_folder(data, training_scenes(6, seed=2))
     out = tmp_path / "w.onnx"
     args = ["detector", "train", "--data", str(data), "--out", str(out), "--epochs", "1"]
-    assert main([*args, "--seed", "3", "-q"]) == 0
-    assert "detector train: 1 epochs" in capsys.readouterr().out
+    done = _softarm(*args, "--seed", "3", "-q")
+    assert done.returncode == 0, done.stderr
+    assert "detector train: 1 epochs" in done.stdout
     record = json.loads(out.with_suffix(".json").read_text())
     assert record["epochs"] == 1 and record["seed"] == 3 and len(record["losses"]) == 1
     assert np.isfinite(record["losses"][0])
@@ -215,14 +259,13 @@ def test_train_end_to_end_on_a_tiny_dataset(
     assert isinstance(dets, list)
 
 
-@pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
-def test_train_from_a_file_that_is_no_network_is_one_line(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+@NEEDS_JAX
+def test_train_from_a_file_that_is_no_network_is_one_line(tmp_path: Path) -> None:
     data = tmp_path / "data"
     write_folder(data, training_scenes(1, seed=2))
     (tmp_path / "bad.onnx").write_bytes(b"nonsense")
     args = ["detector", "train", "--data", str(data), "--out", str(tmp_path / "w.onnx")]
-    assert main([*args, "--from", str(tmp_path / "bad.onnx")]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
+    done = _softarm(*args, "--from", str(tmp_path / "bad.onnx"))
+    assert done.returncode == 2
+    err = done.stderr.strip().splitlines()
     assert len(err) == 1 and "bad.onnx" in err[0]
