@@ -14,14 +14,14 @@ from softarm.sweep.trial import BERRY_COLUMNS
 
 
 def rows(trial: TrialSpec, harvested: bool = True) -> list[dict[str, Any]]:
-    """One row per berry, every berry harvested in 2 s of simulated time."""
+    """One row per berry, every berry harvested in 2 s (+ the seed) of simulated time."""
     out = []
     for i in range(trial.berries):
         row: dict[str, Any] = dict.fromkeys(BERRY_COLUMNS)
         row.update(trial_id=trial.trial_id, seed=trial.seed, **trial.plant)
         row.update(berry=i, tag_id=10 + i, harvested=harvested, duration_s=2.0 + trial.seed,
                    true_position_error_mm=0.5, branch_contact_steps=0, min_branch_gap_m=0.03,
-                   node=str(os.getpid()))  # fmt: skip
+                   sim_s=(2.0 + trial.seed) * trial.berries, node=str(os.getpid()))  # fmt: skip
         out.append(row)
     return out
 

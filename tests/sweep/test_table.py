@@ -74,8 +74,11 @@ def test_summary_tables_and_plot(tmp_path: Path) -> None:
     assert stats[(0.08,)].berries == 4 and stats[(0.08,)].harvested == 1.0
     assert stats[(0.3,)].berries == 2 and stats[(0.3,)].failed_trials == 1
     assert stats[(0.08,)].median_duration_s == pytest.approx(2.5)
+    # 4 berries in 2 x 2 s (seed 0) + 2 x 3 s (seed 1) of simulated time: 1440 an hour.
+    assert stats[(0.08,)].berries_per_hour == pytest.approx(3600 * 4 / 10)
     text = markdown_summary(all_rows, ["pressure_tau"])
     assert "## By pressure_tau" in text and "| 0.3 | 2 | 100.0 % |" in text
+    assert "berries / h" in text and "| 1440 |" in text
     plot_summary(all_rows, ["pressure_tau"], tmp_path / "summary.png")
     assert (tmp_path / "summary.png").stat().st_size > 10_000
 

@@ -48,3 +48,13 @@ def test_harvest_gains_option_checks_the_file_first(
     assert main(["harvest", "--sim", "--berries", "1", "--gains", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "[gains] hybrid_alpha" in err and err.count("\n") == 1
+
+
+def test_a_trial_row_carries_the_bushs_rate() -> None:
+    """Each berry's row repeats its bush's rate (softarm.harvest.rate) and simulated time."""
+    trial = TrialSpec(seed=90040, plant={}, berries=1, rig={}, gains={})
+    rows = run_trial_rows(trial, single_threaded=False)
+    assert rows and all(r["error"] is None for r in rows), rows
+    (row,) = rows
+    assert row["sim_s"] > 0
+    assert row["berries_per_hour"] == pytest.approx(3600 * int(row["harvested"]) / row["sim_s"])

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -29,6 +29,9 @@ class GroupStats:
     contact_steps: int  # cane-contact steps, summed over the trials (bushes)
     min_gap_mm: float  # smallest arm-to-cane gap over the trials
     failed_trials: int
+    #: Berries harvested per hour of simulated time over the trials (their harvested
+    #: berries over their simulated time: survey, moves and way home included).
+    berries_per_hour: float = math.nan
 
 
 def _stats(rows: list[dict[str, Any]]) -> GroupStats:
@@ -49,7 +52,14 @@ def _stats(rows: list[dict[str, Any]]) -> GroupStats:
         contact_steps=int(sum(r["branch_contact_steps"] or 0 for r in per_trial.values())),
         min_gap_mm=1e3 * min(gaps) if gaps else math.nan,
         failed_trials=failed,
+        berries_per_hour=_rate(per_trial.values(), len(harvested)),
     )
+
+
+def _rate(trials: Iterable[dict[str, Any]], harvested: int) -> float:
+    """Harvested berries per hour of the trials' simulated time (NaN without it)."""
+    seconds = [t["sim_s"] for t in trials if t.get("sim_s") is not None]
+    return 3600.0 * harvested / sum(seconds) if seconds and sum(seconds) > 0 else math.nan
 
 
 def group_stats(
@@ -68,12 +78,13 @@ def _fmt(v: float, spec: str) -> str:
 
 def _table(keys: Sequence[str], stats: dict[tuple[Any, ...], GroupStats]) -> list[str]:
     head = [*keys, "berries", "harvested", "mean error (mm)", "median s / berry",
-            "contact steps", "min gap (mm)", "failed trials"]  # fmt: skip
+            "contact steps", "min gap (mm)", "berries / h", "failed trials"]  # fmt: skip
     out = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
     for k, s in stats.items():
         cells = [*map(str, k), str(s.berries), _fmt(100 * s.harvested, ".1f") + " %",
                  _fmt(s.mean_error_mm, ".2f"), _fmt(s.median_duration_s, ".1f"),
-                 str(s.contact_steps), _fmt(s.min_gap_mm, ".1f"), str(s.failed_trials)]  # fmt: skip
+                 str(s.contact_steps), _fmt(s.min_gap_mm, ".1f"),
+                 _fmt(s.berries_per_hour, ".0f"), str(s.failed_trials)]  # fmt: skip
         out.append("| " + " | ".join(cells) + " |")
     return out
 

@@ -35,6 +35,8 @@ _BERRY_TYPES = {
     "branch_contact_steps": "int64",
     "min_branch_gap_m": "float64",
     "stopped": "string",
+    "berries_per_hour": "float64",
+    "sim_s": "float64",
     "error": "string",
     "wall_s": "float64",
     "cpu_s": "float64",

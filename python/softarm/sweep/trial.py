@@ -31,6 +31,8 @@ BERRY_COLUMNS: tuple[str, ...] = (
     "branch_contact_steps",
     "min_branch_gap_m",
     "stopped",
+    "berries_per_hour",
+    "sim_s",
     "error",
     "wall_s",
     "cpu_s",
@@ -96,6 +98,7 @@ def run_trial_rows(trial: TrialSpec, single_threaded: bool = True) -> list[dict[
         ]
     wall = time.perf_counter() - start
     cpu = time.process_time() - cpu_start  # this process's CPU time: throughput on a busy host
+    rate = report.get("rate") or {}
     rows = []
     for i, b in enumerate(report["berries"]):
         rows.append(
@@ -114,6 +117,10 @@ def run_trial_rows(trial: TrialSpec, single_threaded: bool = True) -> list[dict[
                 "branch_contact_steps": report.get("branch_contact_steps"),
                 "min_branch_gap_m": report.get("min_branch_gap_m"),
                 "stopped": report.get("stopped"),
+                # The bush's rate (softarm.harvest.rate): harvested per hour of simulated
+                # time, and that time, survey, moves and way home included.
+                "berries_per_hour": rate.get("berries_per_hour"),
+                "sim_s": rate.get("total_s"),
                 "error": None,
                 "wall_s": wall,
                 "cpu_s": cpu,
