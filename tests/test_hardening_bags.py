@@ -7,7 +7,6 @@ written here; nothing is simulated."""
 from __future__ import annotations
 
 import json
-import os
 import signal
 from pathlib import Path
 from typing import Any
@@ -16,6 +15,7 @@ import pytest
 
 pytest.importorskip("rosbags")
 
+from bag_stops import sigterm_while_writing_bag
 from softarm.cli import main
 from softarm.commands import replay
 from softarm.harvest.header import split_runs
@@ -162,21 +162,8 @@ def test_replay_stopped_by_sigterm_leaves_no_temporary_files(
 ) -> None:
     """Item 19: SIGTERM ended replay where it stood, leaving a ``.bag-*/`` folder and a
     ``.*.tmp.mcap`` per kill; now it unwinds through their clean-up, exit 143."""
-    from softarm.viz.bag import writer
-
     log = _log(tmp_path / "run.jsonl", [_step(0.1 * i) for i in range(5)])
-    write = writer._write
-
-    def killed_mid_write(w: Any, m: Any, messages: Any) -> Any:
-        def stop_after_some(items: Any) -> Any:
-            for n, item in enumerate(items):
-                if n == 5:
-                    os.kill(os.getpid(), signal.SIGTERM)
-                yield item
-
-        return write(w, m, stop_after_some(messages))
-
-    monkeypatch.setattr(writer, "_write", killed_mid_write)
+    sigterm_while_writing_bag(monkeypatch, after=5)
     previous = signal.signal(signal.SIGTERM, lambda s, f: pytest.fail("no handler"))
     try:
         status = main(["replay", str(log), "--bag", str(tmp_path / "run.mcap")])

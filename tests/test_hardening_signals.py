@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 
+from bag_stops import sigterm_while_writing_bag
 from softarm.cli import main
 from softarm.stops import drives_arm
 
@@ -98,20 +99,7 @@ def test_a_stop_while_the_bag_is_written_is_recorded_in_the_log(
     """Item 19: the run had closed its log; the stop during the bag left it without an
     ``interrupted`` record (exit 143, the report written, no bag)."""
     pytest.importorskip("rosbags")
-    from softarm.viz.bag import writer
-
-    write = writer._write
-
-    def stopped_mid_write(w: Any, m: Any, messages: Any) -> Any:
-        def stop_after_some(items: Any) -> Any:
-            for n, item in enumerate(items):
-                if n == 20:
-                    os.kill(os.getpid(), signal.SIGTERM)
-                yield item
-
-        return write(w, m, stop_after_some(messages))
-
-    monkeypatch.setattr(writer, "_write", stopped_mid_write)
+    sigterm_while_writing_bag(monkeypatch, after=20)
     log, bag = tmp_path / "run.jsonl", tmp_path / "run.mcap"
     argv = ["harvest", "--sim", "--berries", "1", "--seed", "3", "--log", str(log)]
     assert main([*argv, "--bag", str(bag), "-q"]) == 143
