@@ -37,11 +37,10 @@ GROUND_Z = -0.45
 #: Trellis wire heights (m) and post positions along the row (m).
 WIRES_Z = (-0.05, 0.35, 0.75)
 POSTS_X = (-1.1, 0.55)
-#: The row's canes, fruit and leaflets.
+#: The row's canes and leaflets (its fruit, dead leaflets and stones: the look's
+#: ``fruit_range``, ``dead_share`` and ``stone_range``, softarm.sim.render.row_look).
 ROW_CANES = (18, 28)
-ROW_FRUIT = (30, 70)
 LEAFLETS = (380, 520)
-DEAD_SHARE = 0.08
 #: Stage odds of the row's fruit (green, red, turning, ripe).
 STAGE_ODDS = (0.22, 0.23, 0.15, 0.40)
 #: Clear distance (m) of the row's canes and fruit from the bush's approach corridors.
@@ -92,11 +91,11 @@ class Row:
             RowFruit(b.tag_id, b.position, stage_of(b.ripeness, rng), float(rng.uniform(0.9, 1.1)))
             for b in bush.berries
         ]
-        fruit += _row_fruit(rng, canes, corridors, [f.position for f in fruit])
+        fruit += _row_fruit(rng, canes, corridors, [f.position for f in fruit], look.fruit_range)
         every = [*bush.branches, *canes]
         lines = [(b.position - 0.08 * PLUS_Y, b.position) for b in bush.berries]
-        leaflets = _leaflets(rng, every, lines)
-        n_stones = int(rng.integers(15, 30))
+        leaflets = _leaflets(rng, every, lines, look.dead_share)
+        n_stones = int(rng.integers(*look.stone_range))
         stones = np.column_stack(
             [
                 rng.uniform(-ROW_HALF, ROW_HALF, n_stones),
@@ -173,10 +172,12 @@ def _row_fruit(
     canes: list[Branch],
     corridors: list[tuple[FloatArray, FloatArray]],
     taken: list[FloatArray],
+    count: tuple[int, int],
 ) -> list[RowFruit]:
-    """Clusters of 1-5 fruit that touch, hanging in front of the row's canes."""
+    """Clusters of 1-5 fruit that touch, hanging in front of the row's canes (their
+    number drawn from ``count``, [lo, hi))."""
     out: list[RowFruit] = []
-    want = int(rng.integers(*ROW_FRUIT))
+    want = int(rng.integers(*count))
     placed = list(taken)
     for _ in range(want * 10):
         if len(out) >= want or not canes:
@@ -202,10 +203,14 @@ def _row_fruit(
 
 
 def _leaflets(
-    rng: np.random.Generator, canes: list[Branch], lines: list[tuple[FloatArray, FloatArray]]
+    rng: np.random.Generator,
+    canes: list[Branch],
+    lines: list[tuple[FloatArray, FloatArray]],
+    dead_share: float,
 ) -> list[Leaflet]:
     """Leaflets along every cane and through the hedge's volume, facing mostly out of
-    the row (±Y), kept out of the last 8 cm before each berry."""
+    the row (±Y), kept out of the last 8 cm before each berry; ``dead_share`` of them
+    dead."""
     out: list[Leaflet] = []
     want = int(rng.integers(*LEAFLETS))
     points = np.vstack([c.points(30) for c in canes])
@@ -225,7 +230,7 @@ def _leaflets(
         length = float(rng.uniform(0.05, 0.09))
         if not _clear(centre[None, :], lines, length + 0.02):
             continue  # as the bush's own leaves (mjcf._leaves)
-        out.append(Leaflet(centre, _leaf_rotation(rng), length, bool(rng.uniform() < DEAD_SHARE)))
+        out.append(Leaflet(centre, _leaf_rotation(rng), length, bool(rng.uniform() < dead_share)))
     return out
 
 

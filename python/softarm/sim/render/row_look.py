@@ -3,6 +3,14 @@
 whose parameters are drawn per seed from the ranges of :data:`LOOK_RANGES`, the one
 table of them (docs/perception.md prints it with :func:`look_table`).
 
+The row's content has two knobs of its own, held by name (``RowLook.named(...,
+lookalikes=, fruit=)``) so that a sweep can vary them apart from the light:
+``lookalikes`` (:data:`LOOKALIKES`: the share of the row's leaflets that are dead and
+dark, and how many stones lie on the ground) and ``fruit`` (:data:`FRUIT_DENSITY`: how
+many fruit the row hangs around the bush's). The row (:class:`~softarm.sim.render.row.Row`)
+draws its counts from these ranges with its own seeded generator; ``normal`` is the
+row every look drew before the knobs existed, draw for draw.
+
 Angles are in degrees. The sun's azimuth is measured in the base frame's XY plane from
 +X towards +Y: -90 is behind C1 (the row lit from the front), +90 behind the row (C1
 looks into the light). ``warmth`` tints the sun from cool (-1) to orange (+1);
@@ -21,11 +29,33 @@ from softarm.errors import ParameterError
 from softarm.sim.render.camera_effects import CameraEffects, StereoEffects
 from softarm.sim.render.look import BushLook, _mix
 
-__all__ = ["FAMILIES", "LOOKS", "LOOK_RANGES", "RowLook", "look_table"]
+__all__ = [
+    "FAMILIES",
+    "FRUIT_DENSITY",
+    "LOOKALIKES",
+    "LOOKS",
+    "LOOK_RANGES",
+    "RowLook",
+    "look_table",
+]
 
 #: The named families, and what ``--look`` accepts.
 FAMILIES = ("sun", "overcast", "backlight", "dusk")
 LOOKS = (*FAMILIES, "random")
+
+#: Look-alike levels: the share of the row's leaflets that are dead (dark, dry: they
+#: pass for ripe fruit) and the range [lo, hi) of stones on the ground.
+LOOKALIKES: dict[str, tuple[float, tuple[int, int]]] = {
+    "few": (0.01, (2, 6)),
+    "normal": (0.08, (15, 30)),
+    "many": (0.25, (50, 80)),
+}
+#: Fruit density levels: the range [lo, hi) of fruit the row hangs around the bush's.
+FRUIT_DENSITY: dict[str, tuple[int, int]] = {
+    "sparse": (8, 20),
+    "normal": (30, 70),
+    "dense": (90, 130),
+}
 
 _COMMON: dict[str, tuple[float, float]] = {
     "sun_elevation": (35.0, 70.0),
@@ -99,12 +129,28 @@ class RowLook(BushLook):
     stereo: StereoEffects
     c2: CameraEffects
     blur_px_s: float
+    lookalikes: str = "normal"
+    fruit: str = "normal"
 
     @classmethod
-    def named(cls, name: str, seed: int) -> RowLook:
-        """A look of family ``name`` (one of :data:`LOOKS`) drawn from ``seed``."""
+    def named(
+        cls, name: str, seed: int, lookalikes: str = "normal", fruit: str = "normal"
+    ) -> RowLook:
+        """A look of family ``name`` (one of :data:`LOOKS`) drawn from ``seed``, its row
+        holding ``lookalikes`` (a key of :data:`LOOKALIKES`) and ``fruit`` (a key of
+        :data:`FRUIT_DENSITY`).
+
+        Raises:
+            ParameterError: a name, level or density not among those.
+        """
         if name not in LOOKS:
             raise ParameterError(f"look must be one of {', '.join(LOOKS)}, got {name!r}")
+        if lookalikes not in LOOKALIKES:
+            known = ", ".join(LOOKALIKES)
+            raise ParameterError(f"lookalikes must be one of {known}, got {lookalikes!r}")
+        if fruit not in FRUIT_DENSITY:
+            known = ", ".join(FRUIT_DENSITY)
+            raise ParameterError(f"fruit must be one of {known}, got {fruit!r}")
         rng = np.random.default_rng([seed, 0x50E])
         if name == "random":
             name = FAMILIES[int(rng.integers(len(FAMILIES)))]
@@ -143,7 +189,24 @@ class RowLook(BushLook):
             stereo=_stereo(r, rng),
             c2=_camera(r, rng),
             blur_px_s=r["blur_px_s"],
+            lookalikes=lookalikes,
+            fruit=fruit,
         )
+
+    @property
+    def dead_share(self) -> float:
+        """The share of the row's leaflets that are dead (:data:`LOOKALIKES`)."""
+        return LOOKALIKES[self.lookalikes][0]
+
+    @property
+    def stone_range(self) -> tuple[int, int]:
+        """The range [lo, hi) of stones on the row's ground (:data:`LOOKALIKES`)."""
+        return LOOKALIKES[self.lookalikes][1]
+
+    @property
+    def fruit_range(self) -> tuple[int, int]:
+        """The range [lo, hi) of the row's own fruit (:data:`FRUIT_DENSITY`)."""
+        return FRUIT_DENSITY[self.fruit]
 
     def ripe_shade(self, rng: np.random.Generator) -> FloatArray:
         """A ripe fruit's colour: blue-black (a glossy berry reflecting the sky),
