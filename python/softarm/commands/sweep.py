@@ -20,7 +20,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "bush. Results stream to OUT/results.parquet (one row per berry); OUT/summary.png and "
         "OUT/summary.md summarise them. Needs the sweep extra: pip install 'softarm[sweep]'.",
     )
-    p.add_argument("spec", type=Path, help="sweep spec (TOML: [sweep], [sweep.plant])")
+    p.add_argument(
+        "spec",
+        type=Path,
+        help="sweep spec (TOML: [sweep], [sweep.plant]; or [perception]: the row's "
+        "perception map, docs/robustness.md)",
+    )
     p.add_argument("--out", type=Path, required=True, help="results directory")
     p.add_argument("--address", help="join this Ray cluster (default: start Ray on this machine)")
     p.add_argument("--cpus", type=int, help="cores of the local Ray (default: all)")
@@ -34,11 +39,17 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def run(args: argparse.Namespace) -> int:
     """Exit 0 when every trial ran, 1 if some failed, 2 on a bad spec, 130 if interrupted."""
     from softarm.errors import ConfigError
+    from softarm.files import load_toml
     from softarm.sweep import load_gains, load_spec
     from softarm.sweep._deps import require
     from softarm.sweep.runner import run_sweep
     from softarm.sweep.summary import markdown_summary, plot_summary
 
+    data = load_toml(args.spec, "sweep spec")
+    if "perception" in data:  # the row's perception map: a spec kind of its own
+        from softarm.sweep.perception_cli import run_perception_map
+
+        return run_perception_map(args, data)
     spec = load_spec(args.spec)
     for module in ("ray", "pyarrow", "tqdm"):  # the sweep extra, before anything starts
         require(module)
