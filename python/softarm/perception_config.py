@@ -7,9 +7,10 @@ OpenCV devices (``left``, ``right``). ``calibration`` is a ``stereo.yml`` writte
 ``softarm camera calibrate`` (resolved against the config file's folder); ``berries``
 is ``"markerless"`` (found by perception, the default) or ``"tags"`` (ArUco tags);
 ``survey`` (true by default) takes C2 to pairs of views of the bush before the first
-berry, to complete the canes C1 fits (:mod:`softarm.harvest.cane_survey`); ``detector``
+berry, to complete the canes C1 fits (:mod:`softarm.harvest.runs.cane_survey`); ``detector``
 is the berry detector, ``"colour"`` (the default), ``"net"`` or ``"net+colour"``
-(:mod:`softarm.perception.detector.choice`).
+(:mod:`softarm.perception.detector.choice`); ``canes`` is where the cane pixels come
+from, the same three names (:mod:`softarm.perception.cane_source`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from softarm.errors import ConfigError
 
 __all__ = [
     "BERRY_MODES",
+    "CANE_SOURCES",
     "DETECTORS",
     "STEREO_SOURCES",
     "PerceptionConfig",
@@ -36,12 +38,16 @@ BERRY_MODES = ("markerless", "tags")
 #: The berry detectors (softarm.perception.detector.choice.DETECTORS, listed here so
 #: that reading a config imports no perception).
 DETECTORS = ("colour", "net", "net+colour")
+#: The cane-pixel sources (softarm.perception.cane_source.CANE_SOURCES, listed here for
+#: the same reason).
+CANE_SOURCES = ("colour", "net", "net+colour")
 
 
 @dataclass(frozen=True)
 class PerceptionConfig:
     """``[perception]``: the stereo source, its calibration file, the berry mode,
-    whether C2 surveys the canes and the berry detector; ``folder`` is the config
+    whether C2 surveys the canes, the berry detector and the cane pixels' source;
+    ``folder`` is the config
     file's, which paths resolve against."""
 
     stereo: str = "zed2"
@@ -52,6 +58,7 @@ class PerceptionConfig:
     berries: str = "markerless"
     survey: bool = True
     detector: str = "colour"
+    canes: str = "colour"
     folder: str | None = field(default=None, compare=False, repr=False)
 
     @property
@@ -93,9 +100,10 @@ def parse_perception(t: TomlTable) -> PerceptionConfig:
     if not isinstance(survey, bool):
         raise t.error("survey", "must be true or false")
     detector = _choice(t, "detector", DETECTORS, "colour")
+    canes = _choice(t, "canes", CANE_SOURCES, "colour")
     config = PerceptionConfig(
         stereo, calibration, berries=berries, survey=survey, detector=detector,
-        folder=t.folder, **sources,
+        canes=canes, folder=t.folder, **sources,
     )  # fmt: skip
     t.done()
     return config

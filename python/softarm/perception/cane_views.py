@@ -1,13 +1,13 @@
 """Cane points from two views of one camera at known poses: C2 on the arm, moved
-sideways between them (the survey, :mod:`softarm.harvest.survey`), is a stereo pair
+sideways between them (the survey, :mod:`softarm.harvest.control.survey`), is a stereo pair
 whose baseline is the move. It sees the bush from nearer and from another side than C1
 does, so it fills in the canes C1's stereo leaves without depth: those hidden from
 C1's right eye, and those behind the leaves C1 looks through.
 
 The pair is rectified from the two poses (:class:`~softarm.vision.stereo_camera.
 StereoCamera` with the second view as the right eye), and the cane pixels of the first
-view are matched and lifted to the centre line as C1's are
-(:func:`softarm.perception.canes.cane_points`).
+view (from the same source as C1's, :mod:`softarm.perception.cane_source`) are matched
+and lifted to the centre line as C1's are (:func:`softarm.perception.canes.cane_points`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ import numpy.typing as npt
 
 from softarm.checks import FloatArray
 from softarm.errors import VisionError
-from softarm.perception.cane_pixels import cane_mask, half_width_px, stereo_disparity
+from softarm.perception.cane_pixels import half_width_px, stereo_disparity
+from softarm.perception.cane_source import source_mask
 from softarm.perception.canes import CaneSettings, centre_line_points
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
@@ -69,7 +70,7 @@ def view_pair_points(
     pair = StereoCamera(camera, camera, T_base_first, invert(T_base_first) @ T_base_second)
     rect = pair.rectification
     left, right = rect.rectify(first, second)
-    mask = cane_mask(left, settings.look)
+    mask = source_mask(left, settings.look, settings.source)
     disparity = stereo_disparity(left, right, rect, mask, VIEW_DEPTHS, settings.smoothness)
     mask &= _consistent(left, right, rect, disparity, settings)
     rows, cols = np.nonzero(mask)

@@ -4,8 +4,9 @@ paper's curve obstacle (eq. 10), in the base frame, with its radius.
 
 The pipeline (:func:`fit_canes`):
 
-1. rectify the pair; the cane pixels of the rectified left image
-   (:func:`softarm.perception.cane_pixels.cane_mask`);
+1. rectify the pair; the cane pixels of the rectified left image, from the chosen
+   source (:mod:`softarm.perception.cane_source`: the colour-and-width mask of
+   :func:`softarm.perception.cane_pixels.cane_mask` by default, or the network's);
 2. their disparity by StereoSGBM over the region they occupy, triangulated to the left
    camera frame (with ``depth`` given: the left image's own pixels, back-projected);
 3. the camera sees the front of each tube, on average π r / 4 nearer than its centre
@@ -30,7 +31,8 @@ from softarm.checks import FloatArray, as_array
 from softarm.errors import ParameterError, VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
-from softarm.perception.cane_pixels import CaneLook, cane_mask, half_width_px, stereo_disparity
+from softarm.perception.cane_pixels import CaneLook, half_width_px, stereo_disparity
+from softarm.perception.cane_source import check_cane_source, source_mask
 from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = [
@@ -40,6 +42,7 @@ __all__ = [
     "centre_line_points",
     "fit_cane_points",
     "fit_canes",
+    "mask_points",
 ]
 
 
@@ -62,13 +65,24 @@ class CaneSettings:
     ``depth_range``: nearest and farthest depth (m) a cane is looked for at;
     ``max_points``: points kept for the fit (an even subsample beyond that);
     ``smoothness``: StereoSGBM's penalties P1, P2 (see
-    :func:`softarm.perception.cane_pixels.stereo_disparity`)."""
+    :func:`softarm.perception.cane_pixels.stereo_disparity`); ``source``: where the cane
+    pixels come from (:data:`softarm.perception.cane_source.CANE_SOURCES`; None: this
+    process's choice, :func:`~softarm.perception.cane_source.use_cane_source`).
+
+    Raises:
+        ParameterError: ``source`` is not None or one of CANE_SOURCES.
+    """
 
     look: CaneLook = field(default_factory=CaneLook)
     search: CurveSearch = field(default_factory=CurveSearch)
     depth_range: tuple[float, float] = (0.6, 1.5)
     max_points: int = 4000
     smoothness: tuple[int, int] = (4, 16)
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.source is not None:
+            check_cane_source(self.source, "settings.source")
 
 
 def fit_canes(
@@ -116,9 +130,14 @@ def cane_points(
     _check_inputs(left, right, stereo, depth)
     if depth is None:
         assert right is not None
-        camera_points = _stereo_points(left, right, stereo, settings)
-    else:
-        camera_points = _depth_points(left, depth, stereo, settings)
+        rect_left, rect_right = stereo.rectification.rectify(left, right)
+        mask = source_mask(rect_left, settings.look, settings.source)
+        return mask_points(rect_left, rect_right, stereo, mask, settings)
+    return _to_base(_depth_points(left, depth, stereo, settings), stereo)
+
+
+def _to_base(camera_points: FloatArray, stereo: StereoCamera) -> FloatArray:
+    """(n, 4) rows in the left camera frame placed in the base frame."""
     T = np.asarray(stereo.T_base_left, dtype=np.float64)
     return np.column_stack([camera_points[:, :3] @ T[:3, :3].T + T[:3, 3], camera_points[:, 3]])
 
@@ -154,34 +173,36 @@ def _check_inputs(left: object, right: object, stereo: StereoCamera, depth: obje
     depth_metres(depth, checked.shape)
 
 
-def _stereo_points(
-    left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8],
-    stereo: StereoCamera, settings: CaneSettings,
+def mask_points(
+    rect_left: npt.NDArray[np.uint8], rect_right: npt.NDArray[np.uint8], stereo: StereoCamera,
+    mask: npt.NDArray[np.bool_], settings: CaneSettings,
 ) -> FloatArray:  # fmt: skip
-    """(n, 4) rows, one per cane pixel of the rectified left image: the point in the
-    left camera frame, pushed to the centre line, and the radius there (m)."""
+    """(n, 4) rows as :func:`cane_points` gives them (base frame), one per pixel of the
+    cane pixels ``mask`` (a source's, of ``rect_left``) with a disparity, from the
+    already rectified pair ``rect_left``, ``rect_right`` of ``stereo``: what follows the
+    choice of source, the same for every source (and for the comparison of sources,
+    :mod:`softarm.experiments.cane_sources`)."""
     rect = stereo.rectification
-    rect_left, rect_right = rect.rectify(left, right)
-    mask = cane_mask(rect_left, settings.look)
     disparity = stereo_disparity(
         rect_left, rect_right, rect, mask, settings.depth_range, settings.smoothness
     )
-    mask &= np.isfinite(disparity)
+    mask = mask & np.isfinite(disparity)
     rows, cols = _subsample(np.nonzero(mask), settings.max_points)
     pixels = np.column_stack([cols, rows]).astype(np.float64)
     surface = rect.triangulate(pixels, disparity[rows, cols])
     radius = half_width_px(mask)[rows, cols] * surface[:, 2] / rect.focal
-    return _to_centre_line(surface, radius, settings.depth_range)
+    return _to_base(_to_centre_line(surface, radius, settings.depth_range), stereo)
 
 
 def _depth_points(
     left: npt.NDArray[np.uint8], depth: npt.NDArray[np.floating[Any]],
     stereo: StereoCamera, settings: CaneSettings,
 ) -> FloatArray:  # fmt: skip
-    """As :func:`_stereo_points`, from a depth image aligned with the left eye."""
+    """(n, 4) rows as :func:`mask_points` gives them but in the left camera frame,
+    from a depth image aligned with the left eye."""
     near, far = settings.depth_range
     z = np.nan_to_num(depth.astype(np.float32), nan=0.0)
-    mask = cane_mask(left, settings.look) & (z >= near) & (z <= far)
+    mask = source_mask(left, settings.look, settings.source) & (z >= near) & (z <= far)
     rows, cols = _subsample(np.nonzero(mask), settings.max_points)
     if rows.size == 0:
         return np.zeros((0, 4))

@@ -1,0 +1,170 @@
+"""The cane pixels' sources side by side (:mod:`softarm.perception.cane_source`): on each
+seed's bush, in each condition (the daylight row's looks, ``sun``, ``overcast``,
+``dusk`` and ``backlight``, and the rendered bush, ``bush``), C1's stereo pair is
+rendered once; every candidate's mask (``colour``, ``net``, their intersection
+``net+colour`` and their union ``net|colour``) goes through the same stereo and curve fit
+(:func:`softarm.perception.canes.mask_points`, :func:`~softarm.perception.canes.
+fit_cane_points`), and :func:`~softarm.perception.cane_metrics.cane_map_error` scores
+the fits against every cane drawn (the bush's and, in the row, the row's) within the
+arm's reach. C1 is where it truly is, the arm out of view; no depth from the renderer.
+
+Rows are written one JSON line per scene and source, so that seeds can be run in parts
+(each part a process of a few minutes) and summed up after::
+
+    MUJOCO_GL=egl python -m softarm.experiments.cane_sources run sun 310000 310024 --out rows/
+    python -m softarm.experiments.cane_sources table rows/ --out docs/data/cane_sources.json
+
+The summary per condition and source: ``coverage`` pooled over the scenes by true cane
+length; ``precision`` pooled by fitted length in the workspace (a scene without fits
+adds nothing, where a mean of per-scene shares would count it as 1); ``median_mm`` the
+median of the per-scene medians.
+
+It lives above :mod:`softarm.perception` (which may not import the simulation).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softarm.perception.cane_curves import curve_points
+from softarm.perception.cane_metrics import DEFAULT_REACH, cane_map_error
+from softarm.perception.canes import CaneFit, CaneSettings, fit_cane_points, mask_points
+
+__all__ = ["CONDITIONS", "SOURCES", "fitted_length", "scene_rows", "summarise"]
+
+#: The row's looks and the rendered bush.
+CONDITIONS = ("sun", "overcast", "dusk", "backlight", "bush")
+#: The candidates, in the order of the table.
+SOURCES = ("colour", "net", "net+colour", "net|colour")
+
+
+def fitted_length(fits: Sequence[CaneFit], reach: float = DEFAULT_REACH) -> float:
+    """The fitted curves' length (m) within ``reach`` of the base origin, as
+    :func:`cane_map_error` scores it."""
+    total = 0.0
+    for fit in fits:
+        points = curve_points(np.asarray(fit.coeffs, np.float64), 400)
+        inside = np.linalg.norm(points, axis=1) <= reach
+        steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+        total += float(np.sum(steps[inside[1:] & inside[:-1]]))
+    return total
+
+
+def scene_rows(condition: str, seed: int, n_berries: int = 8) -> list[dict[str, Any]]:
+    """One row per source for ``seed``'s bush in ``condition``."""
+    import softarm
+    from softarm.harvest.rigs.sim_rig import default_cameras
+    from softarm.perception.cane_source import candidate_masks
+    from softarm.sim.bush import Bush
+    from softarm.sim.render import RenderedBush
+    from softarm.sim.render.row_look import RowLook
+    from softarm.sim.rig_cameras import BASE_TAG_ID
+
+    cams = default_cameras()
+    bush = Bush.generate(
+        softarm.SoftArm.blackberry(), n_berries, seed,
+        view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4,
+    )  # fmt: skip
+    look = None if condition == "bush" else RowLook.named(condition, seed)
+    world = RenderedBush(
+        bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2,
+        cams.T_ee_cube, cams.T_base_tag, BASE_TAG_ID, cams.base_tag, look=look,
+    )  # fmt: skip
+    try:
+        left, right = world.c1()
+        truth = world.canes()
+    finally:
+        world.close()
+    stereo, settings = world.stereo, CaneSettings()
+    rect_left, rect_right = stereo.rectification.rectify(left.colour, right.colour)
+    rows = []
+    for source, mask in candidate_masks(rect_left, settings.look).items():
+        start = time.perf_counter()
+        fits = fit_cane_points(mask_points(rect_left, rect_right, stereo, mask, settings))
+        seconds = time.perf_counter() - start
+        rows.append({
+            "condition": condition, "seed": seed, "source": source,
+            **cane_map_error(fits, truth), "fitted_m": fitted_length(fits),
+            "fits": len(fits), "mask_px": int(mask.sum()), "fit_ms": 1e3 * seconds,
+        })  # fmt: skip
+    return rows
+
+
+def summarise(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One row per condition and source (see the module docstring for the pooling)."""
+    out = []
+    for condition in CONDITIONS:
+        for source in SOURCES:
+            mine = [r for r in rows if r["condition"] == condition and r["source"] == source]
+            if not mine:
+                continue
+            length = np.array([r["length_m"] for r in mine])
+            fitted = np.array([r["fitted_m"] for r in mine])
+            coverage = np.array([r["coverage"] for r in mine])
+            precision = np.array([r["precision"] for r in mine])
+            medians = [r["median_mm"] for r in mine if np.isfinite(r["median_mm"])]
+            out.append({
+                "condition": condition, "source": source, "scenes": len(mine),
+                "coverage": round(float(np.sum(length * coverage) / np.sum(length)), 3),
+                "precision": round(float(np.sum(fitted * precision) / max(fitted.sum(), 1e-9)), 3),
+                "median_mm": round(float(np.median(medians)), 2) if medians else None,
+                "fits_per_scene": round(float(np.mean([r["fits"] for r in mine])), 1),
+                "seeds": [min(r["seed"] for r in mine), max(r["seed"] for r in mine)],
+            })  # fmt: skip
+    return out
+
+
+def _run(args: argparse.Namespace) -> None:
+    folder = Path(args.out)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{args.condition}_{args.first}_{args.last}.jsonl"
+    with path.open("w") as f:
+        for seed in range(args.first, args.last + 1):
+            for row in scene_rows(args.condition, seed):
+                f.write(json.dumps(row) + "\n")
+            f.flush()
+            print(args.condition, seed, flush=True)
+
+
+def _table(args: argparse.Namespace) -> None:
+    rows = [
+        json.loads(line)
+        for folder in args.folders
+        for path in sorted(Path(folder).glob("*.jsonl"))
+        for line in path.read_text().splitlines()
+    ]
+    table = summarise(rows)
+    keys = ("condition", "source", "scenes", "coverage", "precision", "median_mm")
+    print("| " + " | ".join(keys) + " |")
+    print("|" + " --- |" * len(keys))
+    for row in table:
+        print("| " + " | ".join(str(row[k]) for k in keys) + " |")
+    if args.out:
+        Path(args.out).write_text(json.dumps(table, indent=1) + "\n")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``run CONDITION FIRST LAST --out DIR`` or ``table DIR... [--out FILE]``."""
+    parser = argparse.ArgumentParser(prog="python -m softarm.experiments.cane_sources")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="score every source on seeds FIRST..LAST")
+    run.add_argument("condition", choices=CONDITIONS)
+    run.add_argument("first", type=int)
+    run.add_argument("last", type=int)
+    run.add_argument("--out", required=True, help="folder for the rows (JSON lines)")
+    table = sub.add_parser("table", help="the summary of the rows in FOLDERS")
+    table.add_argument("folders", nargs="+")
+    table.add_argument("--out", help="the summary as JSON")
+    args = parser.parse_args(argv)
+    _run(args) if args.command == "run" else _table(args)
+
+
+if __name__ == "__main__":
+    main()
