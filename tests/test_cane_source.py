@@ -148,7 +148,7 @@ def test_the_process_choice_is_what_fit_canes_uses(row: Any) -> None:
 
 @pytest.mark.parametrize("bad", ["yolo", "", "Net", 3, None])
 def test_a_bad_source_is_one_error_naming_it(bad: object) -> None:
-    with pytest.raises(ParameterError, match=r"^cane source must be one of colour, net"):
+    with pytest.raises(ParameterError, match=r"^cane_source must be one of colour, net"):
         use_cane_source(bad)  # type: ignore[arg-type]
     if bad is not None:
         with pytest.raises(ParameterError, match=r"^settings\.source must be one of"):

@@ -66,6 +66,7 @@ PERCEPTION = """\
 # berries = "markerless"  # or "tags"
 # survey = true  # false: no C2 views of the bush before the first berry (C1's canes only)
 # detector = "colour"  # the berry detector: "colour", "net" or "net+colour" (docs/perception.md)
+# canes = "colour"  # the cane pixels' source: "colour", "net" or "net+colour" (docs/perception.md)
 """
 
 HEADER = """\

@@ -47,7 +47,7 @@ BoolImage = npt.NDArray[np.bool_]
 _chosen = DEFAULT_CANE_SOURCE
 
 
-def check_cane_source(name: object, argument: str = "cane source") -> str:
+def check_cane_source(name: object, argument: str = "cane_source") -> str:
     """``name`` when it is one of CANE_SOURCES.
 
     Raises:
