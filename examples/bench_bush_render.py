@@ -20,10 +20,10 @@ from typing import Any
 import numpy as np
 
 import softarm
-from softarm.harvest.sim_rig import C2_SCALE, default_cameras
-from softarm.harvest.sim_vision import BASE_TAG_ID
+from softarm.harvest.rigs.sim_rig import C2_SCALE, default_cameras
 from softarm.sim.bush import Bush
 from softarm.sim.render.world import arm_sections, world_for
+from softarm.sim.rig_cameras import BASE_TAG_ID
 from softarm.vision.poses import invert
 
 REPEATS = 10

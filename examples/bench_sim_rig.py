@@ -18,7 +18,7 @@ fine-positioning errors. The reports go to ``--out``.
 
     git worktree add /tmp/before HEAD   # then the camera and vision files as before:
     git -C /tmp/before checkout c200ecf -- python/softarm/sim/camera.py \\
-        python/softarm/sim/markers.py python/softarm/harvest/sim_vision.py \\
+        python/softarm/sim/markers.py python/softarm/sim/rig_cameras.py \\
         python/softarm/vision/{detector,refine,_checks,camera_model,baseline}.py
     cp python/softarm/_core*.so /tmp/before/python/softarm/
     python examples/bench_sim_rig.py --seeds 100 101 --berries 4 \\
@@ -49,7 +49,7 @@ import dataclasses, json, sys, time
 t0, c0 = time.perf_counter(), time.process_time()
 import cv2
 cv2.setNumThreads(1)
-import softarm.harvest.sim_rig as sr
+import softarm.harvest.rigs.sim_rig as sr
 seed, berries, crop, noise_offset, report = (
     int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], int(sys.argv[4]), sys.argv[5])
 if crop != "default":

@@ -37,7 +37,7 @@ def one_trial(
     """Harvest one bush on one plant; returns the report as a dict plus the plant keys.
     With ``calibrate`` the plant is first calibrated (``softarm calibrate --sim``, 80
     poses) and the harvest runs on the fitted model, as on a real arm."""
-    from softarm.harvest import sim_rig
+    from softarm.harvest.rigs import sim_rig
     from softarm.sim.arm import PlantConfig
 
     plant = PlantConfig(pressure_tau=tau, hysteresis_psi=hysteresis)
@@ -47,8 +47,8 @@ def one_trial(
         if "lag_control" in fields:
             opts.lag_control = lag_control
     else:  # a build older than the plant option: swap the plant's configuration in
-        from softarm.harvest.sim_plant import ArmPlant
         from softarm.sim.arm import SimulatedArm
+        from softarm.sim.plant import ArmPlant
 
         def seeded(model, s):  # type: ignore[no-untyped-def]
             return ArmPlant(SimulatedArm(model, config=plant, seed=s))
@@ -60,7 +60,7 @@ def one_trial(
         from softarm.calibration.sim import build_plant, calibrate_plant
 
         nominal = SoftArm.blackberry()
-        # The rig's plant is drawn from seed + 1000 (softarm.harvest.sim_rig).
+        # The rig's plant is drawn from seed + 1000 (softarm.harvest.rigs.sim_rig).
         opts.calibration = calibrate_plant(
             build_plant(nominal, plant, seed + 1000), plant, nominal, seed=seed
         )[0]

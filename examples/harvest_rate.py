@@ -1,5 +1,5 @@
 """The harvest rate and where its time goes: simulated harvests of the tag world and the
-rendered bush on the same seeds, each bush's ``rate`` (softarm.harvest.rate) summed per
+rendered bush on the same seeds, each bush's ``rate`` (softarm.harvest.records.rate) summed per
 world into seconds per harvested berry by stage, drawn as one stacked bar per world.
 
     MUJOCO_GL=egl python examples/harvest_rate.py --seeds 90050 90051 90052 --berries 6 \
@@ -22,7 +22,7 @@ WORLDS = ("tags", "bush")
 
 def one_bush(world: str, seed: int, berries: int) -> dict[str, Any]:
     """One simulated harvest's ``rate`` record (its harvested berries, time and stages)."""
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 
     rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, world=world))
     try:

@@ -25,13 +25,13 @@ from pathlib import Path
 from typing import Any
 
 import softarm
-from softarm.harvest.sim_rig import default_cameras
-from softarm.harvest.sim_vision import BASE_TAG_ID
+from softarm.harvest.rigs.sim_rig import default_cameras
 from softarm.perception import detect_berries
 from softarm.sim.bush import Bush
 from softarm.sim.render.labels import KINDS
 from softarm.sim.render.row_look import FAMILIES, RowLook
 from softarm.sim.render.world import world_for
+from softarm.sim.rig_cameras import BASE_TAG_ID
 
 
 def _frame_counts(world: Any) -> dict[str, Any]:

@@ -24,11 +24,11 @@ from typing import Any
 import cv2
 
 import softarm
-from softarm.harvest.sim_rig import default_cameras
-from softarm.harvest.sim_vision import BASE_TAG_ID
+from softarm.harvest.rigs.sim_rig import default_cameras
 from softarm.sim.bush import Bush
 from softarm.sim.render.row_look import FAMILIES, RowLook
 from softarm.sim.render.world import RenderedBush
+from softarm.sim.rig_cameras import BASE_TAG_ID
 
 
 def _world(bush: Bush, cams: Any, look: RowLook | None, shadows: bool = True) -> RenderedBush:

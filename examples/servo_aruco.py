@@ -27,7 +27,7 @@ def main(argv: list[str] | None = None) -> int:
     import numpy as np
 
     from softarm.harvest import BerryTarget
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
     from softarm.vision.detector import square_marker_poses
 
     rig = build_sim_rig(SimRigOptions(n_berries=1, seed=args.seed))

@@ -16,7 +16,7 @@ import pytest
 from softarm import Gains, PolynomialCurve, Resolver, SoftArm, _core, geometry
 from softarm._core import Body, lead_gain, play, predicted_loop_alpha
 from softarm.errors import NonFiniteError, ParameterError, ShapeError
-from softarm.harvest.clearance import Clearance
+from softarm.harvest.control.clearance import Clearance
 
 ARM = SoftArm.blackberry()
 
@@ -80,7 +80,7 @@ def test_clearance_gap_agrees_with_brute_force_sampling() -> None:
 
 
 def test_rod_clearance_measures_the_same_body() -> None:
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
     from softarm.sim.arm import PlantConfig
     from softarm.sim.cosserat.clearance import RodClearance
 
@@ -108,7 +108,7 @@ def test_body_checks_its_inputs() -> None:
 
 
 def _old_play(y: np.ndarray, x: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The operator as sim/hysteresis.py and harvest/plant_model.py each wrote it."""
+    """The operator as sim/hysteresis.py and harvest/control/plant_model.py each wrote it."""
     half = 0.5 * w
     return np.clip(y, x - half, x + half)
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from softarm.commands.harvest import Tolerance, line, summary
 from softarm.formatting import plural
-from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.states import HarvestState
+from softarm.harvest.machine.states import HarvestState
+from softarm.harvest.records.report import BerryResult, HarvestReport
 
 
 def _berry(tag: int, pos_mm: float, ang_deg: float) -> BerryResult:

@@ -16,7 +16,7 @@ from softarm import cli
 from softarm.commands.config import template
 from softarm.config import load_config
 from softarm.errors import ConfigError
-from softarm.harvest.log import read_log
+from softarm.harvest.records.log import read_log
 from softarm.vision import CameraModel
 from softarm.vision.camera_model import camera_from_config
 

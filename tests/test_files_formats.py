@@ -15,7 +15,7 @@ import softarm
 from softarm.calibration import Calibration
 from softarm.calibration.metrics import PoseErrorStats
 from softarm.errors import ConfigError, ParameterError
-from softarm.harvest.log import CUT_MARK, HarvestLog, read_log
+from softarm.harvest.records.log import CUT_MARK, HarvestLog, read_log
 from softarm.identified_plant import load_identified
 from softarm.vision.camera_model import CameraModel
 from test_files_hardening import cli

@@ -24,7 +24,7 @@ from softarm.calibration import Calibration
 from softarm.config import load_config
 from softarm.errors import ConfigError, InputError, OutputError
 from softarm.files import write_text
-from softarm.harvest.log import read_log
+from softarm.harvest.records.log import read_log
 from softarm.identified_plant import load_identified
 from softarm.sim.plant_file import load_plant_file
 from softarm.sweep import load_gains, load_spec

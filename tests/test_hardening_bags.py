@@ -18,8 +18,8 @@ pytest.importorskip("rosbags")
 from bag_stops import sigterm_while_writing_bag
 from softarm.cli import main
 from softarm.commands import replay
-from softarm.harvest.header import split_runs
-from softarm.harvest.log import CUT_MARK
+from softarm.harvest.records.header import split_runs
+from softarm.harvest.records.log import CUT_MARK
 from viz.test_bag import _read
 
 NS = 1_000_000_000

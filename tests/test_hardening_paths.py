@@ -63,7 +63,7 @@ def test_a_recording_in_a_folder_that_is_not_utf8_replays(tmp_path: Path) -> Non
     folder = _not_utf8(tmp_path, b"rec\xff")
     code = (
         "import sys, numpy as np\n"
-        "from softarm.harvest.frame_files import FrameFolder, FrameRecorder\n"
+        "from softarm.harvest.records.frame_files import FrameFolder, FrameRecorder\n"
         "rec = FrameRecorder(sys.argv[1] + '/run')\n"
         "frame = rec.wrap('c2', lambda t: np.full((6, 8, 3), 7, np.uint8))\n"
         "frame(0.0)\n"

@@ -13,7 +13,7 @@ import pytest
 
 import softarm
 from softarm import cli
-from softarm.harvest.report import BerryResult, HarvestReport
+from softarm.harvest.records.report import BerryResult, HarvestReport
 from softarm.perception.berries import BerryDetection
 from softarm.sim.render.preview import write_previews
 

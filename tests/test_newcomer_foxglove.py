@@ -191,7 +191,7 @@ def test_without_the_extra_the_line_names_it_before_the_banner(tmp_path: Any) ->
 def test_replay_serves_a_log_at_its_pace_once_a_client_subscribes(tmp_path: Any) -> None:
     import threading
 
-    from softarm.harvest.log import HarvestLog
+    from softarm.harvest.records.log import HarvestLog
     from softarm.viz.foxglove_live import serve_log
 
     log = HarvestLog(tmp_path / "run.jsonl")

@@ -17,9 +17,10 @@ from harvest.fakes import make_rig
 from softarm import cli
 from softarm.commands import harvest
 from softarm.harvest import BerryTarget, HarvestLog
-from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.states import HarvestState
-from softarm.harvest.survey import SurveySettings
+from softarm.harvest.control.survey import SurveySettings
+from softarm.harvest.machine.states import HarvestState
+from softarm.harvest.records.report import BerryResult, HarvestReport
+from softarm.harvest.runs.policy import run_targets
 from softarm.sim import bush
 
 
@@ -139,7 +140,7 @@ def test_a_stop_is_logged_as_interrupted_not_as_a_crash(tmp_path: Path) -> None:
 
     rig.tracker.track = stop  # type: ignore[method-assign]
     with pytest.raises(KeyboardInterrupt):
-        rig.machine.run([BerryTarget(1)])
+        run_targets(rig.machine.run_berry, [BerryTarget(1)], rig.machine.log)
     kinds = [r["kind"] for r in rig.machine.log.records]
     assert "crash" not in kinds and kinds[-1] == "interrupted"
     assert rig.vented()

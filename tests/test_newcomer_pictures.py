@@ -20,10 +20,10 @@ import pytest
 
 from render_required import rendering
 from softarm.commands.harvest import line, summary
-from softarm.harvest.c1_picture import _brighten, _framed
-from softarm.harvest.plots import _named, plot_run, run_ids
-from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+from softarm.harvest.records.c1_picture import _brighten, _framed
+from softarm.harvest.records.report import BerryResult, HarvestReport
+from softarm.harvest.rigs.sim_plots import _named, plot_run, run_ids
+from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 from softarm.harvest_config import HarvestConfig
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -100,7 +100,7 @@ def test_the_c1_picture_has_a_title_band_and_a_legend() -> None:
 
 
 def test_the_bush_figure_names_berries_by_their_map_number(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
-    from softarm.harvest.c1_picture import c1_picture
+    from softarm.harvest.records.c1_picture import c1_picture
 
     with rendering():
         rig = build_sim_rig(SimRigOptions(n_berries=4, seed=SEED, world="bush", survey=False))

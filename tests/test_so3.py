@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from softarm import Resolver, SoftArm, so3
 from softarm.experiments.common import orientation_error
-from softarm.harvest.targets import align_z
+from softarm.harvest.machine.targets import align_z
 
 VEC = st.lists(st.floats(-1.0, 1.0, allow_nan=False), min_size=3, max_size=3).map(np.array)
 

@@ -78,7 +78,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"softarm {argv[0]}: {_UNAVAILABLE[argv[0]]}", file=sys.stderr)
         return 2
     args = parser.parse_args(argv)
-    args.argv = argv  # as typed, for the header record of a run (softarm.harvest.header)
+    args.argv = argv  # as typed, for the header record of a run (softarm.harvest.records.header)
     try:
         return int(args.run(args))
     except SoftarmError as exc:

@@ -129,7 +129,10 @@ class CalibrationConfig:
     as built: 5 cm behind the gripper frame), ``berry_tag``, the side (m) of the
     berry ArUco tags (the paper's 12 mm, section III-D), and ``T_base_tag``, the base
     tag on its bracket in the base frame (None: not known), which the cane fit leaves
-    out as the rig's own (:mod:`softarm.harvest.rig_parts`)."""
+    out as the rig's own (:mod:`softarm.perception.self_filter`); ``marker_body``, the
+    body carrying the tracked tags (:data:`softarm.vision.marker_body.MARKER_BODIES`:
+    the paper's ``"cube"`` or the ``"frustum"``, docs/hardware.md), its tags of side
+    ``marker_length`` (m)."""
 
     c1: CameraConfig = field(default_factory=CameraConfig)
     c2: CameraConfig = field(default_factory=lambda: CameraConfig(source=1))
@@ -139,6 +142,8 @@ class CalibrationConfig:
                          (0.0, 0.0, 0.0, 1.0))  # fmt: skip
     berry_tag: float = 0.012
     T_base_tag: Matrix | None = None
+    marker_body: str = "cube"
+    marker_length: float = 0.08
 
 
 @dataclass(frozen=True)
@@ -347,9 +352,24 @@ def _calibration(t: TomlTable) -> CalibrationConfig:
         _pose(t, "T_EE_cube") or d.T_EE_cube,
         t.number("berry_tag", d.berry_tag, positive=True),
         _pose(t, "T_base_tag"),
+        _marker_body(t, d.marker_body),
+        t.number("marker_length", d.marker_length, positive=True),
     )
     t.done()
     return calibration
+
+
+def _marker_body(t: TomlTable, default: str) -> str:
+    """``marker_body``: one of the bodies softarm.vision.marker_body names."""
+    body = t.get("marker_body", default)
+    if body == default:
+        return default
+    # Imported here: the bodies' module loads OpenCV, which reading a config needs not.
+    from softarm.vision.marker_body import MARKER_BODIES
+
+    if body not in MARKER_BODIES:
+        raise t.error("marker_body", f"must be one of {', '.join(MARKER_BODIES)}")
+    return str(body)
 
 
 def _channel_names(t: TomlTable, d: ChannelsConfig, arm: ArmConfig) -> tuple[str, ...]:
@@ -552,7 +572,8 @@ def dump_config(config: Config) -> str:
     out += ["[gains]", *_lines(config.gains.values), ""]
     cal = config.calibration
     poses = {"T_C1_base": cal.T_C1_base, "T_C2_EE": cal.T_C2_EE, "T_EE_cube": cal.T_EE_cube}
-    tags = {"berry_tag": cal.berry_tag, "T_base_tag": cal.T_base_tag}
+    tags: dict[str, Any] = {"berry_tag": cal.berry_tag, "T_base_tag": cal.T_base_tag}
+    tags |= {"marker_body": cal.marker_body, "marker_length": cal.marker_length}
     out += ["[calibration]", *_lines({**poses, **tags}), ""]
     for name, cam in (("c1", cal.c1), ("c2", cal.c2)):
         written = {k: v for k, v in asdict(cam).items() if k != "folder"}

@@ -1,7 +1,7 @@
 """Tuning of the harvesting state machine (SI units).
 
 Below :mod:`softarm.harvest` (beside :mod:`softarm.config`, which reads it from the
-``[harvest]`` table of a configuration file); :mod:`softarm.harvest.config` re-exports it.
+``[harvest]`` table of a configuration file); :mod:`softarm.harvest_config` re-exports it.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ __all__ = ["HarvestConfig"]
 
 @dataclass(frozen=True)
 class HarvestConfig:
-    """Parameters of :class:`~softarm.harvest.machine.HarvestMachine`.
+    """Parameters of :class:`~softarm.harvest.machine.harvest_machine.HarvestMachine`.
 
     Attributes:
         period: control period (s).

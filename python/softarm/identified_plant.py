@@ -6,8 +6,7 @@ lag-aware gains and a ``[plant_model]`` table of the hardware TOML read it back 
 value per channel, in actuator order ``[l11, l12, l13, l21, ...]``.
 
 Beside :mod:`softarm.config` (which checks a ``[plant_model]`` table with it), below the
-identification that writes it and the harvest that reads it;
-:mod:`softarm.identification.result` re-exports it.
+identification that writes it and the harvest that reads it.
 """
 
 from __future__ import annotations

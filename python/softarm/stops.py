@@ -141,7 +141,7 @@ def _keep_swallowed(
 
 
 class EventLog(Protocol):
-    """What a stop writes to: :class:`softarm.harvest.log.HarvestLog` is one."""
+    """What a stop writes to: :class:`softarm.harvest.records.log.HarvestLog` is one."""
 
     def event(self, kind: str, **fields: Any) -> None: ...
 

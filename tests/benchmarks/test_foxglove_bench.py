@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from softarm.harvest.sim_rig import SimRig, SimRigOptions, build_sim_rig
+from softarm.harvest.rigs.sim_rig import SimRig, SimRigOptions, build_sim_rig
 
 pytest.importorskip("foxglove")
 pytest.importorskip("websockets")

@@ -19,7 +19,7 @@ from softarm.harvest import (
     Observation,
     SafeActuator,
 )
-from softarm.harvest.states import HarvestState
+from softarm.harvest.machine.states import HarvestState
 
 K = 3.0  # metres of end-effector travel per metre of elongation
 P0 = np.array([-0.05, 0.25, 0.25])  # end effector when vented
@@ -109,7 +109,7 @@ class FakeLocator:
 
 @dataclass
 class FakeVision:
-    """Both fakes as one :class:`~softarm.harvest.interfaces.Vision`: the pose, then the
+    """Both fakes as one :class:`~softarm.harvest.machine.interfaces.Vision`: the pose, then the
     berry given that pose."""
 
     tracker: FakeTracker

@@ -102,7 +102,7 @@ def test_lead_speeds_a_first_order_regulator_up_by_one_plus_k() -> None:
     ("tau", "expected"), [(0.0, 0.0), (0.08, 0.5 * 0.5353 / 0.4647), (1.0, 1.5)]
 )
 def test_lead_gain_is_half_the_overshoot_free_bound_capped(tau: float, expected: float) -> None:
-    from softarm.harvest.actuator import lead_gain
+    from softarm.harvest.control.actuator import lead_gain
 
     assert lead_gain(tau, 0.05) == pytest.approx(expected, rel=1e-3)
     with pytest.raises(ParameterError):

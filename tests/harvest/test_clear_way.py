@@ -1,7 +1,7 @@
 """The way a lagging arm takes to each command: straight lines in actuator space
 (``straight_step``), the model's gaps along them (``Clearance.gaps_along``,
 ``ResolverController.way_gaps``) and the check that holds a plan's command whose way
-from where the arm is would cross a cane (``Servo._clear_way``)."""
+from where the arm is would cross a cane (``Transport.clear_way``)."""
 
 from __future__ import annotations
 
@@ -12,9 +12,10 @@ import pytest
 
 from softarm import Resolver, SoftArm
 from softarm.harvest import HarvestConfig, HarvestLog
-from softarm.harvest.clearance import Clearance
-from softarm.harvest.controller import ResolverController
-from softarm.harvest.servo import WAY_SLACK, Servo, straight_step
+from softarm.harvest.control.clearance import Clearance
+from softarm.harvest.control.controller import ResolverController
+from softarm.harvest.machine.servo import Servo
+from softarm.harvest.machine.transport import WAY_SLACK, straight_step
 from softarm.sim.bush import Bush
 
 from .fakes import FakeClock, FakeController
@@ -101,16 +102,16 @@ def test_a_command_whose_way_from_the_lagging_arm_crosses_a_cane_is_not_taken() 
     servo = _servo(_CaneAtHalf(), flight=np.array([0.25, 0.0]))  # the arm is at 0.2
     across, short = np.array([0.8, 0.0]), np.array([0.3, 0.0])
     # Both commands are clear of the cane on their own; the way to the first is not.
-    assert servo._clear_way(q, (across, short)) is short
+    assert servo.transport.clear_way(q, (across, short)) is short
     # None is clear: the last command is held, and the arm goes on along its way.
-    assert servo._clear_way(q, (across,)) is q
+    assert servo.transport.clear_way(q, (across,)) is q
 
 
 def test_without_a_lag_model_the_way_starts_at_the_last_command() -> None:
     q = np.array([0.6, 0.0])  # past the cane already
     servo = _servo(_CaneAtHalf(), flight=None)
     onwards = np.array([0.9, 0.0])
-    assert servo._clear_way(q, (onwards,)) is onwards
+    assert servo.transport.clear_way(q, (onwards,)) is onwards
 
 
 def test_inside_the_margin_the_way_may_close_in_on_a_cane_only_by_the_slack() -> None:
@@ -120,16 +121,16 @@ def test_inside_the_margin_the_way_may_close_in_on_a_cane_only_by_the_slack() ->
     away = np.array([0.5 + 2 * margin, 0.0])
     nearer_by_half_the_slack = q - np.array([0.5 * WAY_SLACK, 0.0])
     nearer_by_twice_the_slack = q - np.array([2 * WAY_SLACK, 0.0])
-    assert servo._clear_way(q, (away,)) is away
-    assert servo._clear_way(q, (nearer_by_half_the_slack,)) is nearer_by_half_the_slack
-    assert servo._clear_way(q, (nearer_by_twice_the_slack,)) is q
+    assert servo.transport.clear_way(q, (away,)) is away
+    assert servo.transport.clear_way(q, (nearer_by_half_the_slack,)) is nearer_by_half_the_slack
+    assert servo.transport.clear_way(q, (nearer_by_twice_the_slack,)) is q
 
 
 def test_a_controller_without_known_canes_takes_the_first_command() -> None:
     q = np.array([0.45, 0.0])
     first = np.array([0.8, 0.0])
     servo = _servo(FakeController(), flight=np.array([0.25, 0.0]))  # its way_gaps: None
-    assert servo._clear_way(q, (first, q)) is first
+    assert servo.transport.clear_way(q, (first, q)) is first
 
 
 def test_the_transport_margin_is_checked() -> None:

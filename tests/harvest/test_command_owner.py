@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from softarm.harvest import BerryTarget, HarvestConfig, HarvestLog
-from softarm.harvest.outcome import Fault
-from softarm.harvest.servo import Servo
-from softarm.harvest.states import FaultReason, HarvestState
+from softarm.harvest.machine.outcome import Fault
+from softarm.harvest.machine.servo import Servo
+from softarm.harvest.machine.states import FaultReason, HarvestState
 
 from .fakes import FakeClock, FakeController, make_rig
 
@@ -38,7 +38,7 @@ class _Clamping:
 
 def test_a_held_command_goes_on_from_what_was_sent() -> None:
     servo = Servo(FakeClock(), FakeController(), _Clamping(0.01), HarvestConfig(), HarvestLog())  # type: ignore[arg-type]
-    held = servo._hold(np.array([0.005, 0.02, 0.01]))
+    held = servo.link.hold(np.array([0.005, 0.02, 0.01]))
     np.testing.assert_array_equal(held, [0.005, 0.01, 0.01])
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from softarm.errors import CapabilityError
 from softarm.harvest import HarvestMachine, SafeActuator
-from softarm.harvest.interfaces import CONTROLLER_METHODS, require_controller
+from softarm.harvest.machine.interfaces import CONTROLLER_METHODS, require_controller
 
 from .fakes import FakeClock, FakeController, make_rig
 

@@ -5,7 +5,7 @@ import numpy as np
 
 import softarm
 from softarm import Gains, Resolver
-from softarm.harvest.controller import ResolverController
+from softarm.harvest.control.controller import ResolverController
 
 
 def _setup() -> tuple[softarm.SoftArm, np.ndarray, np.ndarray, np.ndarray]:

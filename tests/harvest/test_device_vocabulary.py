@@ -4,8 +4,8 @@ protocols of softarm.hardware.protocols, and the simulated and fake devices sati
 from __future__ import annotations
 
 from softarm.hardware import protocols
-from softarm.harvest import interfaces
-from softarm.harvest.sim_devices import SimGripper
+from softarm.harvest.machine import interfaces
+from softarm.harvest.rigs.sim_devices import SimGripper
 
 from .fakes import FakeGripper, make_rig
 

@@ -14,7 +14,7 @@ import pytest
 
 from render_required import need_mujoco, unavailable
 from softarm.cli import main
-from softarm.harvest.frame_files import INDEX
+from softarm.harvest.records.frame_files import INDEX
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -94,7 +94,7 @@ def _run_events(path: Path) -> list[tuple[object, ...]]:
 
 def test_both_rigs_run_the_recorded_harvest_by_one_policy(recording: Path, tmp_path: Path) -> None:
     """The simulator's run and the hardware rig's replay of it tell the same story:
-    the same transitions, berry results and end of run (softarm.harvest.run_policy)."""
+    the same transitions, berry results and end of run (softarm.harvest.runs.policy)."""
     _replay(recording, tmp_path)
     sim = _run_events(recording.parent / "sim.jsonl")
     arm = _run_events(tmp_path / "replay.jsonl")

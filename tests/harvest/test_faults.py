@@ -7,6 +7,7 @@ import pytest
 
 from softarm.errors import HardwareError, HardwareUnavailableError
 from softarm.harvest import BerryTarget, FaultReason, HarvestLog, HarvestState, read_log
+from softarm.harvest.runs.policy import run_targets
 
 from .fakes import commanded_before_the_vent, make_rig
 
@@ -20,7 +21,7 @@ def _fault_events(rig):
 def test_camera_dropout_is_marker_lost_and_the_run_goes_on(tmp_path) -> None:
     rig = make_rig(HarvestLog(tmp_path / "log.jsonl"))
     rig.tracker.blind = lambda t: t >= 1.0  # the eye-to-hand camera stops delivering
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(2)], rig.machine.log)
     assert [b.fault for b in report.berries] == [FaultReason.MARKER_LOST] * 2
     assert report.stopped is None  # not a system fault: each berry was tried
     assert rig.vented() and "marker_lost" in rig.bank.vent_log[1].reason
@@ -50,7 +51,7 @@ def test_long_berry_occlusion_is_marker_lost() -> None:
 def test_serial_disconnect_of_the_gripper_stops_the_run() -> None:
     rig = make_rig()
     rig.gripper.fail_on_close = HardwareUnavailableError("/dev/ttyACM0: disconnected")
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(2)], rig.machine.log)
     assert report.berries[0].fault is FaultReason.HARDWARE_ERROR
     assert report.stopped is FaultReason.HARDWARE_ERROR
     assert report.berries[1].final_state is S.IDLE and not report.berries[1].harvested
@@ -70,7 +71,7 @@ def test_daq_error_vents_and_stops_the_run() -> None:
         real(psi)
 
     rig.backend.set_pressures = flaky  # type: ignore[method-assign]
-    report = rig.machine.run([BerryTarget(1)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1)], rig.machine.log)
     assert report.stopped is FaultReason.HARDWARE_ERROR
     assert rig.vented()
     assert "DAQmx" in _fault_events(rig)[0]["detail"]
@@ -83,7 +84,7 @@ def test_nan_measurement_vents_and_stops_the_run(where: str) -> None:
         rig.tracker.nan_after = 1.0
     else:
         rig.ripeness.values[1] = float("nan")
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(2)], rig.machine.log)
     assert report.berries[0].fault is FaultReason.NAN_MEASUREMENT
     assert report.stopped is FaultReason.NAN_MEASUREMENT
     assert rig.vented()
@@ -94,14 +95,14 @@ def test_emergency_stop_is_a_safety_stop() -> None:
     rig.clock.hooks.append(
         lambda t: t >= 1.0 and not rig.bank.stopped and rig.bank.emergency_stop()
     )
-    report = rig.machine.run([BerryTarget(1)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1)], rig.machine.log)
     assert report.stopped is FaultReason.SAFETY_STOP
     assert rig.vented()
 
 
 def test_every_fault_transition_is_logged_with_its_reason() -> None:
     rig = make_rig()
-    rig.machine.run([BerryTarget(3)])
+    run_targets(rig.machine.run_berry, [BerryTarget(3)], rig.machine.log)
     fault = _fault_events(rig)[0]
     trans = [r for r in rig.machine.log.records if r["kind"] == "transition"][-1]
     assert fault["reason"] == "unreachable" and trans["new"] == "fault"
@@ -123,7 +124,7 @@ def test_daq_error_on_the_way_home_vents_and_stops() -> None:
         real(psi)
 
     rig.backend.set_pressures = flaky  # type: ignore[method-assign]
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(2)], rig.machine.log)
     assert rig.transitions(1)[-2:] == [S.RETURN_HOME, S.FAULT]
     assert report.stopped is FaultReason.HARDWARE_ERROR and rig.vented()
     assert report.berries[1].final_state is S.IDLE  # never attempted
@@ -139,7 +140,7 @@ def test_a_dead_daq_that_cannot_vent_is_logged_as_such() -> None:
         real(psi)
 
     rig.backend.set_pressures = dead  # type: ignore[method-assign]
-    report = rig.machine.run([BerryTarget(1)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1)], rig.machine.log)
     assert report.stopped is FaultReason.HARDWARE_ERROR
     failed = [r for r in rig.machine.log.records if r["kind"] == "vent_failed"]
     assert failed and "could not vent" in failed[0]["error"]

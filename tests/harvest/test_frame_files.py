@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from softarm.errors import ConfigError
-from softarm.harvest.frame_files import INDEX, FrameFolder, FrameRecorder
+from softarm.harvest.records.frame_files import INDEX, FrameFolder, FrameRecorder
 from softarm.vision.crop import ImageCrop
 
 

@@ -7,9 +7,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from softarm import PolynomialCurve, SoftArm
-from softarm.harvest.clearance import CANE_RADIUS, Clearance
-from softarm.harvest.ik import cone_axes
-from softarm.harvest.targets import align_z, grasp_point, pointing_error, tool_pose
+from softarm.harvest.control.clearance import CANE_RADIUS, Clearance
+from softarm.harvest.control.ik import cone_axes
+from softarm.harvest.machine.targets import align_z, grasp_point, pointing_error, tool_pose
 from softarm.sim.bush import Bush
 
 Y = np.array([0.0, 1.0, 0.0])

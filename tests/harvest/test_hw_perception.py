@@ -17,7 +17,8 @@ import pytest
 from softarm._core import PolynomialCurve
 from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.simulated import SimulatedCamera
-from softarm.harvest import hw_devices, hw_rig, rig
+from softarm.harvest.control import stack as rig
+from softarm.harvest.rigs import hw_devices, hw_rig
 from softarm.perception.bush_vision import BushVision
 from softarm.perception_config import PerceptionConfig
 from softarm.vision import CameraModel
@@ -116,7 +117,7 @@ def bush() -> Any:
     """A small rendered bush (the sim rig's own map and canes), or a skip (a failure
     where the render is required)."""
     from render_required import rendering
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 
     with rendering():
         return build_sim_rig(SimRigOptions(n_berries=3, seed=330, world="bush"))

@@ -16,7 +16,8 @@ from softarm.hardware.simulated import (
     SimulatedPressureBank,
     SimulatedRipenessSensor,
 )
-from softarm.harvest import HarvestConfig, hw_devices, hw_rig
+from softarm.harvest import HarvestConfig
+from softarm.harvest.rigs import hw_devices, hw_rig
 
 
 class _Link:

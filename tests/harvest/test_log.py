@@ -8,8 +8,9 @@ import pytest
 
 from softarm.errors import InputError
 from softarm.harvest import BerryTarget, HarvestLog, read_log
-from softarm.harvest.header import UNITS
-from softarm.harvest.log import current_record
+from softarm.harvest.records.header import UNITS
+from softarm.harvest.records.log import current_record
+from softarm.harvest.runs.policy import run_targets
 
 from .fakes import make_rig
 
@@ -19,7 +20,7 @@ def test_crash_mid_run_vents_and_leaves_a_complete_log(tmp_path) -> None:
     rig = make_rig(HarvestLog(path))
     rig.tracker.crash_after = 1.0
     with pytest.raises(RuntimeError, match="simulated bug"):
-        rig.machine.run([BerryTarget(1)])
+        run_targets(rig.machine.run_berry, [BerryTarget(1)], rig.machine.log)
     # No close(): the process "died" here. Every line written so far must parse.
     lines = path.read_text().splitlines()
     records = [json.loads(line) for line in lines]
@@ -34,7 +35,7 @@ def test_crash_mid_run_vents_and_leaves_a_complete_log(tmp_path) -> None:
 
 def test_step_records_hold_the_documented_fields(tmp_path) -> None:
     rig = make_rig(HarvestLog(tmp_path / "run.jsonl"))
-    rig.machine.run([BerryTarget(1)])
+    run_targets(rig.machine.run_berry, [BerryTarget(1)], rig.machine.log)
     rig.machine.log.close()
     steps = [r for r in read_log(tmp_path / "run.jsonl") if r["kind"] == "step"]
     placing = [r for r in steps if r["state"] == "initial_placement"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from softarm.harvest import HarvestLog, read_log
-from softarm.harvest.report import BerryResult
+from softarm.harvest.records.report import BerryResult
 
 
 def test_log_and_report_floats_are_rounded(tmp_path) -> None:

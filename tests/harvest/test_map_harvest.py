@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softarm.harvest.interfaces import BerryTarget
-from softarm.harvest.map_harvest import harvest_map
-from softarm.harvest.report import BerryResult
-from softarm.harvest.states import FaultReason
+from softarm.harvest.machine.interfaces import BerryTarget
+from softarm.harvest.machine.states import FaultReason
+from softarm.harvest.records.report import BerryResult
+from softarm.harvest.runs.map_run import harvest_map
 
 
 @dataclass

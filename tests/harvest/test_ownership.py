@@ -7,17 +7,21 @@ import numpy as np
 import pytest
 
 from softarm.harvest import BerryTarget, FaultReason, HarvestLog, Observation
-from softarm.harvest.observe import BerryWatch
-from softarm.harvest.outcome import Fault
-from softarm.harvest.states import HarvestState
+from softarm.harvest.machine.observe import BerryWatch
+from softarm.harvest.machine.outcome import Fault
+from softarm.harvest.machine.states import HarvestState
+from softarm.harvest.runs.policy import run_targets
 
 from .fakes import FakeClock, make_rig
 
 
 def test_the_stages_keep_no_state_of_a_berry() -> None:
     rig = make_rig()
-    rig.machine.run([BerryTarget(1), BerryTarget(3)])
-    assert set(vars(rig.machine.servo)) == {"clock", "controller", "actuator", "cfg", "log"}
+    run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(3)], rig.machine.log)
+    servo = rig.machine.servo
+    assert set(vars(servo)) == {"link", "transport", "berry_loop"}
+    assert set(vars(servo.link)) == {"clock", "controller", "actuator", "cfg", "log"}
+    assert vars(servo.transport) == vars(servo.berry_loop) == {"link": servo.link}
 
 
 @pytest.mark.parametrize("tag", [1, 3])  # harvested, and unreachable (a fault mid-stage)

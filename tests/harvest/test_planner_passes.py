@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from softarm import SoftArm
-from softarm.harvest.clearance import Clearance
-from softarm.harvest.config import HarvestConfig
-from softarm.harvest.ik import ModelIK, planning_resolver
+from softarm.harvest.control.clearance import Clearance
+from softarm.harvest.control.ik import ModelIK, planning_resolver
+from softarm.harvest_config import HarvestConfig
 from softarm.sim.bush import Bush
 
 
@@ -71,9 +71,9 @@ def test_a_detour_goes_round_a_cane_the_straight_ramps_pass_too_near() -> None:
     # a cane on the model, under the 25 mm margin, and no via point on the approach line
     # clears it; the last pass goes round through a configuration of the arm's own.
     from softarm.geometry import cone_axes
-    from softarm.harvest import sim_rig
-    from softarm.harvest.ik import DETOUR
-    from softarm.harvest.targets import approach_pose
+    from softarm.harvest.control.ik import DETOUR
+    from softarm.harvest.machine.targets import approach_pose
+    from softarm.harvest.rigs import sim_rig
 
     rig = sim_rig.build_sim_rig(sim_rig.SimRigOptions(n_berries=8, seed=641))
     planner = rig.machine.planner

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from softarm.errors import ParameterError
-from softarm.harvest.plant_model import (
+from softarm.harvest.control.plant_model import (
     PREDICTED_ALPHA_LAG_S,
     PREDICTED_ALPHA_MAX,
     PREDICTED_ALPHA_MIN,

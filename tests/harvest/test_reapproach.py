@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from softarm.harvest import BerryTarget, FaultReason, HarvestConfig, HarvestState
-from softarm.harvest.states import FAULTS_THAT_STOP
+from softarm.harvest.machine.states import FAULTS_THAT_STOP
 
 from .fakes import BERRIES, FakeController, make_rig
 

@@ -9,7 +9,8 @@ import pytest
 from softarm.errors import HardwareError
 from softarm.hardware.arduino_devices import ArduinoRipenessSensor
 from softarm.harvest import BerryTarget, FaultReason, HarvestState
-from softarm.harvest.replay_devices import RecordingExhaustedError, ReplayLink
+from softarm.harvest.rigs.replay_devices import RecordingExhaustedError, ReplayLink
+from softarm.harvest.runs.policy import run_targets
 
 from .fakes import make_rig
 
@@ -26,7 +27,9 @@ def test_the_readings_in_order_then_a_stated_device_error() -> None:
 def test_a_replay_out_of_readings_ends_the_berry_with_its_reason() -> None:
     rig = make_rig()
     rig.machine.ripeness = ArduinoRipenessSensor(ReplayLink([0.9], "rec"))
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2), BerryTarget(1)])
+    report = run_targets(
+        rig.machine.run_berry, [BerryTarget(1), BerryTarget(2), BerryTarget(1)], rig.machine.log
+    )
     first, second, third = report.berries
     assert first.harvested  # the one recorded reading
     assert second.fault is FaultReason.HARDWARE_ERROR and not second.harvested

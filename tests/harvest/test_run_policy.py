@@ -1,4 +1,4 @@
-"""The one run policy of both rigs (``softarm.harvest.run_policy``): in order, a berry lost
+"""The one run policy of both rigs (``softarm.harvest.runs.policy``): in order, a berry lost
 from view once more after the others, a stopping fault ends the run, the run's end
 logged the same way, one exit-status rule."""
 
@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from softarm.harvest.interfaces import BerryTarget
-from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.run_policy import exit_status, finish_run, run_targets
-from softarm.harvest.states import FaultReason, HarvestState
+from softarm.harvest.machine.interfaces import BerryTarget
+from softarm.harvest.machine.states import FaultReason, HarvestState
+from softarm.harvest.records.report import BerryResult, HarvestReport
+from softarm.harvest.runs.policy import exit_status, finish_run, run_targets
 
 LOST, SAFETY = FaultReason.MARKER_LOST, FaultReason.SAFETY_STOP
 

@@ -10,7 +10,7 @@ import pytest
 
 from softarm.cli import main
 from softarm.harvest import FaultReason, HarvestState, read_log
-from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 from softarm.harvest_config import HarvestConfig
 from softarm.sim.arm import PlantConfig
 

@@ -36,7 +36,7 @@ def test_an_arm_that_never_settles_times_out_in_idle() -> None:
 def test_a_ramp_refuses_an_unbounded_deadline() -> None:
     rig = make_rig()
     m = rig.machine
-    from softarm.harvest.observe import BerryWatch
+    from softarm.harvest.machine.observe import BerryWatch
 
     watch = BerryWatch(m.vision, m.clock, BerryTarget(1), m.log, 1.0)
     with pytest.raises(ParameterError, match="deadline"):

@@ -8,7 +8,7 @@ import numpy as np
 
 from softarm.errors import HardwareError
 from softarm.harvest import HarvestState
-from softarm.harvest.survey import SurveyPlan
+from softarm.harvest.control.survey import SurveyPlan
 
 from .fakes import make_rig
 

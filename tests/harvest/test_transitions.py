@@ -9,8 +9,9 @@ import pytest
 
 from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest import BerryTarget, FaultReason, HarvestConfig, HarvestState
-from softarm.harvest.outcome import Fault
-from softarm.harvest.targets import grasp_point
+from softarm.harvest.machine.outcome import Fault
+from softarm.harvest.machine.targets import grasp_point
+from softarm.harvest.runs.policy import run_targets
 
 from .fakes import BERRIES, commanded_before_the_vent, make_rig
 
@@ -20,7 +21,7 @@ HAPPY = [S.IDLE, S.INITIAL_PLACEMENT, S.FINE_POSITIONING, S.GRASP, S.RETURN_HOME
 
 def test_happy_path_visits_every_state_in_order_and_ends_at_rest() -> None:
     rig = make_rig()
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(2)], rig.machine.log)
     assert report.success_rate == 1.0
     for tag in (1, 2):
         assert rig.transitions(tag) == HAPPY
@@ -66,7 +67,7 @@ def test_unripe_berry_is_released_and_skipped() -> None:
 
 def test_unreachable_berry_faults_vents_and_the_run_goes_on() -> None:
     rig = make_rig()
-    report = rig.machine.run([BerryTarget(3), BerryTarget(1)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(3), BerryTarget(1)], rig.machine.log)
     first, second = report.berries
     assert first.fault is FaultReason.UNREACHABLE and first.final_state is S.FAULT
     # Backed out home before the vent: the arm relaxes from the ready pose, not in the bush.
@@ -93,7 +94,8 @@ def test_a_retreat_that_fails_vents_where_it_is_with_the_first_fault(
         fine_timeout=0.3, fine_budget=0.2, grasp_workspace=1e-4, home_timeout=0.01
     )
     rig = make_rig(config=config)
-    servo, ramp = rig.machine.servo, rig.machine.servo.ramp
+    transport = rig.machine.servo.transport
+    ramp = transport.ramp
 
     def stuck(watch: object, stage: S, *args: object, **kwargs: object) -> object:
         # The ramp home (after the closed loop ran out of its 10 ms) cannot finish.
@@ -101,7 +103,7 @@ def test_a_retreat_that_fails_vents_where_it_is_with_the_first_fault(
             raise Fault(FaultReason.TIMEOUT, "return_home: ramp not done in time")
         return ramp(watch, stage, *args, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(servo, "ramp", stuck)
+    monkeypatch.setattr(transport, "ramp", stuck)
     result = rig.machine.run_berry(BerryTarget(1))
     assert result.fault is FaultReason.TIMEOUT
     fault = next(r for r in rig.machine.log.records if r["kind"] == "fault")
@@ -121,7 +123,7 @@ def test_fine_budget_grasps_within_the_gripper_workspace() -> None:
 
 def test_report_json_has_one_entry_per_berry_with_the_required_fields() -> None:
     rig = make_rig()
-    report = rig.machine.run([BerryTarget(1), BerryTarget(3)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(3)], rig.machine.log)
     data = json.loads(json.dumps(report.to_dict(), allow_nan=False))
     assert data["success_rate"] == 0.5
     assert [b["tag_id"] for b in data["berries"]] == [1, 3]

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from softarm.harvest import BerryTarget, FaultReason, HarvestState
-from softarm.harvest.states import FAULTS_THAT_STOP
+from softarm.harvest.machine.states import FAULTS_THAT_STOP
+from softarm.harvest.runs.policy import run_targets
 from softarm.vision import CameraModel, MarkerDetector
 
 from .fakes import make_rig
@@ -25,7 +26,7 @@ def test_corrupt_frame_faults_the_berry_and_the_run_goes_on() -> None:
         return track(time)
 
     rig.tracker.track = track_with_a_corrupt_frame  # type: ignore[method-assign]
-    report = rig.machine.run([BerryTarget(1), BerryTarget(2)])
+    report = run_targets(rig.machine.run_berry, [BerryTarget(1), BerryTarget(2)], rig.machine.log)
     first, second = report.berries
     assert first.fault is FaultReason.VISION_ERROR
     assert first.final_state is HarvestState.FAULT

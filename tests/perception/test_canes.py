@@ -231,10 +231,10 @@ def rendered():
 
     need_mujoco()
     import softarm
-    from softarm.harvest.sim_rig import default_cameras
-    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.harvest.rigs.sim_rig import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render import RenderedBush
+    from softarm.sim.rig_cameras import BASE_TAG_ID
 
     arm = softarm.SoftArm.blackberry()
     cams = default_cameras()

@@ -25,10 +25,10 @@ SCALE = 0.25
 
 
 def _world(look: RowLook, shadows: bool = True) -> Any:
-    from softarm.harvest.sim_rig import default_cameras
-    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.harvest.rigs.sim_rig import default_cameras
     from softarm.sim.render import RenderUnavailableError
     from softarm.sim.render.world import RenderedBush
+    from softarm.sim.rig_cameras import BASE_TAG_ID
 
     pytest.importorskip("mujoco")
     cams = default_cameras(scale=SCALE)
@@ -208,7 +208,7 @@ def test_the_row_dataset_has_stages(tmp_path: Path) -> None:
 
 
 def test_harvest_takes_a_look_for_the_row_only(capsys: pytest.CaptureFixture[str]) -> None:
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 
     with pytest.raises(SystemExit) as exit_:
         main(["harvest", "--sim", "--world", "row", "--look", "noon"])

@@ -9,7 +9,7 @@ import pytest
 
 import softarm
 from softarm.errors import ConfigError
-from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 from softarm.sweep.spec import TrialSpec
 from softarm.sweep.trial import BERRY_COLUMNS, run_trial_rows
 
@@ -51,7 +51,8 @@ def test_harvest_gains_option_checks_the_file_first(
 
 
 def test_a_trial_row_carries_the_bushs_rate() -> None:
-    """Each berry's row repeats its bush's rate (softarm.harvest.rate) and simulated time."""
+    """Each berry's row repeats its bush's rate (softarm.harvest.records.rate) and its
+    simulated time."""
     trial = TrialSpec(seed=90040, plant={}, berries=1, rig={}, gains={})
     rows = run_trial_rows(trial, single_threaded=False)
     assert rows and all(r["error"] is None for r in rows), rows

@@ -21,8 +21,8 @@ from scipy.spatial.transform import Rotation
 
 import softarm
 from softarm.cli import main
-from softarm.harvest.log import STEP_RENAMED, read_log
-from softarm.harvest.states import HarvestState
+from softarm.harvest.machine.states import HarvestState
+from softarm.harvest.records.log import STEP_RENAMED, read_log
 from softarm.units import METRES_PER_PSI
 from softarm.viz.bag.convert import TOPICS
 

@@ -95,7 +95,7 @@ class Calibration:
 
     def pressure_map(self, max_psi: float = MAX_PSI) -> GainMap:
         """The elongation <-> psi map of the fitted actuators, for
-        ``softarm.harvest.actuator.SafeActuator(bank, pressure_map=...)``: the model's
+        ``softarm.harvest.control.actuator.SafeActuator(bank, pressure_map=...)``: the model's
         (true) elongations become pressures through each actuator's own gain."""
         return GainMap(max_psi, self.actuator_gain, self.actuator_offset)
 

@@ -1,4 +1,4 @@
-"""The run's header record (:mod:`softarm.harvest.header`) and its ROS 2 bag, for the
+"""The run's header record (:mod:`softarm.harvest.records.header`) and its ROS 2 bag, for the
 commands that run a harvest (``harvest``, ``demo``): the header opens the log and the
 report; the bag (``--bag``) is written from the log's records once the run ends."""
 
@@ -41,21 +41,22 @@ def sim_header(
     rig: Any, rig_options: Any, args: argparse.Namespace | None = None, command: str = "harvest"
 ) -> dict[str, Any]:
     """The header of a simulated run: the invocation and the rig's settings."""
-    from softarm.harvest.header import header_record, sim_settings
+    from softarm.harvest.records.header import header_record
+    from softarm.harvest.rigs.sim_header import sim_settings
 
     return header_record(**_invocation(args, command), **sim_settings(rig, rig_options))
 
 
 def hardware_header(config: Any, args: argparse.Namespace) -> dict[str, Any]:
     """The header of a hardware run on ``config`` (from ``args.config``)."""
-    from softarm.harvest.header import hardware_settings, header_record
+    from softarm.harvest.records.header import hardware_settings, header_record
 
     return header_record(**_invocation(args, "harvest"), **hardware_settings(config, args.config))
 
 
 def start_log(log: Any, header: Mapping[str, Any]) -> None:
     """Open the run's log (a ``HarvestLog``) with its header record."""
-    from softarm.harvest.header import HEADER
+    from softarm.harvest.records.header import HEADER
 
     log.event(HEADER, **header)
 
@@ -93,8 +94,8 @@ def write_log_bag(
 def _one_run(log: Path, run: int | None) -> list[Any]:
     """The records of run ``run`` of ``log`` (None: its only run)."""
     from softarm.errors import InputError
-    from softarm.harvest.header import split_runs
-    from softarm.harvest.log import read_log
+    from softarm.harvest.records.header import split_runs
+    from softarm.harvest.records.log import read_log
 
     runs = split_runs(list(read_log(log)))
     if run is None and len(runs) > 1:

@@ -63,9 +63,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def default_rig(scale: float = 1.0, world: str = "bush", look: str = "random") -> DatasetRig:
     """The simulated harvest's cameras and markers, images scaled by ``scale``; the
     ``world`` and its ``look`` (the row's)."""
-    from softarm.harvest.sim_rig import default_cameras
-    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.harvest.rigs.sim_rig import default_cameras
     from softarm.sim.render.dataset import DatasetRig
+    from softarm.sim.rig_cameras import BASE_TAG_ID
 
     c = default_cameras(scale=scale)
     return DatasetRig(

@@ -33,6 +33,7 @@ from softarm.commands._dry_run import (
     replay_rounds,
 )
 from softarm.commands._looks import LOOKS
+from softarm.commands._marker_bodies import MARKER_BODIES
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
 from softarm.commands._run_info import (
@@ -49,11 +50,11 @@ from softarm.stops import drives_arm, records_late_stop, vents_on_stop
 
 if TYPE_CHECKING:
     from softarm.config import Config
-    from softarm.harvest.hw_rig import HardwareRig
-    from softarm.harvest.log import HarvestLog
-    from softarm.harvest.replay_devices import ReplayDevices
-    from softarm.harvest.report import HarvestReport
-    from softarm.harvest.sim_rig import SimRig
+    from softarm.harvest.records.log import HarvestLog
+    from softarm.harvest.records.report import HarvestReport
+    from softarm.harvest.rigs.hw_rig import HardwareRig
+    from softarm.harvest.rigs.replay_devices import ReplayDevices
+    from softarm.harvest.rigs.sim_rig import SimRig
 
 #: Berries one command may ask for: as many as a simulated bush holds, a bush, not a field
 #: (softarm.sim.bush.MAX_BERRIES; not imported here, it pulls in OpenCV).
@@ -130,6 +131,16 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="--world bush or row: the berry detector (default colour; docs/perception.md, "
         "'Which detector'); on the arm, [perception] detector",
     )  # fmt: skip
+    p.add_argument(
+        "--cane-source", choices=("colour", "net", "net+colour"), default=None,
+        help="--world bush or row: where the cane pixels come from (default colour; "
+        "docs/perception.md, 'Which cane pixels'); on the arm, [perception] canes",
+    )  # fmt: skip
+    p.add_argument(
+        "--marker-body", choices=MARKER_BODIES, default=None,
+        help="--sim: the marker body on the gripper that C1 tracks (default cube; "
+        "docs/hardware.md, 'The marker body'); on the arm, [calibration] marker_body",
+    )  # fmt: skip
     add_plant_options(p)
     add_dry_run_options(p)
     p.add_argument(
@@ -150,7 +161,7 @@ RENDERED = ("bush", "row")
 
 @drives_arm("harvest")
 def run(args: argparse.Namespace) -> int:
-    """Run the harvest; exit status (:func:`~softarm.harvest.run_policy.exit_status`, the
+    """Run the harvest; exit status (:func:`~softarm.harvest.runs.policy.exit_status`, the
     same on both rigs) 0 when every berry ended DONE within tolerance and nothing stopped
     the run, 1 otherwise, 2 when the hardware is absent, 128 + the signal number when
     stopped by SIGINT/SIGTERM."""
@@ -173,6 +184,13 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(
             "--detector: for the rendered worlds; on the arm, [perception] detector"
         )
+    if args.cane_source is not None and not (args.sim and args.world != "tags"):
+        raise ParameterError(
+            "--cane-source: for the rendered worlds; on the arm, [perception] canes"
+        )
+    if args.marker_body is not None and not args.sim:
+        raise ParameterError("--marker-body: for the simulator (--sim); on the arm, "
+                             "[calibration] marker_body")  # fmt: skip
     check_bag(args.bag)
     check_view(args.view, args.record)
     check_foxglove(args.foxglove)
@@ -181,10 +199,12 @@ def run(args: argparse.Namespace) -> int:
     gains = _gains(args)
     if args.sim:
         args.seed = 0 if args.seed is None else args.seed
+        options.update(marker_body=args.marker_body or "cube")
         if args.world in RENDERED:
             options.update(world=args.world, unripe_fraction=BUSH_UNRIPE_FRACTION)
             options.update(survey=args.survey is not False, record_frames=args.record_frames)
             options.update(detector=args.detector or "colour")
+            options.update(cane_source=args.cane_source or "colour")
         if args.world == "row":
             options.update(look=args.look)
         return run_sim(
@@ -263,7 +283,7 @@ def run_sim(
     more ``SimRigOptions`` (``plant``, ``identified``: see ``commands/_plant.py``). The
     log and the report open with the run's header (``args``: the parsed command line);
     ``bag``: the run as a ROS 2 bag."""
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 
     check_view(view, record)  # demo's path too: before the banner and the log
     if not quiet:
@@ -277,7 +297,7 @@ def run_sim(
     # What C1 saw at IDLE, before the arm moved (the rendered bush only).
     seen = None
     if rig.scene is not None and plot_path is not None:
-        from softarm.harvest.c1_picture import c1_picture
+        from softarm.harvest.records.c1_picture import c1_picture
 
         seen = c1_picture(rig.scene, seed)
     viewer = _viewer(rig, view, record)
@@ -301,7 +321,7 @@ def run_sim(
         print(f"log: {log_path}")
     if record is not None:
         print(f"recording: {record}")
-    from softarm.harvest.run_policy import exit_status
+    from softarm.harvest.runs.policy import exit_status
 
     return exit_status(report, off_tolerance(report, rig.machine))
 
@@ -320,7 +340,7 @@ def _sim_outputs(
     report.header = rig.machine.log.records[0]
     print(summary(report.to_dict(), Tolerance.of(getattr(rig.machine, "config", None))))
     if "rate" in report.extra:  # berries per hour and the time by stage (issue 40 item 4)
-        from softarm.harvest.rate import rate_line
+        from softarm.harvest.records.rate import rate_line
 
         print(rate_line(report.extra["rate"]))
     if report_path is not None:
@@ -380,7 +400,7 @@ def _plot(rig: SimRig, report: HarvestReport, path: Path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    from softarm.harvest.plots import plot_run
+    from softarm.harvest.rigs.sim_plots import plot_run
 
     plot_run(rig, report, path)
 
@@ -406,7 +426,7 @@ def _gains(args: argparse.Namespace) -> dict[str, Any] | None:
 
 
 def _run_hardware(args: argparse.Namespace) -> int:
-    from softarm.harvest.log import HarvestLog
+    from softarm.harvest.records.log import HarvestLog
 
     log = HarvestLog(args.log)  # first of all: a stop during set-up is recorded in it
     try:
@@ -451,7 +471,7 @@ def _run_hardware(args: argparse.Namespace) -> int:
         for i, result in enumerate(report.berries):  # after the run: the lines a sim prints
             print(line(i, len(report.berries), result, None, tol=tol, tagged=tagged))
         print(summary(report.to_dict(), tol))
-        from softarm.harvest.run_policy import exit_status
+        from softarm.harvest.runs.policy import exit_status
 
         status = exit_status(report, off_tolerance(report, rig.machine))
         if devices is not None and sent is not None:
@@ -489,7 +509,7 @@ def _hardware_rig(
 ) -> HardwareRig:
     """The hardware rig of ``args``, its header written to ``log`` first; ``devices``:
     the dry run's (default: the real drivers)."""
-    from softarm.harvest.hw_rig import build_hardware_rig
+    from softarm.harvest.rigs.hw_rig import build_hardware_rig
     from softarm.identified_plant import identified_from_config, load_identified
 
     config = _hardware_config(args)

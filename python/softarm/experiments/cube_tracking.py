@@ -24,47 +24,118 @@ It lives above :mod:`softarm.perception` (which may not import the simulation).
 from __future__ import annotations
 
 import argparse
+import itertools
+import json
 import sys
 import time
 from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from softarm.sim.render.row_look import LOOKS
+from softarm.vision.marker_body import MARKER_BODIES
 
-__all__ = ["track_cubes"]
+__all__ = ["ANGLE_BINS", "by_angle", "track_cubes"]
 
 #: The cube is in full view when this share of its faces' pixels is not hidden.
 UNHIDDEN = 0.99
+#: Edges (degrees) of the approach-angle bins: the angle between C1's line of sight and
+#: the normal of the paper cube's best-facing side tag at the true pose (the same for
+#: every body: it says where the arm is, not what it carries).
+ANGLE_BINS = (0.0, 40.0, 50.0, 60.0, 70.0, 90.0)
+
+
+@dataclass(frozen=True)
+class Pose:
+    """One tracked pose: its error (mm, None: not found), approach angle (degrees, see
+    :data:`ANGLE_BINS`), share of the body's tag pixels in view, and whether the pose
+    came from markers consistent on their own."""
+
+    error: float | None
+    angle: float
+    share: float
+    consistent: bool
 
 
 def track_cubes(
-    seeds: Iterable[int], poses: int = 8, side: int | None = None, look: str | None = None
+    seeds: Iterable[int],
+    poses: int = 8,
+    side: int | None = None,
+    look: str | None = None,
+    body: str = "cube",
 ) -> dict[str, Any]:
-    """Position errors (mm) of the cube tracked in C1 over ``poses`` arm poses per seed,
-    the share of poses where the cube was found, the mean time (ms) to render a window
-    (its renderer made; the harvest makes one per size once) and its mean side (px);
-    ``look``: in the daylight row with that look family (``--world row``), drawn from
-    each seed."""
+    """Position errors (mm) of the marker body ``body`` tracked in C1 over ``poses`` arm
+    poses per seed, the share of poses where it was found, the mean time (ms) to render
+    a window (its renderer made; the harvest makes one per size once) and its mean side
+    (px); ``look``: in the daylight row with that look family (``--world row``), drawn
+    from each seed. ``"by_angle"`` holds the same by approach angle (:func:`by_angle`)."""
+    found, seconds, sides = _tracked(seeds, poses, side, look, body)
+    errors = [p.error for p in found if p.error is not None]
+    unhidden = [p.error for p in found if p.error is not None and p.share >= UNHIDDEN]
+    hidden = [p.error for p in found if p.error is not None and p.share < UNHIDDEN]
+    trusted = [p.error for p in found if p.error is not None and p.consistent]
+    return {
+        "body": body,
+        "poses": len(found),
+        "found": len(errors),
+        "median_mm": _median(errors),
+        "p95_mm": _p95(errors),
+        "consistent": len(trusted),
+        "median_consistent_mm": _median(trusted),
+        "p95_consistent_mm": _p95(trusted),
+        "in_full_view": len(unhidden),
+        "median_in_full_view_mm": _median(unhidden),
+        "median_partly_hidden_mm": _median(hidden),
+        "window_ms": 1e3 * seconds / max(len(found), 1),
+        "mean_side_px": float(np.mean(sides)) if sides else float("nan"),
+        "by_angle": by_angle(found),
+    }
+
+
+def by_angle(found: list[Pose]) -> list[dict[str, Any]]:
+    """Per approach-angle bin (:data:`ANGLE_BINS`): poses, found, median and p95 (mm)."""
+    out = []
+    for lo, hi in itertools.pairwise(ANGLE_BINS):
+        here = [p for p in found if lo <= p.angle < hi or (hi == ANGLE_BINS[-1] and p.angle == hi)]
+        errors = [p.error for p in here if p.error is not None]
+        out.append(
+            {
+                "angle_deg": f"{lo:g}-{hi:g}",
+                "poses": len(here),
+                "found": len(errors),
+                "median_mm": _median(errors),
+                "p95_mm": _p95(errors),
+            }
+        )
+    return out
+
+
+def _tracked(
+    seeds: Iterable[int], poses: int, side: int | None, look: str | None, body: str
+) -> tuple[list[Pose], float, list[int]]:
+    """Every pose tracked, the seconds spent rendering windows and the windows' sides."""
     import softarm
-    from softarm.harvest.sim_rig import default_cameras
-    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.harvest.rigs.sim_rig import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import arm_sections, world_for
+    from softarm.sim.rig_cameras import BASE_TAG_ID
     from softarm.vision import MarkerCube
     from softarm.vision.detector import MarkerDetector
+    from softarm.vision.marker_body import marker_body
     from softarm.vision.poses import invert
 
     arm = softarm.SoftArm.blackberry()
     cams = default_cameras()
-    cube = MarkerCube.standard(cams.cube_marker)
-    detector = MarkerDetector(cube.dictionary)
-    errors, sides, tried, seconds = [], [], 0, 0.0
-    unhidden: list[float] = []  # the cube's tags in full view
-    hidden: list[float] = []  # some of them hidden (leaves, fruit, the arm)
-    trusted: list[float] = []  # from markers consistent on their own (the tracker's)
+    cams.marker_body = body
+    tracked = marker_body(body, cams.cube_marker)
+    paper = MarkerCube.standard(cams.cube_marker)  # the approach angle's reference
+    detector = MarkerDetector(tracked.dictionary)
+    out: list[Pose] = []
+    sides: list[int] = []
+    seconds = 0.0
     for seed in seeds:
         bush = Bush.generate(arm, 8, seed, view_point=cams.T_base_c1[:3, 3])
         row = None if look is None else RowLook.named(look, seed)
@@ -78,39 +149,28 @@ def track_cubes(
             T_base_ee = arm.forward(q)
             world.set_arm(arm_sections(arm, q), T_base_ee)
             T_c1_cube = T_c1_base @ T_base_ee @ cams.T_ee_cube
-            tried += 1
             window = _window(world, T_base_ee @ cams.T_ee_cube, side)
             start = time.perf_counter()  # again, timed: its renderer exists now
             window = _window(world, T_base_ee @ cams.T_ee_cube, side)
             seconds += time.perf_counter() - start
             sides.append(window.shape[0])
-            est = cube.estimate(detector.detect(window, world.stereo.left), world.stereo.left)
-            share = world.renderer.visible_share("c1_left", faces)
+            est = tracked.estimate(detector.detect(window, world.stereo.left), world.stereo.left)
+            error = None
             if est is not None:
                 error = 1e3 * float(np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3]))
-                errors.append(error)
-                (unhidden if share >= UNHIDDEN else hidden).append(error)
-                if est.consistent:
-                    trusted.append(error)
+            angle = float(paper.view_angles(T_c1_cube, tuple(sorted(paper.markers))).min())
+            share = world.renderer.visible_share("c1_left", faces)
+            out.append(Pose(error, angle, share, est is not None and est.consistent))
         world.close()
-    return {
-        "poses": tried,
-        "found": len(errors),
-        "median_mm": _median(errors),
-        "p95_mm": float(np.percentile(errors, 95)) if errors else float("nan"),
-        "consistent": len(trusted),
-        "median_consistent_mm": _median(trusted),
-        "p95_consistent_mm": float(np.percentile(trusted, 95)) if trusted else float("nan"),
-        "in_full_view": len(unhidden),
-        "median_in_full_view_mm": _median(unhidden),
-        "median_partly_hidden_mm": _median(hidden),
-        "window_ms": 1e3 * seconds / max(tried, 1),
-        "mean_side_px": float(np.mean(sides)) if sides else float("nan"),
-    }
+    return out, seconds, sides
 
 
 def _median(values: list[float]) -> float:
     return float(np.median(values)) if values else float("nan")
+
+
+def _p95(values: list[float]) -> float:
+    return float(np.percentile(values, 95)) if values else float("nan")
 
 
 def _is_cube_face(world: Any, geom: int) -> bool:
@@ -138,11 +198,25 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--poses", type=int, default=8)
     p.add_argument("--side", type=int, help="fixed window side (px)")
     p.add_argument("--look", choices=LOOKS, help="in the daylight row with this look")
+    p.add_argument("--marker-body", choices=MARKER_BODIES, default="cube", help="the body tracked")
+    p.add_argument("--by-angle", action="store_true", help="also by approach angle")
+    p.add_argument("--json", metavar="FILE", help="write the figures as JSON to FILE")
     args = p.parse_args(argv)
-    result = track_cubes(args.seeds, args.poses, args.side, args.look)
-    fields = (f"{k}={v:.3f}" if isinstance(v, float) else f"{k}={v}" for k, v in result.items())
-    print(" ".join(fields))
+    result = track_cubes(args.seeds, args.poses, args.side, args.look, args.marker_body)
+    print(_line({k: v for k, v in result.items() if k != "by_angle"}))
+    if args.by_angle:
+        for row in result["by_angle"]:
+            print("  " + _line(row))
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as f:
+            json.dump({"seeds": args.seeds, "look": args.look, **result}, f, indent=1)
     return 0
+
+
+def _line(values: dict[str, Any]) -> str:
+    return " ".join(
+        f"{k}={v:.3f}" if isinstance(v, float) else f"{k}={v}" for k, v in values.items()
+    )
 
 
 if __name__ == "__main__":

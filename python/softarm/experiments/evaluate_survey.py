@@ -7,7 +7,7 @@ Each seed is a bush of 8 berries (40 % unripe), as in
 :mod:`softarm.experiments.evaluate_canes`: C1's stereo pair with the arm out of view
 gives the first map (berries by :func:`~softarm.perception.stereo.locate_berries`,
 canes by :func:`~softarm.perception.canes.cane_points`); the survey is planned as the
-harvest plans it (:func:`~softarm.harvest.survey.plan_survey`, from rest, around the
+harvest plans it (:func:`~softarm.harvest.control.survey.plan_survey`, from rest, around the
 mapped berries, clear of C1's canes); the arm is drawn at each view's configuration,
 C2's frame rendered at the harvest's scale and its pose taken from the marker cube
 tracked in C1 (eq. 22); each pair's cane points join C1's for the fit. The arm is
@@ -40,14 +40,14 @@ def evaluate_survey(seeds: Iterable[int], n_berries: int = 8) -> list[dict[str, 
     (``survey_*``), the pairs planned and taken, and the time (ms, this machine) the
     survey's perception took: its pairs' points and the fit."""
     import softarm
-    from softarm.harvest.clearance import Clearance
-    from softarm.harvest.ik import ModelIK, planning_resolver
-    from softarm.harvest.sim_rig import C2_SCALE, default_cameras
-    from softarm.harvest.sim_vision import BASE_TAG_ID
-    from softarm.harvest.survey import plan_survey
+    from softarm.harvest.control.clearance import Clearance
+    from softarm.harvest.control.ik import ModelIK, planning_resolver
+    from softarm.harvest.control.survey import plan_survey
+    from softarm.harvest.rigs.sim_rig import C2_SCALE, default_cameras
     from softarm.harvest_config import HarvestConfig
     from softarm.sim.bush import Bush
     from softarm.sim.render.world import world_for
+    from softarm.sim.rig_cameras import BASE_TAG_ID
 
     arm, cams, cfg = softarm.SoftArm.blackberry(), default_cameras(), HarvestConfig()
     rows = []

@@ -20,8 +20,7 @@ import cv2
 import numpy as np
 
 import softarm
-from softarm.harvest.sim_rig import default_cameras
-from softarm.harvest.sim_vision import BASE_TAG_ID
+from softarm.harvest.rigs.sim_rig import default_cameras
 from softarm.perception import stereo as stereo_module
 from softarm.perception.berries import BerryDetection
 from softarm.perception.net_berries import NetDetector
@@ -29,6 +28,7 @@ from softarm.perception.stereo import locate_berries
 from softarm.sim.bush import Bush
 from softarm.sim.render.scoring import BerryScore, score_berries
 from softarm.sim.render.world import world_for
+from softarm.sim.rig_cameras import BASE_TAG_ID
 
 __all__ = ["compare", "evaluate_berries", "pixel_stage"]
 

@@ -216,11 +216,11 @@ def rendered(seeds: Iterable[int]) -> Iterator[tuple[int, _U8, _U8]]:
     CLUTTER) of each bush, rendered as
     :func:`softarm.experiments.perception.evaluate_berries` renders it."""
     import softarm
-    from softarm.harvest.sim_rig import default_cameras
-    from softarm.harvest.sim_vision import BASE_TAG_ID
+    from softarm.harvest.rigs.sim_rig import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render.labels import KINDS
     from softarm.sim.render.world import world_for
+    from softarm.sim.rig_cameras import BASE_TAG_ID
 
     arm = softarm.SoftArm.blackberry()
     cams = default_cameras()

@@ -1,8 +1,9 @@
 """The berry-harvesting state machine and its simulated and hardware rigs (paper section
 III-D, fig. 4)."""
 
-from softarm.harvest.actuator import SafeActuator
-from softarm.harvest.interfaces import (
+from softarm.harvest.control.actuator import SafeActuator
+from softarm.harvest.machine.harvest_machine import HarvestMachine
+from softarm.harvest.machine.interfaces import (
     BerryFix,
     BerryTarget,
     Clock,
@@ -14,11 +15,10 @@ from softarm.harvest.interfaces import (
     RipenessProbe,
     Vision,
 )
-from softarm.harvest.log import HarvestLog, read_log
-from softarm.harvest.machine import HarvestMachine
-from softarm.harvest.report import BerryResult, HarvestReport
-from softarm.harvest.simulated import simulate
-from softarm.harvest.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+from softarm.harvest.machine.states import FAULTS_THAT_STOP, FaultReason, HarvestState
+from softarm.harvest.records.log import HarvestLog, read_log
+from softarm.harvest.records.report import BerryResult, HarvestReport
+from softarm.harvest.rigs.simulate import simulate
 from softarm.harvest_config import HarvestConfig
 
 __all__ = [

@@ -3,7 +3,7 @@ the Arduino's pressure board as the pressure monitor: the lag is seen in its rea
 the eye-to-hand camera C1 tracking the marker cube for the end-effector pose, and the
 wall clock.
 
-Devices are opened as the harvest opens them (:mod:`softarm.harvest.hw_rig`); a missing
+Devices are opened as the harvest opens them (:mod:`softarm.harvest.rigs.hw_rig`); a missing
 one closes and vents what was opened and raises
 :class:`~softarm.errors.HardwareUnavailableError` naming it.
 """
@@ -24,8 +24,8 @@ from softarm.hardware.clock import MonotonicClock
 from softarm.hardware.daq import NidaqPressureBank
 from softarm.hardware.pressure_map import VoltageMap
 from softarm.hardware.safety import SafePressureBank
-from softarm.vision import MarkerCube
 from softarm.vision.camera_model import camera_from_config
+from softarm.vision.marker_body import marker_body
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision
 
@@ -69,7 +69,7 @@ class HardwareIdentificationRig:
             self.vision = CameraVision(
                 lambda t: cam.read(), lambda t: None, model1, model1,
                 invert(np.array(cal.T_C1_base)), np.eye(4), np.array(cal.T_EE_cube),
-                MarkerCube.standard(), cal.berry_tag, 0.0,
+                marker_body(cal.marker_body, cal.marker_length), cal.berry_tag, 0.0,
             )  # fmt: skip
             self._devices = stack.pop_all()
 

@@ -4,7 +4,7 @@ The output follows the input only once the input has moved more than half the ba
 width ``w`` away from it, ``y = clip(y_prev, x - w/2, x + w/2)``; it depends on the
 path of the input, not on its speed. A pneumatic muscle's braid friction gives this
 kind of loop between pressure and length. The law is the core's (``softarm._core.play``),
-which the controller's model of the plant (``softarm.harvest.plant_model``) applies too."""
+which the controller's model of the plant (``softarm.harvest.control.plant_model``) applies too."""
 
 from __future__ import annotations
 

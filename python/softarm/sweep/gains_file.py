@@ -15,7 +15,7 @@ import softarm
 from softarm.config import GAIN_KEYS
 from softarm.errors import ConfigError
 from softarm.files import load_toml, write_text
-from softarm.harvest.rig import gains_over
+from softarm.harvest.control.stack import gains_over
 
 __all__ = ["GAIN_KEYS", "gains_from", "load_gains", "write_gains"]
 

@@ -53,7 +53,7 @@ def _single_threaded() -> None:
 
 def run_trial(trial: TrialSpec) -> Any:
     """Build the simulated rig for ``trial`` and harvest its bush; returns the report."""
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
     from softarm.stops import vents_on_stop
     from softarm.sweep.plant_keys import plant_config
 
@@ -117,7 +117,7 @@ def run_trial_rows(trial: TrialSpec, single_threaded: bool = True) -> list[dict[
                 "branch_contact_steps": report.get("branch_contact_steps"),
                 "min_branch_gap_m": report.get("min_branch_gap_m"),
                 "stopped": report.get("stopped"),
-                # The bush's rate (softarm.harvest.rate): harvested per hour of simulated
+                # The bush's rate (softarm.harvest.records.rate): harvested per hour of simulated
                 # time, and that time, survey, moves and way home included.
                 "berries_per_hour": rate.get("berries_per_hour"),
                 "sim_s": rate.get("total_s"),

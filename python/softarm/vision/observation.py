@@ -2,7 +2,7 @@
 position fix and where it came from, and one observation of a control period.
 
 Defined in the vision layer so that vision and identification use them without the
-harvest; :mod:`softarm.harvest.interfaces` re-exports them.
+harvest; :mod:`softarm.harvest.machine.interfaces` re-exports them.
 """
 
 from __future__ import annotations

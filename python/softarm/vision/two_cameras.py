@@ -5,9 +5,9 @@ first berry position; the eye-in-hand camera C2 gives the berry close up, carrie
 base frame through the tracked end-effector pose (eq. 21). :class:`CameraFusion` picks
 the source: C1 until the grasp point is within 6 cm of the berry, C2 after, the most
 recent fix while the berry is hidden (section III-D, fig. 4). Implements
-:class:`~softarm.harvest.interfaces.Vision`: one :meth:`CameraVision.observe` per control
+:class:`~softarm.harvest.machine.interfaces.Vision`: one :meth:`CameraVision.observe` per control
 step reads both cameras. (In the vision layer, so that identification and calibration
-track the cube without the harvest; :mod:`softarm.harvest.vision_loop` re-exports it.)
+track the cube without the harvest.)
 """
 
 from __future__ import annotations

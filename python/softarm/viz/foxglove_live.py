@@ -298,7 +298,7 @@ def serve_log(path: str | Path, address: str, announce: Callable[[str], None] = 
     """``softarm replay LOG --foxglove``: serve the run log at ``path`` at the run's own
     pace (its records' ``t``), from the moment a Foxglove client subscribes; the number
     of records served."""
-    from softarm.harvest.log import read_log
+    from softarm.harvest.records.log import read_log
 
     records: list[dict[str, Any]] = []
     listener = _Subscribed()

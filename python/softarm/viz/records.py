@@ -1,4 +1,4 @@
-"""Harvest run-log records (:mod:`softarm.harvest.log`) drawn in a rerun recording.
+"""Harvest run-log records (:mod:`softarm.harvest.records.log`) drawn in a rerun recording.
 
 One record at a time, on the ``sim_time`` timeline at the record's own ``t`` (the time its
 step observed; a record without one, e.g. ``ripeness``, goes at the last time seen). The
@@ -26,7 +26,7 @@ import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.errors import InputError, ShapeError
-from softarm.harvest.states import HarvestState
+from softarm.harvest.machine.states import HarvestState
 from softarm.viz.arm import arm_polylines
 from softarm.viz.gripper import gripper_outline
 from softarm.viz.rerun_sdk import TIMELINE
@@ -270,7 +270,7 @@ class RecordLogger:
         self._text(r, "harvest/log", skip=("q",))
 
     def _header(self, r: Mapping[str, Any]) -> None:
-        """The run's header (softarm.harvest.header) as one line: what made the run."""
+        """The run's header (softarm.harvest.records.header) as one line: what made the run."""
         argv = r.get("argv")
         words = " ".join(str(a) for a in argv) if isinstance(argv, list) else ""
         text = (

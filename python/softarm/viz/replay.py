@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 
 from softarm.errors import InputError
-from softarm.harvest.header import find_header
-from softarm.harvest.log import read_log
+from softarm.harvest.records.header import find_header
+from softarm.harvest.records.log import read_log
 from softarm.viz.bag.scene import RunScene
 from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import RecordLogger
@@ -38,7 +38,7 @@ def replay(
     returns the number of records. ``model``: the arm the run controlled (default the
     header's arm, else the nominal blackberry arm), on which the commanded elongations
     are drawn. The bush of a simulated run is drawn (the canes and the true berries at
-    ``world/bush``) from the log's header record (:mod:`softarm.harvest.header`); for an
+    ``world/bush``) from the log's header record (:mod:`softarm.harvest.records.header`); for an
     older log without one, ``scene`` = (seed, berries) of its ``harvest --sim`` run
     rebuilds it, after checking that the log's berries are that bush's.
 
@@ -89,7 +89,7 @@ def _header_scene(path: Path, records: list[Any]) -> RunScene:
 def _bush(path: Path, records: list[Any], seed: int, berries: int) -> Any:
     """The bush of ``harvest --sim --seed seed --berries berries``, checked against the
     berries the log estimated (a log of another run would draw a wrong scene)."""
-    from softarm.harvest.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
 
     bush = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed)).bush
     true = {b.tag_id: np.asarray(b.position) for b in bush.berries}

@@ -1,6 +1,6 @@
 """Clearance between the Cosserat rod's body and the canes (ground truth of contact).
 
-The same body as :class:`softarm.harvest.clearance.Clearance`, the core's one description
+The same body as :class:`softarm.harvest.control.clearance.Clearance`, the core's one description
 of it (:class:`softarm._core.Body`: each section's radius, the gripper as a capsule from
 the distal arc's tip to the grasp point; 5 mm canes), measured on the rod's *current*
 centre line, a polyline: exact point-to-segment distances from every centre-line segment

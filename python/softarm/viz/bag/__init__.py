@@ -1,5 +1,5 @@
 """A harvest run as a ROS 2 bag (rosbag2 in one MCAP file), without a ROS install: the
-records of a run log (:mod:`softarm.harvest.log`) become standard ROS 2 messages, written
+records of a run log (:mod:`softarm.harvest.records.log`) become standard ROS 2 messages, written
 with the pure-Python ``rosbags`` package (the ``ros`` extra). See docs/ros.md for the
 topics and frames.
 

@@ -1,4 +1,4 @@
-"""Run-log records (:mod:`softarm.harvest.log`) as ROS 2 messages on their topics.
+"""Run-log records (:mod:`softarm.harvest.records.log`) as ROS 2 messages on their topics.
 
 The stamps are the run's start (from the header) plus each record's ``t``; a record
 without one (``ripeness``, ``berry_result``) takes the last time seen, and the clock never
@@ -19,7 +19,7 @@ import numpy as np
 
 from softarm.checks import FloatArray
 from softarm.errors import InputError
-from softarm.harvest.header import HEADER, find_header
+from softarm.harvest.records.header import HEADER, find_header
 from softarm.viz.bag.markers import scene_markers
 from softarm.viz.bag.messages import Messages
 from softarm.viz.bag.scene import CANE_SAMPLES, RunScene, cane_branch, stamp_ns

@@ -1,4 +1,4 @@
-"""Recorded camera frames (a ``--record-frames`` folder, :mod:`softarm.harvest.frame_files`)
+"""Recorded camera frames (a ``--record-frames`` folder, :mod:`softarm.harvest.records.frame_files`)
 as ``sensor_msgs/CompressedImage`` messages, each stamped at its frame's time ``t``.
 
 The frame files are put in the bag as they are (PNG as recorded, or JPEG), with the
@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from softarm.errors import ConfigError, InputError
-from softarm.harvest.frame_files import INDEX, FrameFolder
+from softarm.harvest.records.frame_files import INDEX, FrameFolder
 from softarm.viz.bag.convert import Message
 from softarm.viz.bag.messages import Messages
 from softarm.viz.bag.scene import RunScene, stamp_ns

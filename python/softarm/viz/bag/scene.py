@@ -1,6 +1,6 @@
 """What a bag draws besides the records: the arm model, the fixed frames, the cameras,
 the canes and the berries, and the pressure map, read from the log's header record
-(:mod:`softarm.harvest.header`). A log without a header (written before it existed) gets
+(:mod:`softarm.harvest.records.header`). A log without a header (written before it existed) gets
 the nominal blackberry arm and the simulated rig's cameras, and no bush."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 import softarm
 from softarm.checks import FloatArray
 from softarm.errors import InputError
-from softarm.harvest.header import READABLE_FORMATS
+from softarm.harvest.records.header import READABLE_FORMATS
 from softarm.sim.bush import Branch
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.viz.bag.messages import NS_PER_S
@@ -99,8 +99,8 @@ class RunScene:
 
     @classmethod
     def _defaults(cls) -> RunScene:
-        from softarm.harvest.header import camera
-        from softarm.harvest.sim_rig import default_cameras
+        from softarm.harvest.records.header import camera
+        from softarm.harvest.rigs.sim_rig import default_cameras
 
         cams = default_cameras()
         return cls(

@@ -19,7 +19,7 @@ from typing import Any
 
 from softarm.errors import InputError, OutputError
 from softarm.files import atomic_path, check_target
-from softarm.harvest.header import split_runs
+from softarm.harvest.records.header import split_runs
 from softarm.viz.bag.convert import TOPICS, Converter
 from softarm.viz.bag.deps import require_rosbags, typestore
 from softarm.viz.bag.images import IMAGE_TOPICS, FrameImages
@@ -68,7 +68,7 @@ def write_bag(
     Raises:
         InputError: a record is malformed (the message names its number and field), or
             the records hold more than one run (a log appended to: pick one with
-            :func:`softarm.harvest.header.split_runs`).
+            :func:`softarm.harvest.records.header.split_runs`).
         ConfigError: the frames folder is broken: no index, a frame file missing or not
             an image (the file named).
         MissingDependencyError: rosbags (the ``ros`` extra) is not installed.

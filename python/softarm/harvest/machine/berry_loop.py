@@ -1,0 +1,94 @@
+"""The loop on the berry (eq. 21-22): the end effector driven along the approach axis to
+a :class:`~softarm.harvest.machine.servo_goal.ServoGoal` short of the berry, one resolver
+step a period, until one of the stage's end rules (:mod:`.end_rules`) ends it. Placement,
+fine positioning and the back-out of the way home are this loop with different goals."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from softarm.errors import NonFiniteError
+from softarm.harvest.machine.arm_link import ArmLink
+from softarm.harvest.machine.end_rules import lost_near, settled_or_out_of_time, stalled
+from softarm.harvest.machine.interfaces import BerryFix, FloatArray, Observation
+from softarm.harvest.machine.observe import BerryWatch
+from softarm.harvest.machine.outcome import Fault, StageOutcome
+from softarm.harvest.machine.servo_goal import Aim, Progress, ServoGoal
+from softarm.harvest.machine.states import HarvestState
+from softarm.harvest.machine.targets import grasp_point, pointing_error, tool_pose
+
+__all__ = ["BerryLoop"]
+
+
+class BerryLoop:
+    """Runs a :class:`ServoGoal` on the shared :class:`ArmLink`."""
+
+    def __init__(self, link: ArmLink) -> None:
+        self.link = link
+
+    def run(
+        self, watch: BerryWatch, stage: HarvestState, q: FloatArray, axis: FloatArray,
+        goal: ServoGoal,
+    ) -> StageOutcome:  # fmt: skip
+        """Drive the end effector to ``goal.distance`` short of the berry along the
+        approach ``axis`` until the error stays below ``goal.tol``; see
+        :class:`HarvestConfig` and :class:`ServoGoal` for how else it may end."""
+        start = self.link.clock.now()
+        watch.excuse_berry(start)  # the open-loop ramp needed no berry
+        progress = Progress(start)
+        last: Aim | None = None  # this stage's last measured aim
+        while True:
+            try:
+                seen = self.link.look(watch, q, need_fix=goal.frozen is None)
+            except Fault as fault:
+                return lost_near(self.link, fault, q, axis, last, goal)
+            if goal.frozen is not None:
+                seen = replace(seen, fix=BerryFix(goal.frozen, "held", seen.t - start))
+            if seen.pose is None or seen.fix is None:
+                watch.log_step(stage, seen, q, None, None, False)
+                q = self.link.hold(q)
+                continue
+            aim = last = self._aim(seen, axis, goal.distance)
+            if goal.record_errors:  # the errors at the grasp
+                watch.record_grasp_errors(self._grasp_error(seen), aim.pointing)
+            ended = settled_or_out_of_time(
+                self.link, watch, stage, seen, q, axis, aim, goal, progress
+            )
+            if ended is not None:
+                return ended
+            q_next, saturated = self._loop_step(q, aim.goal, seen.pose)
+            progress.update(seen.t, aim.error, saturated, self.link.cfg.stall_progress)
+            if progress.stalled(seen.t, self.link.cfg.stall_time):
+                return stalled(self.link, stage, seen, q, axis, aim, goal)
+            watch.log_step(stage, seen, q_next, aim.goal, (aim.error, aim.pointing), saturated)
+            q = self.link.hold(q_next)  # goes on from what was sent
+
+    def _aim(self, seen: Observation, axis: FloatArray, distance: float) -> Aim:
+        """The grasp point, not the end-effector origin, is servoed onto its goal
+        ``distance - grasp_offset`` short of the berry: a residual pointing error then
+        does not move the berry off the fingers."""
+        assert seen.pose is not None and seen.fix is not None
+        offset = self.link.cfg.grasp_offset
+        point = seen.fix.position - (distance - offset) * axis
+        goal = tool_pose(seen.pose, point, axis, offset)
+        error = float(np.linalg.norm(grasp_point(seen.pose, offset) - point))
+        return Aim(goal, error, pointing_error(seen.pose, axis))
+
+    def _grasp_error(self, seen: Observation) -> float:
+        """The grasp point's distance (m) from the berry."""
+        assert seen.pose is not None and seen.fix is not None
+        return float(
+            np.linalg.norm(grasp_point(seen.pose, self.link.cfg.grasp_offset) - seen.fix.position)
+        )
+
+    def _loop_step(
+        self, q: FloatArray, goal: FloatArray, pose: FloatArray
+    ) -> tuple[FloatArray, bool]:
+        """The resolver's next command towards ``goal`` from the measured ``pose``."""
+        q_next, saturated = self.link.controller.step(q, goal, pose)
+        q_next = np.asarray(q_next, dtype=np.float64)
+        if not np.all(np.isfinite(q_next)):
+            raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
+        return q_next, saturated

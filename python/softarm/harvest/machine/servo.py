@@ -1,0 +1,190 @@
+"""The stages inside the harvesting states: wait for the markers, plan, place, fine
+position, go home. Each is the loop on the berry (:mod:`.berry_loop`) with its goal, or a
+move of :mod:`.transport`, on the devices and settings they share (:mod:`.arm_link`)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+from softarm.harvest.machine.arm_link import ArmLink
+from softarm.harvest.machine.berry_loop import BerryLoop
+from softarm.harvest.machine.interfaces import (
+    Clock,
+    Controller,
+    FloatArray,
+    PlacementPlanner,
+    PressureActuator,
+    require_controller,
+)
+from softarm.harvest.machine.observe import BerryWatch
+from softarm.harvest.machine.outcome import Fault, StageOutcome
+from softarm.harvest.machine.servo_goal import ServoGoal
+from softarm.harvest.machine.states import FaultReason, HarvestState
+from softarm.harvest.machine.transport import Transport
+from softarm.harvest.records.log import HarvestLog
+from softarm.harvest_config import HarvestConfig
+
+__all__ = ["Fault", "Servo"]
+
+
+class Servo:
+    """Runs the stages of :class:`~softarm.harvest.machine.harvest_machine.HarvestMachine`.
+
+    It keeps no state of a berry or of the machine: each stage is told the berry's
+    :class:`~softarm.harvest.machine.observe.BerryWatch`, the ``stage`` it runs as (for the step
+    log and the fault messages) and what it works towards, and returns where it ended.
+    """
+
+    def __init__(
+        self,
+        clock: Clock,
+        controller: Controller,
+        actuator: PressureActuator,
+        config: HarvestConfig,
+        log: HarvestLog,
+    ) -> None:
+        self.link = ArmLink(clock, require_controller(controller), actuator, config, log)
+        self.transport = Transport(self.link)
+        self.berry_loop = BerryLoop(self.link)
+
+    @property
+    def controller(self) -> Controller:
+        """The controller every stage steps with (one, in :attr:`link`)."""
+        return self.link.controller
+
+    @controller.setter
+    def controller(self, controller: Controller) -> None:
+        self.link.controller = require_controller(controller)
+
+    def ramp(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        goal: FloatArray,
+        deadline: float,
+        observe: bool = False,
+        settle: bool = True,
+    ) -> FloatArray:
+        """An open-loop ramp to ``goal`` (:meth:`Transport.ramp`)."""
+        return self.transport.ramp(watch, stage, q, goal, deadline, observe, settle)
+
+    # -- stages ---------------------------------------------------------------------
+
+    def wait_visible(self, watch: BerryWatch, stage: HarvestState, q: FloatArray) -> None:
+        """IDLE: hold the arm until both the cube and the berry are seen."""
+        watch.restart()
+        while True:
+            seen = watch.observe()
+            watch.log_step(stage, seen, q, None, None, False)
+            if seen.pose is not None and seen.fix is not None:
+                return
+            q = self.link.hold(q)
+
+    def plan(
+        self,
+        watch: BerryWatch,
+        q: FloatArray,
+        planner: PlacementPlanner,
+        avoid: Sequence[FloatArray] = (),
+    ) -> tuple[tuple[FloatArray, ...], FloatArray]:
+        """INITIAL_PLACEMENT, first: solve the pre-grasp pose (and the approach axis,
+        inside the allowed cone, none of ``avoid``) on the model, holding ``q`` until the
+        cube and the berry are seen. Returns the plan's waypoints and its axis; no plan
+        is UNREACHABLE."""
+        seen = watch.observe()
+        while seen.pose is None or seen.fix is None:
+            q = self.link.hold(q)
+            seen = watch.observe()
+        plan = planner.plan(q, seen.fix.position, seen.pose, avoid)
+        if plan is None:
+            raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
+        planned, axis = plan
+        self.link.log.event(
+            "plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position,
+            fell_back=bool(getattr(planner, "fell_back", False)),
+        )  # fmt: skip
+        return tuple(planned), axis
+
+    def place(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        axis: FloatArray,
+        waypoints: tuple[FloatArray, ...] = (),
+    ) -> StageOutcome:
+        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose,
+        approaching along ``axis``.
+
+        A plan's ``waypoints`` (:meth:`plan`) are first followed in closed loop
+        (:meth:`Transport.follow`, the canes repelling inside the resolver), then the loop closes
+        on the berry (eq. 22) to remove the model's error. The outcome carries the axis
+        and the waypoints used."""
+        c = self.link.cfg
+        start = self.link.clock.now()
+        for q_way in waypoints:
+            q = self.transport.follow(watch, stage, q, q_way, start + c.placement_timeout)
+        placement = ServoGoal(
+            c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout,
+            placed_on_limit=True,
+        )  # fmt: skip
+        out = self.berry_loop.run(watch, stage, q, axis, placement)
+        return replace(out, waypoints=waypoints)
+
+    def fine(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        axis: FloatArray,
+        grasp_within: float | None = None,
+    ) -> StageOutcome:
+        """FINE_POSITIONING: grasp point onto the berry (eye-in-hand, eq. 21).
+
+        Saturated on a joint limit without progress, or past ``fine_budget``, it grasps
+        inside the gripper's ±1 cm (III-D), or only within ``grasp_within`` (m) when the
+        machine has a better use for the arm (another axis to try, an earlier attempt
+        that ended nearer): farther out it is UNREACHABLE here, with the error."""
+        c = self.link.cfg
+        within = c.grasp_workspace if grasp_within is None else grasp_within
+        fine = ServoGoal(c.grasp_offset, c.fine_tolerance, c.fine_timeout, c.fine_budget, within)
+        return self.berry_loop.run(watch, stage, q, axis, fine)
+
+    def go_home(
+        self,
+        watch: BerryWatch,
+        stage: HarvestState,
+        q: FloatArray,
+        home: FloatArray,
+        axis: FloatArray,
+        waypoints: tuple[FloatArray, ...],
+        berry: FloatArray | None,
+    ) -> FloatArray:
+        """RETURN_HOME: back out to the pre-grasp pose (the approach line is free of
+        branches) of the ``berry`` last seen, along ``axis``, ramp back through the
+        placement plan's ``waypoints``, then to ``home``."""
+        c = self.link.cfg
+        start = self.link.clock.now()
+        try:
+            back_out = ServoGoal(
+                c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2,
+                record_errors=False, frozen=berry,
+            )  # fmt: skip
+            q = self.berry_loop.run(watch, stage, q, axis, back_out).q
+        except Fault as fault:
+            # Backing out is best effort: the berry is already in the fingers (or the
+            # machine is backing out of a fault), and the ramp home is open loop anyway.
+            # With the cube lost it is the only way out: vented in the bush, the arm
+            # would relax to its rest shape through the canes.
+            if fault.reason not in (
+                FaultReason.TIMEOUT,
+                FaultReason.UNREACHABLE,
+                FaultReason.MARKER_LOST,
+            ):
+                raise
+            self.link.log.event("retreat_incomplete", t=self.link.clock.now(), detail=str(fault))
+            if fault.retreat_from is not None:  # where the loop left the arm
+                q = fault.retreat_from
+        return self.transport.way_back(watch, stage, q, (*reversed(waypoints), home), start)
