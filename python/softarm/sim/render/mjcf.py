@@ -25,6 +25,7 @@ from softarm.sim.render.look import BushLook
 from softarm.sim.render.row import Row
 from softarm.vision.cube import FACE_PER_MARKER
 from softarm.vision.dictionaries import get_dictionary
+from softarm.vision.marker_body import body_markers
 
 __all__ = ["ARM_SEGMENTS_PER_SECTION", "CameraSpec", "SceneSpec", "scene_xml", "z_to"]
 
@@ -77,6 +78,8 @@ class SceneSpec:
     tag_length: float
     cube_ids: tuple[int, int, int, int] = (0, 1, 2, 3)
     cube_marker: float = 0.08
+    #: The gripper's marker body (softarm.vision.marker_body.MARKER_BODIES).
+    marker_body: str = "cube"
     n_sections: int = 3
     dictionary: str = "DICT_4X4_50"
     keep_clear: Sequence[tuple[FloatArray, FloatArray]] = field(default_factory=tuple)
@@ -354,26 +357,12 @@ def _arm(spec: SceneSpec) -> str:
     cams = "".join(_camera(c) for c in spec.hand_cameras)
     out.append(f'<body name="arm_ee" mocap="true">{fingers}{cams}</body>')
     s = FACE_PER_MARKER * spec.cube_marker
-    faces = "".join(
-        _quad(f"arm_cubeface{i}", _cube_face(k, s), s, f"tag{i}")
-        for k, i in enumerate(spec.cube_ids)
-    )
-    # Four side faces and no lid: C2 looks out through the open end (it sits in the
-    # palm, inside the cube's outline).
+    poses = body_markers(spec.marker_body, spec.cube_marker, spec.cube_ids)
+    faces = "".join(_quad(f"arm_cubeface{i}", poses[i], s, f"tag{i}") for i in spec.cube_ids)
+    # The body's four tagged panels and no lid: C2 looks out through the open end (it
+    # sits in the palm, inside the body's outline).
     out.append(f'<body name="arm_cube" mocap="true">{faces}</body>')
     return "".join(out)
-
-
-def _cube_face(k: int, size: float) -> FloatArray:
-    """The pose of face ``k`` in the cube frame (normal +x, +y, -x, -y; y up), as
-    :meth:`softarm.vision.MarkerCube.standard` lays out its markers."""
-    a = k * np.pi / 2
-    n = np.array([np.cos(a), np.sin(a), 0.0])
-    y = np.array([0.0, 0.0, 1.0])
-    pose = np.eye(4)
-    pose[:3, :3] = np.column_stack([np.cross(y, n), y, n])
-    pose[:3, 3] = 0.5 * size * n
-    return pose
 
 
 def _quad(name: str, pose: FloatArray, side: float, material: str) -> str:

@@ -34,7 +34,8 @@ from softarm.sim.render.row_camera import RowCameras
 from softarm.sim.render.row_look import RowLook
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
-from softarm.vision.cube import FACE_PER_MARKER
+from softarm.vision.marker_body import marker_body as make_body
+from softarm.vision.marker_body import panel_corners
 from softarm.vision.poses import invert
 from softarm.vision.stereo_camera import StereoCamera
 
@@ -46,7 +47,7 @@ ZED2_BASELINE = 0.12
 CUBE_REACH = 0.07
 GRIPPER_REACH = 0.04
 #: The C1 window rendered around the marker cube while tracking it holds the cube's
-#: eight corners with WINDOW_PAD px to spare on each side (the tags' quiet zone and
+#: panels' corners with WINDOW_PAD px to spare on each side (the tags' quiet zone and
 #: the detector's adaptive threshold reach past the outline); its side is a multiple of
 #: WINDOW_STEP px (one renderer, an OpenGL context, per side). The pinhole window
 #: rendered for it is WINDOW_MARGIN px larger (the distortion's shift).
@@ -94,6 +95,8 @@ class RenderedBush:
         baseline: C1's stereo baseline (m).
         n_sections: sections of the arm drawn.
         shadows: in the row, the sun casts shadows (a shadow map; off: cheaper).
+        marker_body: the body carrying the tags C1 tracks
+            (:data:`~softarm.vision.marker_body.MARKER_BODIES`).
     """
 
     def __init__(
@@ -112,6 +115,7 @@ class RenderedBush:
         baseline: float = ZED2_BASELINE,
         n_sections: int = 3,
         shadows: bool = True,
+        marker_body: str = "cube",
     ) -> None:
         self.bush = bush
         self.look = look or BushLook.random(bush.seed)
@@ -122,8 +126,13 @@ class RenderedBush:
         self.stereo = StereoCamera(c1, c1, T_base_c1, T_left_right)
         self.c2 = c2
         self.T_ee_cube = T_ee_cube
-        half = 0.5 * FACE_PER_MARKER * cube_marker
-        self._cube_corners = half * np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
+        outline = panel_corners(make_body(marker_body, cube_marker)).reshape(-1, 3)
+        self._cube_corners = outline
+        # The leaves the body pushes: as far as the cube's, plus what the body reaches past it.
+        cube_outline = panel_corners(make_body("cube", cube_marker)).reshape(-1, 3)
+        self._cube_reach = CUBE_REACH + float(
+            np.linalg.norm(outline, axis=1).max() - np.linalg.norm(cube_outline, axis=1).max()
+        )
         right = T_base_c1 @ T_left_right
         spec = SceneSpec(
             bush=bush,
@@ -134,6 +143,7 @@ class RenderedBush:
             base_tag_id=base_tag_id,
             tag_length=base_tag,
             cube_marker=cube_marker,
+            marker_body=marker_body,
             n_sections=n_sections,
             keep_clear=_approach_lines(bush),
             row=self.row,
@@ -156,7 +166,7 @@ class RenderedBush:
         self.renderer.set_cube(cube)
         body = [_densified(s) for s in sections] + [cube[None, :3, 3], T_base_ee[None, :3, 3]]
         radius = [np.full(len(b), ARM_TUBE_RADIUS) for b in body[:-2]] + [
-            np.array([CUBE_REACH]),
+            np.array([self._cube_reach]),
             np.array([GRIPPER_REACH]),
         ]
         self.renderer.push_leaves(np.vstack(body), np.concatenate(radius))
@@ -180,7 +190,7 @@ class RenderedBush:
     def cube_window(self, T_base_cube: FloatArray) -> ImageCrop:
         """C1's left eye around the marker cube at ``T_base_cube`` (where it truly is,
         as the tag world's crop): the smallest square of WINDOW_STEP px steps, centred
-        on the cube, that holds the cube's eight corners with WINDOW_PAD px to spare.
+        on the cube, that holds the corners of the body's panels with WINDOW_PAD px to spare.
         A software rasteriser's cost goes with the pixels."""
         T_c1_cube = invert(self.stereo.T_base_left) @ T_base_cube
         points = np.vstack([T_c1_cube[:3, 3], self._cube_corners @ T_c1_cube[:3, :3].T])
@@ -303,12 +313,13 @@ def world_for(
     bush: Bush, cams: Any, base_tag_id: int, look: BushLook | None = None, c2_scale: float = 1.0
 ) -> RenderedBush:
     """The rendered world of ``bush`` seen by the simulated rig's cameras ``cams`` (a
-    ``softarm.harvest.sim_vision.SimCameras``: C1's left eye where the tag world's
+    ``softarm.sim.rig_cameras.SimCameras``: C1's left eye where the tag world's
     eye-to-hand camera is); ``c2_scale`` shrinks C2's image and focal length."""
     return RenderedBush(
         bush, cams.T_base_c1, cams.model(1), scaled(cams.model(2), c2_scale), cams.T_ee_c2,
         cams.T_ee_cube,
         cams.T_base_tag, base_tag_id, cams.base_tag, cams.cube_marker, look,
+        marker_body=getattr(cams, "marker_body", "cube"),
     )  # fmt: skip
 
 
