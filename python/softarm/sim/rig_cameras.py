@@ -15,7 +15,8 @@ from softarm.checks import FloatArray
 from softarm.sim.bush import Berry
 from softarm.sim.camera import SyntheticCamera
 from softarm.sim.markers import SceneMarker, cube_scene_markers
-from softarm.vision import CameraModel, MarkerCube
+from softarm.vision import CameraModel
+from softarm.vision.marker_body import marker_body
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision, register_c1
 
@@ -61,6 +62,8 @@ class SimCameras:
     c2_focal: float = 300.0
     noise_std: float = 2.0
     cube_marker: float = 0.08
+    #: The gripper's marker body (:data:`softarm.vision.marker_body.MARKER_BODIES`).
+    marker_body: str = "cube"
     base_tag: float = 0.08
     berry_tag: float = 0.03
     scale: float = 1.0
@@ -96,7 +99,7 @@ def sim_vision(
     c2 = SyntheticCamera(m2, w2, h2, noise_std=cams.noise_std, supersample=2, seed=seed + 1)
     render1 = c1.render_crop if cams.crop else c1.render
     render2 = c2.render_crop if cams.crop else c2.render
-    cube = MarkerCube.standard(cams.cube_marker)
+    cube = marker_body(cams.marker_body, cams.cube_marker)
     T_c1_base = invert(cams.T_base_c1)
 
     base_tag = SceneMarker(BASE_TAG_ID, DICT, cams.base_tag, T_c1_base @ cams.T_base_tag)
