@@ -293,9 +293,10 @@ pub fn add_rows_step(rows: &[f64], asks: &[f64], threshold: f64, out: &mut [f64]
     let row = |k: usize| &rows[k * n..(k + 1) * n];
     let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let gram = DMatrix::from_fn(m, m, |i, j| dot(row(i), row(j)));
-    let eig = gram.symmetric_eigen();
     let t2 = threshold * threshold;
-    let mut z = eig.eigenvectors.transpose() * nalgebra::DVector::from_column_slice(asks);
+    let asks = leveraged_asks(&gram, asks, t2);
+    let eig = gram.symmetric_eigen();
+    let mut z = eig.eigenvectors.transpose() * asks;
     for (zi, &l) in z.iter_mut().zip(eig.eigenvalues.iter()) {
         *zi *= if l > t2 { (1.0 - t2 / l) / l } else { 0.0 };
     }
@@ -305,6 +306,35 @@ pub fn add_rows_step(rows: &[f64], asks: &[f64], threshold: f64, out: &mut [f64]
             *o += zk * x;
         }
     }
+}
+
+/// The asks of [`add_rows_step`], with the ask of a row the null space has no leverage
+/// on (`‖b_k‖ ≤ ε`) taken out where another row has some: `y_k (1 − (1 − ψ_k) o_k)`, with
+/// `ψ_k = clamp(‖b_k‖²/ε² − 1, 0, 1)` (0 up to ε, 1 from √2 ε on) and
+/// `o_k = max_{j≠k} min(1, ‖b_j‖²/ε²)`. Without it such a row's ask leaked through a nearly
+/// parallel row with leverage: the Gram matrix's large eigenvector mixes the two
+/// (`u ≈ (‖b_k‖/‖b_j‖, 1)`), so the step raised the other piece, which asked nothing, by
+/// `‖b_k‖/‖b_j‖` of the ask, for `‖b_k‖` of clearance per metre of motion, below ε: the
+/// body crept on (seed 36 case 119 of the repulsion test: 5–40 µm per step, growing, for
+/// 0.01 µm of clearance). A lone row, or rows all with leverage above √2 ε, keep their
+/// asks; the asks are continuous as rows enter and leave.
+fn leveraged_asks(gram: &DMatrix<f64>, asks: &[f64], t2: f64) -> nalgebra::DVector<f64> {
+    let m = asks.len();
+    let level = |k: usize| {
+        if t2 > 0.0 {
+            gram[(k, k)] / t2
+        } else {
+            f64::INFINITY
+        }
+    };
+    nalgebra::DVector::from_fn(m, |k, _| {
+        let own = (level(k) - 1.0).clamp(0.0, 1.0);
+        let others = (0..m)
+            .filter(|&j| j != k)
+            .map(|j| level(j).min(1.0))
+            .fold(0.0, f64::max);
+        asks[k] * (1.0 - (1.0 - own) * others)
+    })
 }
 
 /// How far (m) the repulsion's step may move the gripper, per metre of clearance it earns
@@ -467,6 +497,39 @@ mod tests {
         };
         let (o1, o2, o3) = (off(1e-2), off(1e-4), off(1e-6));
         assert!(o1 > o2 && o2 > o3 && o3 < 1e-5, "{o1} {o2} {o3}");
+    }
+
+    /// Seed 36 case 119 of the repulsion test: the nearest piece's row has no leverage
+    /// (‖a‖ = 0.002, below ε) and a nearly parallel second row has leverage but asks
+    /// nothing. The step is zero, as for the first row alone; it was `‖a‖/‖b‖` of the ask
+    /// along b. A row with leverage between ε and √2 ε keeps its whole ask as the other row's
+    /// weight falls to 0: the step tends to the lone row's.
+    #[test]
+    fn a_row_without_leverage_asks_nothing_through_a_parallel_one() {
+        let b = [0.3, 0.1, -0.2, 0.0];
+        let a: Vec<f64> = b
+            .iter()
+            .zip([0.0, 0.0, 0.0, 1.0])
+            .map(|(x, e)| 0.005 * x + 0.001 * e)
+            .collect();
+        let rows: Vec<f64> = a.iter().chain(&b).copied().collect();
+        let mut out = [0.0; 4];
+        add_rows_step(&rows, &[1e-3, 0.0], 0.05, &mut out);
+        assert_eq!(out, [0.0; 4]);
+        let a = [0.0, 0.03, 0.0, 0.05]; // ‖a‖ = 0.058, between ε and √2 ε
+        let mut alone = [0.0; 4];
+        add_gap_step(&a, 1e-3, 0.05, &mut alone);
+        let norm = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let off = |w: f64| {
+            let s = w.sqrt();
+            let rows: Vec<f64> = a.iter().copied().chain(b.iter().map(|x| s * x)).collect();
+            let mut out = [0.0; 4];
+            add_rows_step(&rows, &[1e-3, 0.0], 0.05, &mut out);
+            let d: Vec<f64> = out.iter().zip(&alone).map(|(x, y)| x - y).collect();
+            norm(&d) / norm(&alone)
+        };
+        let (o1, o2, o3) = (off(1e-2), off(1e-4), off(1e-6));
+        assert!(o1 > o2 && o2 > o3 && o3 < 1e-4, "{o1} {o2} {o3}");
     }
 
     #[test]
