@@ -39,6 +39,10 @@ CALIBRATION = """\
 # and the side (m) of the berry tags: measure your build (these are the defaults).
 T_EE_cube = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.05], [0, 0, 0, 1]]
 berry_tag = 0.012
+# The body carrying the tags C1 tracks: "cube" (the paper's) or "frustum" (docs/hardware.md,
+# "The marker body"), and its tags' side (m).
+marker_body = "cube"
+marker_length = 0.08
 
 [calibration.c1]  # eye-to-hand camera (a ZED2 in the paper)
 source = 0  # OpenCV device index, or a video file or stream URL
