@@ -17,7 +17,7 @@ from softarm.errors import ConfigError, ParameterError
 from softarm.sweep import perception_map
 from softarm.sweep.perception_score import cell_summary, stereo_counts
 from softarm.sweep.perception_spec import PerceptionTrial, parse_perception_spec
-from softarm.sweep.perception_trial import run_perception_trial
+from softarm.sweep.perception_trial import run_perception_trial, trial_look
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "examples" / "sweeps" / "row_robustness_tiny.toml"
@@ -101,6 +101,23 @@ def test_a_bad_level_names_its_argument(kwargs: dict[str, str], name: str) -> No
 
     with pytest.raises(ParameterError, match=f"^{name} must be one of"):
         RowLook.named("sun", 1, **kwargs)
+
+
+def test_the_camera_levels() -> None:
+    from softarm.sim.render.camera_effects import CameraEffects
+
+    def look(effects: str) -> Any:
+        return trial_look(PerceptionTrial("dusk", effects, "few", "sparse", 300000, ("colour",),
+                                          8, 0.3, 1.0, True, True, True))  # fmt: skip
+
+    on, off = look("on"), look("off")
+    assert on.stereo.left.read_noise > 0 and on.blur_px_s > 0 and on.stereo.left.jpeg_quality
+    # An ideal camera: auto-exposure alone, both eyes alike, no blur; the scene unchanged.
+    assert off.stereo.left == CameraEffects() and off.stereo.left.exposure is None
+    assert off.stereo.right_exposure == 1.0 and off.stereo.right_offset_px == (0.0, 0.0)
+    assert off.blur_px_s == 0.0 and off.c2 == CameraEffects()
+    assert off.sun_elevation == on.sun_elevation and off.ambient == on.ambient
+    assert look("raw").stereo == on.stereo  # raw: the look's; the world applies none
 
 
 def test_stereo_pairs_nearest_first_each_once() -> None:

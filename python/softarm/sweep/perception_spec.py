@@ -7,7 +7,7 @@ what is measured on each frame.
 [perception]
 seeds = [300000, 300001]              # per cell; required
 looks = ["sun", "overcast", "backlight", "dusk"]
-effects = ["off", "on"]               # the camera model: off = the frame as rendered
+effects = ["off", "on"]               # the camera model: raw, off (ideal) or on
 lookalikes = ["few", "many"]          # softarm.sim.render.row_look.LOOKALIKES
 fruit = ["sparse", "dense"]           # softarm.sim.render.row_look.FRUIT_DENSITY
 detectors = ["colour", "net", "net+colour"]
@@ -48,9 +48,11 @@ __all__ = [
 
 #: The grid's axes, in the order a cell is named.
 CELL_KEYS = ("look", "effects", "lookalikes", "fruit")
-#: What ``effects`` may hold: the camera model off (the frame as rendered, lens
-#: distortion only) or on (the look's camera model).
-EFFECTS = ("off", "on")
+#: What ``effects`` may hold: ``raw``, the frames as rendered (the renderer's linear
+#: output, lens distortion only: dark, since nothing exposes them); ``off``, an ideal
+#: camera (auto-exposure alone: no noise, blur, vignetting, white balance error, black
+#: level or JPEG, the two eyes alike); ``on``, the look's whole camera model.
+EFFECTS = ("raw", "off", "on")
 
 
 @dataclass(frozen=True)
@@ -154,7 +156,7 @@ def _choices() -> dict[str, tuple[str, ...]]:
 #: The defaults of the grid's lists: the map of issue 37 (two levels of each knob).
 DEFAULT_LISTS = {
     "looks": ("sun", "overcast", "backlight", "dusk"),
-    "effects": EFFECTS,
+    "effects": ("off", "on"),
     "lookalikes": ("few", "many"),
     "fruit": ("sparse", "dense"),
     "detectors": ("colour", "net", "net+colour"),

@@ -3,8 +3,9 @@ seed, measured on a single stereo frame pair from C1 (the arm out of view).
 
 The bush is :meth:`~softarm.sim.bush.Bush.generate`'s for the seed (``berries``,
 ``unripe_fraction``), inside the row of :meth:`RowLook.named(look, seed, lookalikes,
-fruit) <softarm.sim.render.row_look.RowLook.named>`; with ``effects = "off"`` the frames
-are as rendered (lens distortion only), with ``"on"`` through the look's camera model.
+fruit) <softarm.sim.render.row_look.RowLook.named>`; its frames through the look's camera
+model (``effects = "on"``), an ideal camera that only exposes (``"off"``) or none
+(``"raw"``: as rendered, lens distortion only).
 Every detector runs on the left eye and, by stereo
 (:func:`~softarm.perception.stereo.locate_berries`), on the pair; the canes are fitted
 on the pair. Scores: :mod:`.perception_score`. This is perception per frame, not the
@@ -19,6 +20,7 @@ from __future__ import annotations
 import socket
 import time
 import traceback
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -26,7 +28,7 @@ import numpy as np
 from softarm.sweep.perception_score import is_counted, stereo_counts, tally_counts
 from softarm.sweep.perception_spec import CELL_KEYS, PerceptionTrial
 
-__all__ = ["run_perception_trial"]
+__all__ = ["run_perception_trial", "trial_look"]
 
 #: Fruit with fewer visible pixels than this in the left eye are not labelled (as in
 #: ``softarm dataset``).
@@ -59,11 +61,23 @@ def run_perception_trial(trial: PerceptionTrial) -> dict[str, Any]:
     return row
 
 
+def trial_look(trial: PerceptionTrial) -> Any:
+    """The trial's :class:`~softarm.sim.render.row_look.RowLook`; with ``effects = "off"``
+    its cameras ideal (auto-exposure, nothing else)."""
+    from softarm.sim.render.camera_effects import CameraEffects, StereoEffects
+    from softarm.sim.render.row_look import RowLook
+
+    look = RowLook.named(trial.look, trial.seed, trial.lookalikes, trial.fruit)
+    if trial.effects == "off":
+        ideal = CameraEffects()
+        look = replace(look, stereo=StereoEffects(ideal), c2=ideal, blur_px_s=0.0)
+    return look
+
+
 def _world(trial: PerceptionTrial) -> Any:
     import softarm
     from softarm.harvest.rigs.sim_rig import default_cameras
     from softarm.sim.bush import Bush
-    from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import RenderedBush, scaled
     from softarm.sim.rig_cameras import BASE_TAG_ID
 
@@ -75,7 +89,6 @@ def _world(trial: PerceptionTrial) -> Any:
         view_point=cams.T_base_c1[:3, 3],
         unripe_fraction=trial.unripe_fraction,
     )
-    look = RowLook.named(trial.look, trial.seed, trial.lookalikes, trial.fruit)
     world = RenderedBush(
         bush,
         cams.T_base_c1,
@@ -87,10 +100,10 @@ def _world(trial: PerceptionTrial) -> Any:
         BASE_TAG_ID,
         cams.base_tag,
         cams.cube_marker,
-        look,
+        trial_look(trial),
         shadows=trial.shadows,
     )
-    if trial.effects == "off":
+    if trial.effects == "raw":
         world.effects = None  # the frames as rendered: no camera model
     return world
 
