@@ -68,6 +68,17 @@ class HarvestConfig:
             planner's margin on the closed-loop approach, 1 cm.
         arrival_tolerance: an open-loop ramp ends once the lag model has every actuator
             within this (m) of the ramp's end (with a known lag; see docs/control.md §6).
+        follow_blind_time: while following a plan, how long (s) its feedforward goes on,
+            open loop and each command's way checked, through periods without a pose of
+            the cube (a dropped frame; a fast move's pose the tracker refuses as a jump
+            of more than 3 cm); then the arm waits for the next pose. 0: it waits at once.
+        handover_tolerance: a plan's last leg hands the arm to the loop on the berry once
+            its end is commanded and the lag model has every actuator within this (m) of
+            it (with a known lag): the loop, closed through the lag model, counts the
+            motion still in flight; ``arrival_tolerance`` waits for the arm itself.
+        lead_cap: the most pre-compensation gain ``k`` of the regulators' lag (the
+            regulators are told ``q + k (q - ŷ)``, within the safety layer's rate limit
+            and pressure range; ``softarm._core.lead_gain``, docs/control.md §6); 0: no lead.
     """
 
     period: float = 0.05
@@ -93,20 +104,26 @@ class HarvestConfig:
     home_speed: float = 0.045
     home_elongation: float = 0.0167
     arrival_tolerance: float = 0.001
+    follow_blind_time: float = 0.15
+    handover_tolerance: float = 0.001
+    lead_cap: float = 1.5
     transport_margin: float = 0.01
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
                      "grasp_workspace", "marker_timeout", "placement_timeout", "fine_timeout",
                      "fine_budget", "home_timeout", "idle_timeout", "stall_time", "home_speed",
-                     "arrival_tolerance", "angle_tolerance_deg"):  # fmt: skip
+                     "arrival_tolerance", "angle_tolerance_deg", "handover_tolerance"):  # fmt: skip
             value = _real(self, name)
             if not value > 0:
                 raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
-        for name in ("grasp_offset", "stall_progress", "home_elongation", "transport_margin"):
+        for name in ("grasp_offset", "stall_progress", "home_elongation", "transport_margin",
+                     "follow_blind_time", "lead_cap"):  # fmt: skip
             value = _real(self, name)
             if not value >= 0:
                 raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
+        if self.lead_cap > 20.0:  # the actuator's bound on its lead
+            raise ParameterError(f"lead_cap must be in [0, 20], got {self.lead_cap!r}")
         _real(self, "ripeness_threshold")
         cone = _real(self, "approach_cone_deg")
         if not 0 <= cone < 90:

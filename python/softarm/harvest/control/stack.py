@@ -176,7 +176,7 @@ def _actuator(
         lag=None if lag is None else (lag, cfg.period),
         now=now,
         sensor_lag_s=_sensor_lag(cfg),
-        lead=0.0 if lag is None else lead_gain(lag, cfg.period),
+        lead=0.0 if lag is None else lead_gain(lag, cfg.period, cfg.lead_cap),
         play_m=inputs.play_m if lag is not None else 0.0,
     )
 

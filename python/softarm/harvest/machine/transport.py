@@ -71,17 +71,28 @@ class Transport:
         goal_final = model_pose(q_way)
         best, best_t = np.inf, self.link.clock.now()
         held = False
+        posed = best_t  # when the cube's pose was last seen
         while True:
             seen = self.link.look(watch, q, need_fix=False)
-            if seen.pose is None:
-                watch.log_step(stage, seen, q, None, None, False)
-                q = self.link.hold(q)
-                continue
             on_plan_end = bool(np.all(nominal == q_way))
+            if seen.pose is None:
+                # A period without the cube's pose (a frame dropped, or a fast move's
+                # pose refused as a jump): the plan's feedforward goes on, open loop and
+                # its way checked, for up to ``follow_blind_time``; then the arm waits.
+                advance = straight_step(nominal, q_way, step)
+                if on_plan_end or seen.t - posed > c.follow_blind_time:
+                    advance = np.zeros_like(advance)
+                q_next = self.clear_way(q, (np.clip(q + advance, lower, upper),))
+                if q_next is not q:
+                    nominal = nominal + advance
+                watch.log_step(stage, seen, q_next, None, None, False)
+                q = self.link.hold(q_next)
+                continue
+            posed = seen.t
             err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
             if on_plan_end and err <= c.placement_tolerance:
                 return q
-            if on_plan_end and self.link.actuator.in_flight() is not None and self.link.arrived():
+            if on_plan_end and self._handover():
                 # The plan is done and the arm has caught up with it (lag model): what is
                 # left is the model's error, which the lag-bounded correction here takes
                 # out at a few per cent a period on a slow plant. The loop on the berry
@@ -121,6 +132,12 @@ class Transport:
                 stage, seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
             )
             q = self.link.hold(q_next)  # goes on from what was sent
+
+    def _handover(self) -> bool:
+        """Whether the lag model has every actuator within ``handover_tolerance`` of the
+        last command (False without a lag model: the plan's end is then its pose)."""
+        left = self.link.actuator.in_flight()
+        return left is not None and float(np.max(np.abs(left))) <= self.link.cfg.handover_tolerance
 
     def clear_way(self, q: FloatArray, candidates: Sequence[FloatArray]) -> FloatArray:
         """The first of the ``candidates`` commands whose way keeps clear of the canes on
