@@ -159,3 +159,29 @@ def test_without_a_pose_for_longer_than_the_blind_time_the_arm_waits() -> None:
 def test_bad_move_shaping_keys_name_themselves(key: str, value: float) -> None:
     with pytest.raises(ParameterError, match=key):
         HarvestConfig(**{key: value})  # type: ignore[arg-type]
+
+
+# -- the way home passes its waypoints -----------------------------------------------------
+
+
+def test_the_way_home_passes_a_waypoint_the_arm_is_already_at() -> None:
+    """The back-out leaves the arm at the plan's pre-grasp pose but a few mm of elongation
+    off the plan's q: the way home goes on from there, not back to that q first."""
+    clock, plant = FakeClock(), FakePlant()
+    bank = SafePressureBank(
+        SimulatedPressureBank(plant, channels=3), 70.0, MAX_RATE, 0.5, clock.now,
+        watchdog_thread=False,
+    )  # fmt: skip
+    log, config = HarvestLog(), HarvestConfig()
+    servo = Servo(clock, FakeController(), SafeActuator(bank), config, log)
+    vision = FakeVision(FakeTracker(plant), FakeLocator(dict(BERRIES)))
+    vision.select(BerryTarget(1))
+    watch = BerryWatch(vision, clock, BerryTarget(1), log, config.marker_timeout)
+    q_way, home = np.array([0.02, 0.015, 0.025]), np.full(3, 0.0167)
+    q = q_way + np.array([0.002, -0.002, 0.001])  # its pose 9 mm from the waypoint's
+    servo.ramp(watch, HarvestState.RETURN_HOME, np.zeros(3), q, 10.0)
+    q = servo.transport.way_back(watch, HarvestState.RETURN_HOME, q, (q_way, home), clock.now())
+    np.testing.assert_array_equal(q, home)
+    commanded = [np.array(r["q"]) for r in log.records if r["kind"] == "step"]
+    nearest = min(float(np.max(np.abs(c - q_way))) for c in commanded)
+    assert nearest > 0.0005  # never sent back to the plan's q on the way

@@ -51,10 +51,12 @@ class Transport:
         q: FloatArray,
         q_way: FloatArray,
         deadline: float,
+        near_ends: bool = False,
     ) -> FloatArray:
         """Follow the planned segment ``q`` → ``q_way`` in closed loop on the eye-to-hand
         camera until the end effector is within ``placement_tolerance`` of the model's pose
-        at ``q_way``.
+        at ``q_way``: once the plan's feedforward has reached ``q_way`` or, with
+        ``near_ends`` (a waypoint of the way home), as soon as the arm is there.
 
         Each period the plan's elongations advance by ``home_speed`` (the feedforward of the
         planned q) and the resolver's step, closed on the measured pose towards the model's
@@ -90,7 +92,7 @@ class Transport:
                 continue
             posed = seen.t
             err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
-            if on_plan_end and err <= c.placement_tolerance:
+            if (on_plan_end or near_ends) and err <= c.placement_tolerance:
                 return q
             if on_plan_end and self._handover():
                 # The plan is done and the arm has caught up with it (lag model): what is
@@ -229,7 +231,13 @@ class Transport:
         legs = list(way)
         try:
             while legs:
-                q = self.follow(watch, stage, q, legs[0], start + c.home_timeout)
+                # The way home's waypoints are places to pass: a leg ends once the arm is
+                # at its end (the back-out leaves the arm at the plan's pre-grasp pose, a
+                # few mm of elongation off the plan's q after the loop's corrections), and
+                # the next leg's way from there is checked as every command's is. The
+                # last leg runs to home's q: the open-loop ramp after it is short.
+                deadline = start + c.home_timeout
+                q = self.follow(watch, stage, q, legs[0], deadline, near_ends=len(legs) > 1)
                 legs.pop(0)
         except Fault as fault:
             if fault.reason not in (FaultReason.TIMEOUT, FaultReason.MARKER_LOST):
