@@ -157,3 +157,39 @@ def test_unknown_body_name_names_the_key() -> None:
 
 def test_the_command_line_knows_the_same_bodies() -> None:
     assert _marker_bodies.MARKER_BODIES == MARKER_BODIES
+
+
+def test_the_harvest_takes_a_marker_body_in_the_simulator_only(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from softarm.cli import main
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["harvest", "--sim", "--marker-body", "ball"])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and err.count("\n") == 1 and "--marker-body" in err
+    config = resources.files("softarm.data").joinpath("blackberry.toml")
+    assert main(["harvest", "--config", str(config), "--marker-body", "frustum"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--marker-body" in err and "[calibration]" in err
+    with pytest.raises(ConfigError, match="marker_body must be one of"):
+        build_sim_rig(SimRigOptions(marker_body="ball"))
+
+
+def test_tracking_errors_binned_by_approach_angle() -> None:
+    from softarm.experiments.cube_tracking import ANGLE_BINS, Pose, by_angle
+
+    poses = [
+        Pose(0.1, 35.0, 1.0, True),
+        Pose(0.3, 45.0, 1.0, True),
+        Pose(None, 48.0, 0.5, False),  # not found: counted, not scored
+        Pose(2.0, 65.0, 1.0, False),
+        Pose(9.0, 90.0, 1.0, True),  # the last bin holds its upper edge
+    ]
+    rows = by_angle(poses)
+    assert [r["angle_deg"] for r in rows] == ["0-40", "40-50", "50-60", "60-70", "70-90"]
+    assert len(rows) == len(ANGLE_BINS) - 1
+    assert [(r["poses"], r["found"]) for r in rows] == [(1, 1), (2, 1), (0, 0), (1, 1), (1, 1)]
+    assert rows[1]["median_mm"] == pytest.approx(0.3)
+    assert np.isnan(rows[2]["median_mm"]) and rows[4]["p95_mm"] == pytest.approx(9.0)

@@ -16,7 +16,11 @@ are the least bent marker's pose). ``--side N``
 renders fixed N-pixel
 windows instead (the harvest's window before it was fitted to the cube), for
 comparison on the same poses. ``--look L`` measures it in the daylight row
-(``--world row``) with the look family L.
+(``--world row``) with the look family L. ``--marker-body B`` tracks (and draws) the
+marker body B instead of the paper's cube (:mod:`softarm.vision.marker_body`);
+``--by-angle`` prints the figures by approach angle as well (:data:`ANGLE_BINS`: the
+angle between C1's line of sight and the paper cube's best-facing tag, whichever body
+is drawn), ``--json FILE`` writes them all.
 
 It lives above :mod:`softarm.perception` (which may not import the simulation).
 """
