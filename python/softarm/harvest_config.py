@@ -13,7 +13,12 @@ import numpy as np
 from softarm.errors import ParameterError
 from softarm.geometry import APPROACH_CONE_DEG
 
-__all__ = ["HarvestConfig"]
+__all__ = ["FINE_END_RULES", "HarvestConfig"]
+
+#: How fine positioning decides it has arrived (``HarvestConfig.fine_end_rule``):
+#: "confidence", the measured error's upper confidence bound within ``fine_tolerance``;
+#: "steps", ``settle_steps`` measured errors in a row within it (the rule before).
+FINE_END_RULES = ("confidence", "steps")
 
 
 @dataclass(frozen=True)
@@ -38,7 +43,20 @@ class HarvestConfig:
         grasp_workspace: error (m) the gripper still grasps at (±1 cm, section III-D);
             used only when fine positioning runs out of time or stalls on a joint limit
             (see ``reapproaches``).
-        settle_steps: consecutive steps within tolerance before moving on (noise).
+        settle_steps: consecutive steps within tolerance before moving on (noise); in
+            fine positioning under the "confidence" rule, the fewest measurements an
+            estimate is made from.
+        fine_end_rule: how fine positioning ends (``FINE_END_RULES``): "confidence"
+            once the upper ``fine_confidence`` bound of the grasp error, from
+            the mean and standard error of the last measurements (at least
+            ``settle_steps``, at most ``fine_window``), is within ``fine_tolerance``: a
+            noisy measurement of an arm on the berry ends within a few steps, a biased
+            one does not end; "steps": ``settle_steps`` measured errors in a row within
+            ``fine_tolerance`` (each value alone, however noisy; the default).
+        fine_window: the most measurements (control steps with a new pose or berry fix)
+            the "confidence" rule's estimate is made from (an integer >= 2).
+        fine_confidence: the probability, in (0, 1), with which the true mean error lies
+            under the bound the "confidence" rule compares with ``fine_tolerance``.
         marker_timeout: how long (s) the cube or the berry may stay unseen (beyond the
             locator's own hold of the last target) before MARKER_LOST.
         placement_timeout, fine_timeout, home_timeout: time budgets (s) of the stages.
@@ -91,6 +109,9 @@ class HarvestConfig:
     fine_tolerance: float = 0.0005
     grasp_workspace: float = 0.01
     settle_steps: int = 3
+    fine_end_rule: str = "steps"
+    fine_window: int = 20
+    fine_confidence: float = 0.95
     marker_timeout: float = 1.0
     placement_timeout: float = 30.0
     fine_timeout: float = 20.0
@@ -136,10 +157,22 @@ class HarvestConfig:
             and abs(float(np.linalg.norm(a)) - 1.0) <= 1e-9
         ):
             raise ParameterError(f"approach must be a unit vector (3 numbers), got {a!r}")
-        for name, least in (("settle_steps", 1), ("reapproaches", 0)):
+        for name, least in (("settle_steps", 1), ("reapproaches", 0), ("fine_window", 2)):
             n = getattr(self, name)
             if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < least:
                 raise ParameterError(f"{name} must be an integer >= {least}, got {n!r}")
+        self._check_end_rule()
+
+    def _check_end_rule(self) -> None:
+        """``fine_end_rule`` one of FINE_END_RULES, ``fine_confidence`` in (0, 1)."""
+        if self.fine_end_rule not in FINE_END_RULES:
+            raise ParameterError(
+                f"fine_end_rule must be one of {', '.join(FINE_END_RULES)}, "
+                f"got {self.fine_end_rule!r}"
+            )
+        confidence = _real(self, "fine_confidence")
+        if not 0.0 < confidence < 1.0:
+            raise ParameterError(f"fine_confidence must be in (0, 1), got {confidence!r}")
 
     @property
     def approach_axis(self) -> np.ndarray:

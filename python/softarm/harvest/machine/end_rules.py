@@ -1,12 +1,16 @@
 """How a stage of the loop on the berry ends (:mod:`.berry_loop`): settled within its
-tolerances, past its budget or timeout (:func:`settled_or_out_of_time`), saturated on a
-joint limit without progress (:func:`stalled`), or the marker lost near the berry
-(:func:`lost_near`). Each returns the stage's :class:`StageOutcome`, raises its
+tolerances, past its budget or timeout (:func:`settled_or_out_of_time`; fine positioning
+settles on the measured error's upper confidence bound, :func:`confidently_within`),
+saturated on a joint limit without progress (:func:`stalled`), or the marker lost near
+the berry (:func:`lost_near`). Each returns the stage's :class:`StageOutcome`, raises its
 :class:`Fault`, or (the first) returns None: the loop goes on."""
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
+from scipy import stats
 
 from softarm.harvest.machine.arm_link import ArmLink
 from softarm.harvest.machine.interfaces import FloatArray, Observation
@@ -15,21 +19,31 @@ from softarm.harvest.machine.outcome import Ending, Fault, StageOutcome
 from softarm.harvest.machine.servo_goal import Aim, Progress, ServoGoal
 from softarm.harvest.machine.states import FaultReason, HarvestState
 
-__all__ = ["lost_near", "settled_or_out_of_time", "stalled"]
+__all__ = ["Estimate", "confidently_within", "lost_near", "settled_or_out_of_time", "stalled"]
+
+#: The grasp error estimated from the last ``samples`` measurements: the norm of their
+#: mean offset (m) and its upper confidence bound (m).
+Estimate = tuple[int, float, float]
 
 
 def settled_or_out_of_time(
     link: ArmLink, watch: BerryWatch, stage: HarvestState, seen: Observation, q: FloatArray,
     axis: FloatArray, aim: Aim, goal: ServoGoal, progress: Progress,
 ) -> StageOutcome | None:  # fmt: skip
-    """SETTLED after ``settle_steps`` steps within the tolerances; past the budget,
-    BUDGET inside ``grasp_within`` (else UNREACHABLE); past the timeout, TIMEOUT;
-    else None (the loop goes on)."""
+    """SETTLED within the tolerances (fine positioning under the "confidence"
+    ``fine_end_rule``: the error's upper confidence bound, :func:`confidently_within`;
+    else ``settle_steps`` steps in a row); past the budget, BUDGET inside
+    ``grasp_within`` (else UNREACHABLE); past the timeout, TIMEOUT; else None (the loop
+    goes on)."""
     c = link.cfg
     err, elapsed = aim.error, seen.t - progress.start
-    within = err <= goal.tol and aim.pointing <= np.radians(c.angle_tolerance_deg)
-    progress.inside = progress.inside + 1 if within else 0
-    if progress.inside >= c.settle_steps:
+    pointed = aim.pointing <= np.radians(c.angle_tolerance_deg)
+    progress.inside = progress.inside + 1 if err <= goal.tol and pointed else 0
+    if goal.budget is not None and c.fine_end_rule == "confidence":  # fine positioning
+        settled = _confident(link, seen, aim, goal, progress, pointed)
+    else:
+        settled = progress.inside >= c.settle_steps
+    if settled:
         watch.log_step(stage, seen, q, aim.goal, (err, aim.pointing), False)
         return StageOutcome(q, Ending.SETTLED, axis)
     if goal.budget is not None and elapsed > goal.budget and err <= c.grasp_workspace:
@@ -50,6 +64,77 @@ def settled_or_out_of_time(
             retreat_from=q,
         )
     return None
+
+
+def _confident(
+    link: ArmLink, seen: Observation, aim: Aim, goal: ServoGoal, progress: Progress,
+    pointed: bool,
+) -> bool:  # fmt: skip
+    """This step's measured offset kept in ``progress``; whether the arm is ``pointed``
+    and the estimate from the offsets kept is within ``goal.tol``
+    (:func:`confidently_within`; logged when both are)."""
+    c = link.cfg
+    assert seen.pose is not None  # an aim is measured from a pose
+    # The grasp point's offset from its goal is the tool pose's offset from its goal:
+    # the goal's origin is the grasp point's goal less the offset along the current z.
+    if not progress.measured(seen.pose[:3, 3] - aim.goal[:3, 3], c.fine_window):
+        return False  # the same frames again: the estimate has not changed
+    found = confidently_within(progress.offsets, goal.tol, c.settle_steps, c.fine_confidence)
+    if found is None or not pointed:
+        return False
+    link.log.event("fine_confident", t=seen.t, samples=found[0], error=found[1], bound=found[2])
+    return True
+
+
+def confidently_within(
+    offsets: list[FloatArray], tol: float, fewest: int, confidence: float
+) -> Estimate | None:
+    """The grasp error now, estimated from the last n of ``offsets`` (each a measured
+    offset of the grasp point from its goal, oldest first), whose upper ``confidence``
+    bound is within ``tol``; n from ``fewest`` (at least 2) up to all of them, the
+    shortest first; None when no estimate is.
+
+    Two models of the last n offsets, each fitted by least squares per axis: the arm
+    still (their mean), and the arm still converging (a straight line in the step,
+    evaluated at the last one). An estimate's bound is the norm of its value plus
+    Student's t quantile (two-sided, its residuals' degrees of freedom) times its
+    standard error, sqrt(trace(residual covariance) x its variance factor). Averaging
+    vectors, not norms, keeps noise from biasing the error up (a norm of noise is never
+    0): a noisy measurement of an arm on the berry ends once enough of it is in, a
+    biased one keeps the estimate off the goal and does not end. The line lets an arm
+    converging under little noise (older offsets larger) end as soon as its last
+    offsets are on the berry; the mean gains it from more offsets while the arm sits
+    still under noise.
+    """
+    for n in range(max(2, fewest), len(offsets) + 1):
+        recent = np.asarray(offsets[-n:], dtype=np.float64)
+        steps = np.arange(1 - n, 1, dtype=np.float64)  # 0 at the last offset
+        for columns in (1, 2) if n > 2 else (1,):
+            design = np.column_stack([np.ones(n), steps][:columns])
+            bound = _bound(design, recent, confidence)
+            if bound[1] <= tol:
+                return n, bound[0], bound[1]
+    return None
+
+
+def _bound(design: FloatArray, offsets: FloatArray, confidence: float) -> tuple[float, float]:
+    """The least-squares fit of ``offsets`` (n, 3) on ``design`` (n, p; the first column
+    ones, the last row the step to estimate at): the norm of its value at the last step
+    and that norm's upper ``confidence`` bound."""
+    coef, *_ = np.linalg.lstsq(design, offsets, rcond=None)
+    n, p = design.shape
+    residual = offsets - design @ coef
+    spread = float(np.sum(residual**2)) / (n - p)  # trace of the residual covariance
+    at = design[-1]
+    factor = float(at @ np.linalg.solve(design.T @ design, at))  # 1/n for the mean
+    value = float(np.linalg.norm(at @ coef))
+    return value, value + _t_quantile(confidence, n - p) * float(np.sqrt(spread * factor))
+
+
+@lru_cache(maxsize=256)
+def _t_quantile(confidence: float, dof: int) -> float:
+    """Student's t two-sided ``confidence`` quantile at ``dof`` degrees of freedom."""
+    return float(stats.t.ppf(0.5 + 0.5 * confidence, dof))
 
 
 def stalled(

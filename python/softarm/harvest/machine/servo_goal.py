@@ -4,7 +4,7 @@ how it may end (:class:`ServoGoal`), where the grasp point is against it each st
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -48,13 +48,16 @@ class Aim:
 @dataclass
 class Progress:
     """How a stage has gone: steps in a row within tolerance, the best error and when,
-    since when the resolver has been saturated (None: it is not)."""
+    since when the resolver has been saturated (None: it is not), and the last measured
+    grasp-point offsets from the goal (m, base frame; oldest first) that fine
+    positioning's "confidence" end rule estimates the error from."""
 
     start: float
     inside: int = 0
     best: float = np.inf
     best_t: float = 0.0
     saturated_since: float | None = None
+    offsets: list[FloatArray] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.best_t = self.start
@@ -67,6 +70,16 @@ class Progress:
             self.saturated_since = None
         elif self.saturated_since is None:  # not `or`: a saturation from t = 0.0 is one
             self.saturated_since = t
+
+    def measured(self, offset: FloatArray, window: int) -> bool:
+        """Keep ``offset`` among the last ``window`` offsets; False (nothing kept) when it
+        repeats the last one exactly: the same camera frames read again are no new
+        measurement, and counting them would shrink the standard error for nothing."""
+        if self.offsets and np.array_equal(self.offsets[-1], offset):
+            return False
+        self.offsets.append(np.array(offset, dtype=np.float64))
+        del self.offsets[:-window]
+        return True
 
     def stalled(self, t: float, stall_time: float) -> bool:
         """Saturated, and without progress, for longer than ``stall_time``."""
