@@ -142,16 +142,25 @@ def test_a_cell_pools_its_seeds_and_counts_failures() -> None:
     def row(t: Tally, located: int) -> dict[str, Any]:
         stereo = {"targets": 4, "located": located, "errors_mm": [2.0, 8.0]}
         det = {"tally": asdict(t), "stereo": stereo}
-        canes = {"coverage": 0.5, "precision": 1.0, "median_mm": 2.0, "length_m": 1.0}
+        canes = {"coverage": 0.5, "precision": 1.0, "median_mm": 2.0, "length_m": 1.0, "fits": 2}
         return {"error": None, "fruit_in_view": 10, "ripe_targets": 4,
                 "detectors": {"colour": det}, "canes": canes}  # fmt: skip
 
-    cell = cell_summary([row(a, 2), row(b, 1), {"error": "RuntimeError: x"}], ["colour"])
-    assert cell["frames"] == 2 and cell["failed"] == 1 and cell["ripe_targets"] == 8
+    no_fit = row(b, 1)
+    no_fit["canes"] = {"coverage": 0.0, "precision": 0.0, "median_mm": None, "length_m": 1.0,
+                       "fits": 0}  # fmt: skip
+    rows = [row(a, 2), row(b, 1), no_fit, {"error": "RuntimeError: x"}]
+    rows[0]["detectors"]["colour"]["wrong_ripe_on"] = {"clutter": 1}
+    rows[1]["detectors"]["colour"]["wrong_ripe_on"] = {"clutter": 2, "turning": 1}
+    cell = cell_summary(rows, ["colour"])
+    assert cell["frames"] == 3 and cell["failed"] == 1 and cell["ripe_targets"] == 12
     colour = cell["detectors"]["colour"]
-    assert colour["ripe_precision"] == round(4 / 6, 3) and colour["recall_ripe"] == 0.5
-    assert colour["located"] == round(3 / 8, 3) and colour["stereo_median_mm"] == 5.0
-    assert cell["canes"] == {"coverage": 0.5, "precision": 1.0, "median_mm": 2.0}
+    assert colour["ripe_precision"] == round(5 / 8, 3) and colour["recall_ripe"] == round(5 / 11, 3)
+    assert colour["located"] == round(4 / 12, 3) and colour["stereo_median_mm"] == 5.0
+    assert colour["wrong_ripe_on"] == {"clutter": 3, "turning": 1}
+    # A frame without any cane fit lowers the coverage, not the precision.
+    assert cell["canes"] == {"coverage": round(1 / 3, 3), "precision": 1.0, "median_mm": 2.0,
+                             "frames_without_fit": 1}  # fmt: skip
 
 
 def test_a_failing_trial_is_a_row_with_its_error() -> None:
@@ -181,7 +190,9 @@ def test_one_cell_end_to_end_writes_the_table_and_the_picture(
     assert cell["frames"] == 1 and cell["failed"] == 0
     assert cell["fruit_in_view"] > 0 and cell["ripe_targets"] > 0
     assert set(cell["detectors"]) == {"colour"} and "located" in cell["detectors"]["colour"]
-    assert 0.0 <= cell["canes"]["precision"] <= 1.0
+    canes = cell["canes"]  # at this size C1 may fit no cane: no precision then
+    assert 0.0 <= canes["coverage"] <= 1.0 and canes["frames_without_fit"] in (0, 1)
+    assert (canes["precision"] is None) == (canes["frames_without_fit"] == 1)
     table = (out / "row_robustness.md").read_text()
     assert "| overcast | on | many | sparse |" in table
     png = (out / "row_robustness_map.png").read_bytes()

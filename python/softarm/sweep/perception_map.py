@@ -235,7 +235,8 @@ def _f(value: Any, digits: int = 2) -> str:
 def markdown_table(doc: dict[str, Any]) -> str:
     """The map as Markdown: one row per cell; per detector ripe precision / ripe recall /
     located (share of ripe targets placed by stereo within 10 mm); the colour detector's
-    median stereo error; the cane map's coverage / precision / median distance (mm)."""
+    median stereo error and its wrong ripe calls (on look-alikes / turning fruit / else);
+    the cane map's coverage / precision / median distance (mm)."""
     detectors = doc["spec"]["detectors"]
     head = [
         "look",
@@ -244,7 +245,8 @@ def markdown_table(doc: dict[str, Any]) -> str:
         "fruit",
         "ripe targets",
         *(f"{d}: P / R / loc" for d in detectors),
-        "stereo mm",
+        f"{detectors[0]} stereo mm",
+        f"{detectors[0]} wrong ripe: alike / turning / else",
         "canes: cov / prec / mm",
     ]
     lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
@@ -256,6 +258,8 @@ def markdown_table(doc: dict[str, Any]) -> str:
             for d in detectors
         ]
         first = dets[detectors[0]].get("stereo_median_mm")
+        wrong = dict(dets[detectors[0]].get("wrong_ripe_on", {}))
+        alike, turning = wrong.pop("clutter", 0), wrong.pop("turning", 0)
         canes = c.get("canes")
         cane = (
             "–"
@@ -272,6 +276,7 @@ def markdown_table(doc: dict[str, Any]) -> str:
             str(c["ripe_targets"]),
             *cells,
             _f(first, 1),
+            f"{alike} / {turning} / {sum(wrong.values())}",
             cane,
         ]
         lines.append("| " + " | ".join(row) + " |")

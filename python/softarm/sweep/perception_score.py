@@ -11,6 +11,8 @@ pooling the scores of a cell's seeds (the perception map, :mod:`.perception_map`
   within LOCATED_WITHIN (the harvest's approach starts from there).
 * Canes: :func:`~softarm.perception.cane_metrics.cane_map_error` of the fitted canes
   against every cane drawn (the bush's and the row's) in the arm's workspace.
+* Wrong ripe calls, by what they are: the stage of the fruit they match, else what lies
+  under their centre (``clutter``: a look-alike).
 """
 
 from __future__ import annotations
@@ -96,6 +98,11 @@ def _detector_summary(frames: list[Mapping[str, Any]]) -> dict[str, Any]:
         k: figures[k] for k in ("ripe_precision", "recall_ripe", "precision", "stage_right")
     }
     out = {k: None if v is None else round(v, 3) for k, v in out.items()}
+    wrong: dict[str, int] = {}
+    for f in frames:
+        for what, n in f.get("wrong_ripe_on", {}).items():
+            wrong[what] = wrong.get(what, 0) + n
+    out["wrong_ripe_on"] = dict(sorted(wrong.items()))
     stereo = [f["stereo"] for f in frames if f.get("stereo") is not None]
     if stereo:
         targets = sum(s["targets"] for s in stereo)
@@ -108,14 +115,13 @@ def _detector_summary(frames: list[Mapping[str, Any]]) -> dict[str, Any]:
 def _cane_summary(canes: list[Mapping[str, Any]]) -> dict[str, Any]:
     length = np.array([c["length_m"] for c in canes])
     medians = [c["median_mm"] for c in canes if c["median_mm"] is not None]
+    fitted = [c["precision"] for c in canes if c.get("fits", 1)]  # a frame with no fit has none
+    coverage = np.sum(length * [c["coverage"] for c in canes]) / np.sum(length)
     return {
-        "coverage": round(
-            float(np.sum(length * [c["coverage"] for c in canes]) / np.sum(length)), 3
-        )
-        if np.sum(length) > 0
-        else None,
-        "precision": round(float(np.mean([c["precision"] for c in canes])), 3),
+        "coverage": round(float(coverage), 3) if np.sum(length) > 0 else None,
+        "precision": round(float(np.mean(fitted)), 3) if fitted else None,
         "median_mm": round(float(np.median(medians)), 1) if medians else None,
+        "frames_without_fit": len(canes) - len(fitted),
     }
 
 
@@ -123,7 +129,8 @@ def cell_summary(rows: Sequence[Mapping[str, Any]], detectors: Sequence[str]) ->
     """One cell's figures pooled over its seeds' ``rows`` (trial results; failed ones
     counted, not scored): per detector the pooled tallies' ripe precision, ripe recall,
     precision, stage right and the stereo's located share and median error; the cane
-    map's length-weighted coverage, mean precision and median of the frames' medians."""
+    map's length-weighted coverage, mean precision over the frames with a fit, median of
+    the frames' medians and the frames without any fit."""
     good = [r for r in rows if r.get("error") is None]
     out: dict[str, Any] = {
         "frames": len(good),

@@ -156,8 +156,13 @@ def _detector_counts(
 
     det = detector(name)
     tally = Tally()
-    tally.add(list(det.detect_berries(left.colour, world.stereo.left)), [o for _, o in fruit])
-    out: dict[str, Any] = {"tally": tally_counts(tally), "stereo": None}
+    dets = list(det.detect_berries(left.colour, world.stereo.left))
+    pairs = tally.add(dets, [o for _, o in fruit])
+    out: dict[str, Any] = {
+        "tally": tally_counts(tally),
+        "wrong_ripe_on": _wrong_ripe_on(dets, pairs, fruit, world, left.geoms),
+        "stereo": None,
+    }
     if stereo:
         from softarm.perception.stereo import locate_berries
 
@@ -177,10 +182,38 @@ def _detector_counts(
     return out
 
 
-def _canes(world: Any, left: Any, right: Any) -> dict[str, float | None]:
+def _wrong_ripe_on(
+    dets: list[Any], pairs: dict[int, int], fruit: list[tuple[int, Any]], world: Any, geoms: Any
+) -> dict[str, int]:
+    """The ripe calls that match no ripe fruit, by what they are: the stage of the fruit
+    they match (turning, unripe), else what lies under their centre (a look-alike is
+    ``clutter``; ``berry`` a fruit they overlap too little or one under MIN_PIXELS)."""
+    from softarm.sim.render.labels import KINDS
+
+    out: dict[str, int] = {}
+    h, w = geoms.shape
+    for i, d in enumerate(dets):
+        if d.ripeness != "ripe":
+            continue
+        j = pairs.get(i)
+        if j is not None:
+            what = fruit[j][1].stage
+        else:
+            u, v = (min(max(round(c), 0), n - 1) for c, n in zip(d.center, (w, h), strict=True))
+            g = int(geoms[v, u])
+            what = KINDS[world.labels.kind[g]] if g >= 0 else "background"
+        if what != "ripe":
+            out[what] = out.get(what, 0) + 1
+    return out
+
+
+def _canes(world: Any, left: Any, right: Any) -> dict[str, float | int | None]:
     from softarm.perception.cane_metrics import cane_map_error
     from softarm.perception.canes import fit_canes
 
-    scores = cane_map_error(fit_canes(left.colour, right.colour, world.stereo), world.canes())
+    fits = fit_canes(left.colour, right.colour, world.stereo)
+    scores = cane_map_error(fits, world.canes())
     # A map with no fit has no distances (NaN, inf): None in the JSON.
-    return {k: round(float(v), 4) if np.isfinite(v) else None for k, v in scores.items()}
+    out = {k: round(float(v), 4) if np.isfinite(v) else None for k, v in scores.items()}
+    out["fits"] = len(fits)
+    return out
