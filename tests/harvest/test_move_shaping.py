@@ -185,3 +185,42 @@ def test_the_way_home_passes_a_waypoint_the_arm_is_already_at() -> None:
     commanded = [np.array(r["q"]) for r in log.records if r["kind"] == "step"]
     nearest = min(float(np.max(np.abs(c - q_way))) for c in commanded)
     assert nearest > 0.0005  # never sent back to the plan's q on the way
+
+
+# -- the hand-over of a plan's last leg ----------------------------------------------------
+
+
+class _OffModel(FakeController):
+    """A model 2 cm off the arm along x: the plan's end pose is never measured within
+    ``placement_tolerance`` at the plan's q."""
+
+    def model_pose(self, q: np.ndarray) -> np.ndarray:
+        pose = super().model_pose(q)
+        pose[0, 3] += 0.02
+        return pose
+
+    def follow_step(self, q: np.ndarray, target: np.ndarray, current: np.ndarray):  # type: ignore[no-untyped-def]
+        return np.asarray(q, dtype=np.float64), False  # no correction: the plan alone
+
+
+def _hand_over(tolerance: float) -> tuple[float, float]:
+    """Follow a plan on the lagging plant to its end; when the follow returned (s) and
+    the motion the lag model still had in flight then (m)."""
+    clock, plant, _, actuator = _lagging_rig(lead_gain(TAU, PERIOD, 1.5))
+    log, config = HarvestLog(), HarvestConfig(handover_tolerance=tolerance)
+    servo = Servo(clock, _OffModel(), actuator, config, log)
+    vision = FakeVision(FakeTracker(plant), FakeLocator(dict(BERRIES)))
+    vision.select(BerryTarget(1))
+    watch = BerryWatch(vision, clock, BerryTarget(1), log, config.marker_timeout)
+    q_way = np.array([0.02, 0.015, 0.025])
+    servo.transport.follow(watch, HarvestState.INITIAL_PLACEMENT, np.zeros(3), q_way, 30.0)
+    flight = actuator.in_flight()
+    assert flight is not None
+    return clock.now(), float(np.max(np.abs(flight)))
+
+
+def test_a_plans_end_hands_over_once_the_lag_model_has_the_arm_within_the_tolerance() -> None:
+    late, late_flight = _hand_over(0.001)
+    early, early_flight = _hand_over(0.01)
+    assert late_flight <= 0.001 < early_flight <= 0.01
+    assert early < late - 0.3
