@@ -16,6 +16,7 @@ from, the same three names (:mod:`softarm.perception.cane_source`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
 from softarm.config_table import TomlTable, resolve
@@ -26,15 +27,32 @@ __all__ = [
     "CANE_SOURCES",
     "DETECTORS",
     "STEREO_SOURCES",
+    "BerryMode",
     "PerceptionConfig",
+    "StereoSource",
     "check_perception",
     "parse_perception",
 ]
 
-#: The stereo sources: one side-by-side device, or two devices.
-STEREO_SOURCES = ("zed2", "pair")
-#: How the berries are found: by perception, or by their ArUco tags.
-BERRY_MODES = ("markerless", "tags")
+
+class StereoSource(StrEnum):
+    """C1's stereo source: one side-by-side device (a ZED2), or two devices."""
+
+    ZED2 = "zed2"
+    PAIR = "pair"
+
+
+class BerryMode(StrEnum):
+    """How the berries are found: by perception, or by their ArUco tags."""
+
+    MARKERLESS = "markerless"
+    TAGS = "tags"
+
+
+#: The stereo sources' names.
+STEREO_SOURCES = tuple(s.value for s in StereoSource)
+#: The berry modes' names.
+BERRY_MODES = tuple(m.value for m in BerryMode)
 #: The berry detectors (softarm.perception.detector.choice.DETECTORS, listed here so
 #: that reading a config imports no perception).
 DETECTORS = ("colour", "net", "net+colour")
@@ -50,16 +68,21 @@ class PerceptionConfig:
     ``folder`` is the config
     file's, which paths resolve against."""
 
-    stereo: str = "zed2"
+    stereo: StereoSource = StereoSource.ZED2
     calibration: str = "stereo.yml"
     device: int | str | None = None
     left: int | str | None = None
     right: int | str | None = None
-    berries: str = "markerless"
+    berries: BerryMode = BerryMode.MARKERLESS
     survey: bool = True
     detector: str = "colour"
     canes: str = "colour"
     folder: str | None = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # Names given as strings (Python callers) become the enums the rigs compare.
+        object.__setattr__(self, "stereo", StereoSource(self.stereo))
+        object.__setattr__(self, "berries", BerryMode(self.berries))
 
     @property
     def calibration_path(self) -> str:
@@ -69,7 +92,7 @@ class PerceptionConfig:
     def devices(self) -> tuple[int | str, ...]:
         """The OpenCV sources: (device,) for a ZED2, (left, right) for a pair; a
         relative file name resolved against the config file's folder."""
-        raw = (self.device,) if self.stereo == "zed2" else (self.left, self.right)
+        raw = (self.device,) if self.stereo is StereoSource.ZED2 else (self.left, self.right)
         return tuple(_device(d, self.folder) for d in raw if d is not None)
 
 
@@ -82,20 +105,20 @@ def _device(source: int | str, folder: str | None) -> int | str:
 def parse_perception(t: TomlTable) -> PerceptionConfig:
     """``[perception]`` checked key by key; a key not given takes its default (an empty
     table is the ZED2 on device 0 with ``stereo.yml``, not no table)."""
-    stereo = _choice(t, "stereo", STEREO_SOURCES, "zed2")
+    stereo = StereoSource(_choice(t, "stereo", STEREO_SOURCES, "zed2"))
     calibration = t.get("calibration", "stereo.yml")
     if not isinstance(calibration, str) or not calibration:
         raise t.error("calibration", "must be a path string (a stereo.yml)")
-    wanted = ("device",) if stereo == "zed2" else ("left", "right")
-    unwanted = ("left", "right") if stereo == "zed2" else ("device",)
+    wanted = ("device",) if stereo is StereoSource.ZED2 else ("left", "right")
+    unwanted = ("left", "right") if stereo is StereoSource.ZED2 else ("device",)
     for name in unwanted:
         if name in t.data:
-            raise t.error(name, f"is not a key of stereo = {stereo!r} (it takes {wanted})")
+            raise t.error(name, f"is not a key of stereo = {stereo.value!r} (it takes {wanted})")
     sources = {name: _source(t, name, 0 if name == "device" else None) for name in wanted}
     eyes = [_device(sources[name], t.folder) for name in wanted]
     if len(eyes) == 2 and eyes[0] == eyes[1]:
         raise t.error("right", "must be another device than perception.left (one per eye)")
-    berries = _choice(t, "berries", BERRY_MODES, "markerless")
+    berries = BerryMode(_choice(t, "berries", BERRY_MODES, "markerless"))
     survey = t.get("survey", True)
     if not isinstance(survey, bool):
         raise t.error("survey", "must be true or false")

@@ -11,8 +11,9 @@ from .fakes import FakeGripper, make_rig
 
 
 def test_the_old_names_are_the_hardware_protocols() -> None:
-    assert interfaces.GripperDevice is interfaces.Gripper is protocols.Gripper
-    assert interfaces.RipenessProbe is interfaces.RipenessSensor is protocols.RipenessSensor
+    assert interfaces.Gripper is protocols.Gripper
+    assert interfaces.RipenessSensor is protocols.RipenessSensor
+    assert not hasattr(interfaces, "GripperDevice")  # one name for each device
     assert not hasattr(interfaces, "Camera")  # the camera-name Literal is CameraName
 
 

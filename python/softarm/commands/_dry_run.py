@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from softarm.commands._args import output_dir
 from softarm.errors import ParameterError
+from softarm.sim.world import WorldName
 
 if TYPE_CHECKING:
     from softarm.harvest.records.log import HarvestLog
@@ -58,7 +59,7 @@ def check_dry_run(args: argparse.Namespace) -> None:
     Raises:
         ParameterError: the option and what it needs, named.
     """
-    if args.record_frames is not None and not (args.sim and args.world == "bush"):
+    if args.record_frames is not None and not (args.sim and args.world is WorldName.BUSH):
         raise ParameterError("--record-frames: records the rendered bush (--sim --world bush)")
     if args.dry_run != (args.frames is not None):
         raise ParameterError("--dry-run and --frames DIR: give both (with --config)")

@@ -10,7 +10,9 @@ from typing import TYPE_CHECKING
 
 from softarm.commands._args import add_quiet, float_range, int_range, output_dir, positive_int
 from softarm.commands._looks import LOOKS
+from softarm.commands._worlds import world_metavar, world_type
 from softarm.errors import ParameterError
+from softarm.sim.world import WorldName
 from softarm.stops import stops_on_signals
 
 if TYPE_CHECKING:
@@ -47,7 +49,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="image size and focal length factor (1: C1 1280x720, C2 640x480)",
     )  # fmt: skip
     p.add_argument(
-        "--world", choices=("bush", "row"), default="bush",
+        "--world", type=world_type(WorldName.BUSH, WorldName.ROW),
+        metavar=world_metavar(WorldName.BUSH, WorldName.ROW), default=WorldName.BUSH,
         help="'bush' (default): the rendered bush; 'row': the bush in a hedgerow in daylight, "
         "every frame through a camera model, fruit green, red, turning and ripe "
         "(docs/perception.md, 'The daylight row')",
@@ -60,7 +63,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.set_defaults(run=run)
 
 
-def default_rig(scale: float = 1.0, world: str = "bush", look: str = "random") -> DatasetRig:
+def default_rig(
+    scale: float = 1.0, world: WorldName = WorldName.BUSH, look: str = "random"
+) -> DatasetRig:
     """The simulated harvest's cameras and markers, images scaled by ``scale``; the
     ``world`` and its ``look`` (the row's)."""
     from softarm.harvest.rigs.sim_rig import default_cameras
@@ -83,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
     from softarm.sim.render.preview import write_previews
 
     require_offscreen_gl()  # one line naming the fix, before OUT is created
-    if args.look is not None and args.world != "row":
+    if args.look is not None and args.world is not WorldName.ROW:
         raise ParameterError("--look: for the rendered row (--world row)")
     rig = default_rig(args.scale, args.world, args.look or "random")
     workers = ray_workers(args.images, args.workers)

@@ -6,7 +6,9 @@ import argparse
 
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
 from softarm.commands._plant import add_plant_options, plant_options
+from softarm.commands._worlds import world_metavar, world_type
 from softarm.commands.harvest import MAX_BERRIES
+from softarm.sim.world import WorldName
 from softarm.stops import drives_arm
 
 #: What the demo writes into --out.
@@ -27,7 +29,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the bush and arm")
     p.add_argument(
-        "--world", choices=("tags", "bush"), default="tags",
+        "--world", type=world_type(WorldName.TAGS, WorldName.BUSH),
+        metavar=world_metavar(WorldName.TAGS, WorldName.BUSH), default=WorldName.TAGS,
         help="'tags' (default): tagged berries, mapped canes; 'bush': the markerless "
         "harvest in the rendered bush (render extra), with harvest_c1.png, what C1 saw",
     )  # fmt: skip
@@ -42,8 +45,8 @@ def run(args: argparse.Namespace) -> int:
     from softarm.commands.harvest import check_render, configure_logging, run_sim
 
     options = plant_options(args)  # a bad --plant/--identified fails before any output
-    check_render(args.world == "bush")  # so does a missing renderer
-    if args.world == "bush":
+    check_render(args.world.rendered)  # so does a missing renderer
+    if args.world is WorldName.BUSH:
         from softarm.commands.harvest import BUSH_UNRIPE_FRACTION
 
         options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)

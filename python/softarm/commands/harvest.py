@@ -43,9 +43,11 @@ from softarm.commands._run_info import (
     start_log,
     write_run_bag,
 )
+from softarm.commands._worlds import world_metavar, world_type
 from softarm.errors import ConfigError, HardwareUnavailableError, ParameterError
 from softarm.formatting import plural
 from softarm.harvest_config import HarvestConfig
+from softarm.sim.world import WorldName
 from softarm.stops import drives_arm, records_late_stop, vents_on_stop
 
 if TYPE_CHECKING:
@@ -108,8 +110,25 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="serve the run live to Foxglove on HOST:PORT (alone: 127.0.0.1:8765; "
         "foxglove extra; docs/ros.md)",
     )  # fmt: skip
+    add_world_options(p)
+    add_plant_options(p)
+    add_dry_run_options(p)
     p.add_argument(
-        "--world", choices=("tags", "bush", "row"), default="tags",
+        "--gains",
+        type=config_file,
+        help="resolver gains: a TOML [gains] table of softarm.Gains keywords (`softarm tune` "
+        "writes one); over the defaults with --sim, over the config's [gains] on hardware",
+    )
+    add_quiet(p)
+    p.set_defaults(run=run)
+
+
+def add_world_options(p: argparse.ArgumentParser) -> None:
+    """The simulated world and what perceives it: ``--world``, ``--look``, ``--survey``,
+    ``--detector``, ``--cane-source``, ``--marker-body``."""
+    p.add_argument(
+        "--world", type=world_type(*WorldName), metavar=world_metavar(*WorldName),
+        default=WorldName.TAGS,
         help="--sim: 'tags', berries tagged and canes mapped (fast); 'bush', the rendered "
         "bush, berries and canes found by the cameras (render extra, MUJOCO_GL=egl); "
         "'row', the same bush inside a hedgerow in daylight (--look); "
@@ -141,22 +160,10 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="--sim: the marker body on the gripper that C1 tracks (default cube; "
         "docs/hardware.md, 'The marker body'); on the arm, [calibration] marker_body",
     )  # fmt: skip
-    add_plant_options(p)
-    add_dry_run_options(p)
-    p.add_argument(
-        "--gains",
-        type=config_file,
-        help="resolver gains: a TOML [gains] table of softarm.Gains keywords (`softarm tune` "
-        "writes one); over the defaults with --sim, over the config's [gains] on hardware",
-    )
-    add_quiet(p)
-    p.set_defaults(run=run)
 
 
 #: The share of unripe fruit on a rendered bush (``--world bush`` or ``row``).
 BUSH_UNRIPE_FRACTION = 0.3
-#: The worlds the renderer draws.
-RENDERED = ("bush", "row")
 
 
 @drives_arm("harvest")
@@ -172,19 +179,19 @@ def run(args: argparse.Namespace) -> int:
         print("softarm harvest: error: --view/--record: work with --sim only", file=sys.stderr)
         return 2
     check_dry_run(args)
-    check_render(args.sim and args.world in RENDERED)
-    if args.survey is not None and not (args.sim and args.world in RENDERED):
+    check_render(args.sim and args.world.rendered)
+    if args.survey is not None and not (args.sim and args.world.rendered):
         raise ParameterError(
             "--survey/--no-survey: for the rendered bush (--sim --world bush or row); "
             "on the arm, [perception] survey"
         )
-    if args.look is not None and not (args.sim and args.world == "row"):
+    if args.look is not None and not (args.sim and args.world is WorldName.ROW):
         raise ParameterError("--look: for the rendered row (--sim --world row)")
-    if args.detector is not None and not (args.sim and args.world != "tags"):
+    if args.detector is not None and not (args.sim and args.world.rendered):
         raise ParameterError(
             "--detector: for the rendered worlds; on the arm, [perception] detector"
         )
-    if args.cane_source is not None and not (args.sim and args.world != "tags"):
+    if args.cane_source is not None and not (args.sim and args.world.rendered):
         raise ParameterError(
             "--cane-source: for the rendered worlds; on the arm, [perception] canes"
         )
@@ -200,12 +207,12 @@ def run(args: argparse.Namespace) -> int:
     if args.sim:
         args.seed = 0 if args.seed is None else args.seed
         options.update(marker_body=args.marker_body or "cube")
-        if args.world in RENDERED:
+        if args.world.rendered:
             options.update(world=args.world, unripe_fraction=BUSH_UNRIPE_FRACTION)
             options.update(survey=args.survey is not False, record_frames=args.record_frames)
             options.update(detector=args.detector or "colour")
             options.update(cane_source=args.cane_source or "colour")
-        if args.world == "row":
+        if args.world is WorldName.ROW:
             options.update(look=args.look)
         return run_sim(
             args.berries, args.seed, args.log, args.report, args.plot, args.quiet,

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from softarm.perception.cane_metrics import cane_map_error
+from softarm.sim.world import WorldName
 
 __all__ = ["summarise"]
 
@@ -169,7 +170,7 @@ def main(argv: list[str]) -> None:
     for name in argv:
         folder = Path(name)
         reports = _reports(folder)
-        bush = all(r.get("world") == "bush" for r in reports)
+        bush = all(r.get("world") == WorldName.BUSH for r in reports)
         figures: dict[str, float] = summarise(reports) if bush else {"bushes": len(reports)}
         if (folder / "wall_times.txt").exists():
             figures["wall_s_per_berry"] = wall_per_berry(folder)

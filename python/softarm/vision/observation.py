@@ -1,5 +1,6 @@
 """What the two-camera vision reports (section III-D, fig. 4): the berry looked for, its
-position fix and where it came from, and one observation of a control period.
+position fix and where it came from, one observation of a control period, and the
+protocol of a vision that gives them (:class:`Vision`).
 
 Defined in the vision layer so that vision and identification use them without the
 harvest; :mod:`softarm.harvest.machine.interfaces` re-exports them.
@@ -8,11 +9,11 @@ harvest; :mod:`softarm.harvest.machine.interfaces` re-exports them.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol
 
 from softarm.checks import FloatArray
 
-__all__ = ["BerryFix", "BerryTarget", "CameraName", "Observation"]
+__all__ = ["BerryFix", "BerryTarget", "CameraName", "Observation", "Vision"]
 
 #: Which camera the berry position came from; ``held`` = the most recent one, kept while
 #: the berry is hidden (section III-D). (A name, not a device: the device protocol is
@@ -48,3 +49,19 @@ class Observation:
     t: float
     pose: FloatArray | None
     fix: BerryFix | None
+
+
+class Vision(Protocol):
+    """Both cameras: eye-to-hand tracking of the end-effector cube (eq. 22), and the berry
+    from eye-to-hand far away, eye-in-hand (eq. 21) within the 6 cm hand-over distance,
+    the most recent fix held while the berry is hidden, up to an age limit (section
+    III-D, fig. 4). How long the harvest tolerates a lost marker is not the vision's
+    business (:class:`softarm.harvest.machine.observe.BerryWatch` owns that)."""
+
+    def select(self, berry: BerryTarget) -> None:
+        """Track ``berry`` from now on, forgetting any held fix."""
+        ...
+
+    def observe(self, time: float) -> Observation:
+        """The end-effector pose and the berry at ``time``."""
+        ...

@@ -128,6 +128,12 @@ class CameraVision:
         T_c1_ee, _ = self._view_c1(time)
         return None if T_c1_ee is None else self.T_base_c1 @ T_c1_ee
 
+    def place_from_view(self, image: Any, T_base_c2: FloatArray) -> None:
+        """Place fruit C1 found but could not place, from C2's ``image`` taken at
+        ``T_base_c2`` (the cane survey's views). Nothing here: the tags' vision keeps no
+        map; the markerless vision (:class:`softarm.perception.bush_vision.BushVision`)
+        places its map's unplaced fruit."""
+
     def view_c2(self, time: float) -> tuple[Any, FloatArray] | None:
         """C2's frame at ``time`` and C2's pose in the base frame, from the cube in C1's
         frame and the hand-eye calibration (eq. 21, 22); None without either, or when

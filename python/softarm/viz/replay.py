@@ -12,6 +12,7 @@ import numpy as np
 from softarm.errors import InputError
 from softarm.harvest.records.header import find_header
 from softarm.harvest.records.log import read_log
+from softarm.sim.bush import Bush
 from softarm.viz.bag.scene import RunScene
 from softarm.viz.layout import harvest_blueprint
 from softarm.viz.records import RecordLogger
@@ -86,12 +87,12 @@ def _header_scene(path: Path, records: list[Any]) -> RunScene:
         raise type(exc)(f"{path}: {exc}") from None
 
 
-def _bush(path: Path, records: list[Any], seed: int, berries: int) -> Any:
+def _bush(path: Path, records: list[Any], seed: int, berries: int) -> Bush:
     """The bush of ``harvest --sim --seed seed --berries berries``, checked against the
     berries the log estimated (a log of another run would draw a wrong scene)."""
-    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_rig import SimRigOptions, sim_bush
 
-    bush = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed)).bush
+    bush = sim_bush(SimRigOptions(n_berries=berries, seed=seed))
     true = {b.tag_id: np.asarray(b.position) for b in bush.berries}
     for r in records:
         if not isinstance(r, dict) or r.get("kind") != "berry_result" or r.get("target") is None:

@@ -6,11 +6,11 @@ provide these few objects.
 
 The devices have one vocabulary, :mod:`softarm.hardware.protocols` (``PressureBank``,
 ``Gripper``, ``RipenessSensor``, ``Camera``); the machine takes a ``Gripper`` and a
-``RipenessSensor`` from there. ``GripperDevice`` and ``RipenessProbe`` are their old names
-here, kept as aliases so that existing imports keep working. What is defined here is what
+``RipenessSensor`` from there. What is defined here is what
 the harvest loop adds on top of the devices: the estimates, the controller, the clock.
-The vision's vocabulary (``BerryTarget``, ``BerryFix``, ``Observation``) is defined in
-:mod:`softarm.vision.observation` and re-exported here.
+The vision's vocabulary (``BerryTarget``, ``BerryFix``, ``Observation``, ``Vision``) is
+defined in :mod:`softarm.vision.observation`, the simulation's ``GroundTruth`` in
+:mod:`softarm.sim.world`; both are gathered here with the machine's own protocols.
 """
 
 from __future__ import annotations
@@ -21,7 +21,8 @@ from typing import Protocol
 from softarm.checks import FloatArray as FloatArray  # re-exported (machine, observe, servo)
 from softarm.errors import CapabilityError
 from softarm.hardware.protocols import Gripper, RipenessSensor
-from softarm.vision.observation import BerryFix, BerryTarget, CameraName, Observation
+from softarm.sim.world import GroundTruth
+from softarm.vision.observation import BerryFix, BerryTarget, CameraName, Observation, Vision
 
 __all__ = [
     "CONTROLLER_METHODS",
@@ -31,12 +32,10 @@ __all__ = [
     "Clock",
     "Controller",
     "Gripper",
-    "GripperDevice",
     "GroundTruth",
     "Observation",
     "PlacementPlanner",
     "PressureActuator",
-    "RipenessProbe",
     "RipenessSensor",
     "Vision",
     "require_controller",
@@ -53,22 +52,6 @@ class Clock(Protocol):
 
     def sleep(self, dt: float) -> None:
         """Let ``dt`` seconds pass."""
-        ...
-
-
-class Vision(Protocol):
-    """Both cameras: eye-to-hand tracking of the end-effector cube (eq. 22), and the berry
-    from eye-to-hand far away, eye-in-hand (eq. 21) within the 6 cm hand-over distance,
-    the most recent fix held while the berry is hidden, up to an age limit (section
-    III-D, fig. 4). How long the harvest tolerates a lost marker is not the vision's
-    business (:class:`softarm.harvest.machine.observe.BerryWatch` owns that)."""
-
-    def select(self, berry: BerryTarget) -> None:
-        """Track ``berry`` from now on, forgetting any held fix."""
-        ...
-
-    def observe(self, time: float) -> Observation:
-        """The end-effector pose and the berry at ``time``."""
         ...
 
 
@@ -165,17 +148,4 @@ class PressureActuator(Protocol):
     def in_flight(self) -> FloatArray | None:
         """The motion (m) the arm will still make towards the last q sent, by a lag model
         of the actuators; None when there is none (the arm is taken to be there)."""
-        ...
-
-
-#: Old names of the device protocols of :mod:`softarm.hardware.protocols`.
-GripperDevice = Gripper
-RipenessProbe = RipenessSensor
-
-
-class GroundTruth(Protocol):
-    """Simulation only: true errors, to report what vision cannot see."""
-
-    def grasp_errors(self, berry: BerryTarget, axis: FloatArray) -> tuple[float, float]:
-        """True (grasp point to ``berry`` in m, gripper axis to ``axis`` in rad) now."""
         ...

@@ -1,4 +1,4 @@
-"""The markerless harvest in the rendered bush (``--world bush``): the cameras are the
+"""The markerless harvest in the rendered worlds (``--world bush`` and ``row``): the cameras are the
 rendered C1 stereo pair and C2, the berries to pick come from the bush map (ripe ones
 found in C1 without tags), and the canes given to the planner, the resolver and the
 clearance checks are the ones fitted from C1. The true bush serves only the ground
@@ -7,7 +7,7 @@ truth: the gripper's catch, the contacts, and the report's errors.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -15,22 +15,29 @@ import numpy as np
 from softarm._core import PolynomialCurve
 from softarm.checks import FloatArray
 from softarm.errors import ParameterError
+from softarm.harvest.control.stack import ControlStack
+from softarm.harvest.machine.harvest_machine import HarvestMachine
 from softarm.harvest.machine.interfaces import BerryTarget
 from softarm.harvest.machine.states import FAULTS_THAT_STOP
 from softarm.harvest.records.report import BerryResult, HarvestReport
 from softarm.harvest.rigs.sim_devices import SimGripper
+from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.harvest.runs.map_run import harvest_map
+from softarm.harvest.runs.policy import finish_run
 from softarm.perception.bush_map import BushMap, MappedBerry
+from softarm.perception.bush_vision import BushVision
 from softarm.perception.c1 import Pair, StereoC1
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.overlay import draw_bush_map
+from softarm.perception.self_filter import CANE_REACH
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.plant import ArmPlant
 from softarm.sim.render.world import RenderedBush, arm_sections, polyline_sections
+from softarm.sim.world import WorldName
 from softarm.vision.poses import invert
 from softarm.vision.stereo_camera import StereoCamera
 
-__all__ = ["BushGripper", "BushScene", "draw_arm", "harvest_bush"]
+__all__ = ["BushGripper", "BushScene", "RenderedWorld", "draw_arm", "harvest_bush"]
 
 #: A mapped berry is the true berry nearest it within this distance (m), for the
 #: ground truth only.
@@ -187,7 +194,6 @@ class BushGripper(SimGripper):
 def harvest_bush(
     scene: BushScene,
     run_berry: Callable[[BerryTarget], BerryResult],
-    delivered: list[int],
     on_berry: Callable[[int, BerryResult], None] | None = None,
     on_look: Callable[[], None] | None = None,
 ) -> HarvestReport:
@@ -217,17 +223,16 @@ def harvest_bush(
         scene.look, scene.bush_map, run_berry, rounds, judged, stop_on=FAULTS_THAT_STOP,
         on_look=on_look,
     )  # fmt: skip
-    report.extra.update(_bush_extra(scene, delivered))
     return report
 
 
-def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
+def _bush_extra(scene: BushScene, delivered: list[int], name: WorldName) -> dict[str, object]:
     ripe = [b for b in scene.bush.berries if b.ripeness >= 0.5]
     picked = {b.tag_id: b for b in scene.bush.berries if b.tag_id in delivered}
     mapped = {t.tag_id for e in scene.bush_map.berries if (t := scene.truth_of(e.id)) is not None}
     unmapped = [b.tag_id for b in ripe if b.tag_id not in mapped]
     return {
-        "world": "bush" if scene.world.row is None else "row",
+        "world": name.value,
         "ripe_in_reach": len(ripe),
         "ripe_harvested": sum(b.ripeness >= 0.5 for b in picked.values()),
         "unripe_picked": sum(b.ripeness < 0.5 for b in picked.values()),
@@ -240,3 +245,57 @@ def _bush_extra(scene: BushScene, delivered: list[int]) -> dict[str, object]:
             if k in ("median_mm", "p95_mm", "coverage", "precision", "length_m")
         },
     }
+
+
+@dataclass
+class RenderedWorld:
+    """The :class:`~softarm.sim.world.World` the renderer draws (the bush, or the bush in
+    the daylight row): the markerless vision, the gripper closing on the true berry a
+    map entry stands for, the canes fitted from C1."""
+
+    name: WorldName
+    scene: BushScene
+    vision: BushVision
+    gripper: BushGripper
+    canes: list[PolynomialCurve]
+    #: Whether C2 surveys the canes C1 fitted before the first berry.
+    surveyed: bool = True
+
+    def survey(
+        self, machine: HarvestMachine, stack: ControlStack, parts: FloatArray
+    ) -> CaneSurvey | None:
+        """C2's survey of the canes C1 fitted (the rig's own ``parts`` left out), as the
+        hardware flies it; None with the survey off."""
+        if not self.surveyed:
+            return None
+        c1 = self.scene.stereo_c1()
+        return CaneSurvey(machine, stack, c1, self.vision, parts, CANE_REACH)
+
+    def known_canes(self) -> Sequence[PolynomialCurve]:
+        """The canes fitted from C1 (and the survey's refit, which goes to the stack)."""
+        return self.canes
+
+    def truth_of(self, berry_id: int) -> Berry | None:
+        """The true berry the map entry ``berry_id`` stands for (:meth:`BushScene.truth_of`)."""
+        return self.scene.truth_of(berry_id)
+
+    def report_extra(self) -> dict[str, object]:
+        """The world's ripe and unripe counts, what the map never placed, the cane map's
+        error against the true canes."""
+        return _bush_extra(self.scene, self.gripper.delivered, self.name)
+
+    def close(self) -> None:
+        """Free the renderer's OpenGL contexts."""
+        self.scene.world.close()
+
+    def harvest(
+        self, machine: HarvestMachine, on_berry: Callable[[int, BerryResult], None] | None
+    ) -> HarvestReport:
+        """The map's ripe berries, by the loop the arm runs (:func:`harvest_bush`), the
+        map logged after each look; the run finished by the run policy."""
+        scene = self.scene
+        report = harvest_bush(
+            scene, machine.run_berry, on_berry, on_look=lambda: machine.log_map(scene.bush_map)
+        )
+        report.extra.update(self.report_extra())
+        return finish_run(report, machine.log)

@@ -37,7 +37,7 @@ from softarm.harvest.records.report import BerryResult
 from softarm.harvest.rigs.bush_world import BushScene
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
-from softarm.perception_config import PerceptionConfig
+from softarm.perception_config import PerceptionConfig, StereoSource
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.poses import invert
 from softarm.vision.stereo_camera import StereoCamera
@@ -154,7 +154,9 @@ class RigDescription:
             calibration,
             plant_model=_plant_model(self.plant),
             harvest=self.harvest,
-            perception=PerceptionConfig("pair", "stereo.yml", left=0, right=2, survey=self.survey),
+            perception=PerceptionConfig(
+                StereoSource.PAIR, "stereo.yml", left=0, right=2, survey=self.survey
+            ),
         )
 
 

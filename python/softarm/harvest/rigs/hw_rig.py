@@ -43,6 +43,7 @@ from softarm.perception.c1 import StereoC1
 from softarm.perception.cane_source import use_cane_source
 from softarm.perception.detector.choice import use_detector
 from softarm.perception.self_filter import CANE_REACH, rig_parts
+from softarm.perception_config import BerryMode
 from softarm.vision.camera_model import camera_from_config
 from softarm.vision.marker_body import marker_body
 from softarm.vision.poses import invert
@@ -143,7 +144,7 @@ def build_hardware_rig(
             ArduinoRipenessSensor(link), inputs.model.n_actuators, cfg, log,
             planner=control.planner,
         )  # fmt: skip
-        markerless = isinstance(vision, BushVision)
+        markerless = _markerless(config, c1)
         survey = None
         if c1 is not None and parts is not None and config.perception is not None:
             if config.perception.survey:
@@ -223,7 +224,13 @@ def _vision(
         invert(np.array(cal.T_C1_base)), invert(np.array(cal.T_C2_EE)),
         np.array(cal.T_EE_cube), body, cal.berry_tag, cfg.grasp_offset,
     )  # fmt: skip
-    perception = config.perception
-    if c1 is not None and perception is not None and perception.berries == "markerless":
+    if c1 is not None and _markerless(config, c1):
         return BushVision(*args, bush_map=c1.bush_map)
     return CameraVision(*args)
+
+
+def _markerless(config: Config, c1: StereoC1 | None) -> bool:
+    """Whether the berries come from C1's map (``[perception] berries = "markerless"``
+    with a stereo source), not from their tags."""
+    perception = config.perception
+    return c1 is not None and perception is not None and perception.berries is BerryMode.MARKERLESS

@@ -10,7 +10,7 @@ from typing import Any
 from softarm.checks import FloatArray
 from softarm.errors import ConfigError
 from softarm.perception.c1 import Pair
-from softarm.perception_config import PerceptionConfig
+from softarm.perception_config import PerceptionConfig, StereoSource
 from softarm.vision.stereo_calibration import split_side_by_side
 from softarm.vision.stereo_camera import StereoCamera
 from softarm.vision.stereo_files import read_stereo
@@ -39,7 +39,7 @@ def open_stereo(
     for device in perception.devices():
         cams.append(open_camera(device))
         stack.callback(cams[-1].close)
-    if perception.stereo == "zed2":
+    if perception.stereo is StereoSource.ZED2:
         return lambda: _halves(cams[0].read())
     return lambda: (cams[0].read(), cams[1].read())
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -23,14 +23,14 @@ from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.hardware.pressure_map import ElongationMap
 from softarm.harvest.control.actuator import PressureMap
 from softarm.harvest.control.clearance import Clearance
-from softarm.harvest.control.stack import ControlInputs, build_control_stack
+from softarm.harvest.control.stack import ControlInputs, ControlStack, build_control_stack
 from softarm.harvest.machine.harvest_machine import HarvestMachine
-from softarm.harvest.machine.interfaces import BerryTarget, Controller
+from softarm.harvest.machine.interfaces import Controller
 from softarm.harvest.records.frame_files import FrameRecorder
 from softarm.harvest.records.log import HarvestLog
 from softarm.harvest.records.rate import rate_record
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.bush_world import BushGripper, BushScene, harvest_bush
+from softarm.harvest.rigs.bush_world import BushGripper, BushScene, RenderedWorld
 from softarm.harvest.rigs.dry_run import (
     BERRY_STATES,
     COMMANDS,
@@ -41,8 +41,8 @@ from softarm.harvest.rigs.dry_run import (
     write_rig_files,
 )
 from softarm.harvest.rigs.sim_devices import ArmWatch, SimClock, SimGripper
+from softarm.harvest.rigs.tag_world import TagWorld
 from softarm.harvest.runs.cane_survey import CaneSurvey
-from softarm.harvest.runs.policy import finish_run, run_targets
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception.bush_map import BushMap
@@ -56,12 +56,22 @@ from softarm.sim.plant import ArmPlant
 from softarm.sim.render.row_look import RowLook
 from softarm.sim.render.world import world_for
 from softarm.sim.rig_cameras import BASE_TAG_ID, SimCameras, look_at, sim_vision
+from softarm.sim.world import World, WorldName
 from softarm.units import MAX_PSI, METRES_PER_PSI
 from softarm.vision.marker_body import check_marker_body, marker_body
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision, register_c1
 
-__all__ = ["SimRig", "SimRigOptions", "build_sim_rig", "control_inputs", "default_cameras"]
+__all__ = [
+    "WORLDS",
+    "HarvestWorld",
+    "SimRig",
+    "SimRigOptions",
+    "build_sim_rig",
+    "control_inputs",
+    "default_cameras",
+    "sim_bush",
+]
 
 
 @dataclass
@@ -101,7 +111,7 @@ class SimRigOptions:
     #: controller sweeps); "bush": the rendered bush, berries and canes found by
     #: perception (softarm.perception), the markerless harvest; "row": the same in
     #: the daylight row around the bush (softarm.sim.render.row).
-    world: str = "tags"
+    world: WorldName = WorldName.TAGS
     #: ``world = "row"``: the daylight family (softarm.sim.render.row_look.LOOKS; None:
     #: "random", one of them drawn from the seed).
     look: str | None = None
@@ -124,6 +134,9 @@ class SimRigOptions:
     #: The gripper's marker body C1 tracks (softarm.vision.marker_body.MARKER_BODIES;
     #: ``--marker-body``), drawn in every world; hw.toml's ``[calibration] marker_body``.
     marker_body: str = "cube"
+
+    def __post_init__(self) -> None:
+        self.world = WorldName.parse(self.world)  # a name given as a string, checked
 
 
 def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
@@ -152,6 +165,35 @@ def default_cameras(scale: float = 1.0, noise_std: float = 2.0) -> SimCameras:
     )
 
 
+class HarvestWorld(World, Protocol):
+    """A :class:`~softarm.sim.world.World` the simulated rig harvests: its berry source
+    run by the run policy (:class:`~softarm.harvest.rigs.tag_world.TagWorld`,
+    :class:`~softarm.harvest.rigs.bush_world.RenderedWorld`)."""
+
+    def harvest(
+        self, machine: HarvestMachine, on_berry: Callable[[int, BerryResult], None] | None
+    ) -> HarvestReport:
+        """The world's berries through ``machine``; the run finished by the policy."""
+        ...
+
+    @property
+    def vision(self) -> CameraVision:
+        """The world's two cameras: the synthetic ones, or the rendered world's."""
+        ...
+
+    @property
+    def gripper(self) -> SimGripper:
+        """The simulated gripper, closing on the world's true berries."""
+        ...
+
+    def survey(
+        self, machine: HarvestMachine, stack: ControlStack, parts: FloatArray
+    ) -> CaneSurvey | None:
+        """C2's survey of the canes the world's C1 fitted (the rig's own ``parts`` left
+        out), or None where the canes are mapped or the survey is off."""
+        ...
+
+
 @dataclass
 class SimRig:
     """Everything wired (see :func:`build_sim_rig`)."""
@@ -161,53 +203,50 @@ class SimRig:
     plant: ArmPlant
     clock: SimClock
     bank: SafePressureBank
-    vision: CameraVision
-    gripper: SimGripper
+    world: HarvestWorld
     watch: ArmWatch
     machine: HarvestMachine
-    #: The rendered bush and its map (``world = "bush"``), None in the tag world.
-    scene: BushScene | None = None
     #: What ``record_frames`` records into, None without it.
     recorder: FrameRecorder | None = None
-    #: C2's survey of the canes (``world = "bush"`` with ``survey``), flown first.
+    #: C2's survey of the canes (the rendered worlds with ``survey``), flown first.
     survey: CaneSurvey | None = None
 
-    def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
-        """Harvest every berry of the bush by the run policy both rigs follow
-        (:mod:`softarm.harvest.runs.policy`); ``on_berry(i, result)`` after each attempt.
-        The report keeps each berry's last attempt."""
-        if self.scene is not None:
-            try:
-                return self._finish(self._harvest_bush(on_berry))
-            except BaseException:
-                if self.recorder is not None:  # an unfinished recording is not left behind
-                    self.recorder.discard()
-                raise
-        targets = [BerryTarget(b.tag_id) for b in self.bush.berries]
-        return self._finish(
-            run_targets(self.machine.run_berry, targets, self.machine.log, on_berry)
-        )
+    @property
+    def vision(self) -> CameraVision:
+        """The world's cameras as the harvest sees them."""
+        return self.world.vision
 
-    def _harvest_bush(self, on_berry: Callable[[int, BerryResult], None] | None) -> HarvestReport:
-        """The markerless harvest of the rendered bush, the survey first."""
-        assert self.scene is not None
-        scene = self.scene
-        if self.survey is not None:
-            self.survey.run()
-        report = harvest_bush(
-            scene, self.machine.run_berry, self.gripper.delivered, on_berry,
-            on_look=lambda: self.machine.log_map(scene.bush_map),
-        )  # fmt: skip
-        return finish_run(report, self.machine.log)
+    @property
+    def gripper(self) -> SimGripper:
+        """The world's gripper (device, ripeness sensor, ground truth)."""
+        return self.world.gripper
+
+    @property
+    def scene(self) -> BushScene | None:
+        """The rendered world's scene and map (C1's picture), None in the tag world."""
+        return getattr(self.world, "scene", None)
+
+    def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
+        """Harvest the world's berries by the run policy both rigs follow
+        (:mod:`softarm.harvest.runs.policy`), the survey first where there is one;
+        ``on_berry(i, result)`` after each attempt. The report keeps each berry's last
+        attempt."""
+        try:
+            if self.survey is not None:
+                self.survey.run()
+            return self._finish(self.world.harvest(self.machine, on_berry))
+        except BaseException:
+            if self.recorder is not None:  # an unfinished recording is not left behind
+                self.recorder.discard()
+            raise
 
     def close(self) -> None:
-        """Free the rendered bush's OpenGL contexts (if any) now, rather than in
-        finalizers at exit, where a stop signal would be lost, and drop a recording the
-        run did not finish. Harmless twice."""
+        """Free the world's renderer contexts (if any) now, rather than in finalizers at
+        exit, where a stop signal would be lost, and drop a recording the run did not
+        finish. Harmless twice."""
         if self.recorder is not None:
             self.recorder.discard()
-        if self.scene is not None:
-            self.scene.world.close()
+        self.world.close()
 
     def _finish(self, report: HarvestReport) -> HarvestReport:
         report.extra.update(
@@ -251,37 +290,31 @@ def _build_sim_rig(
     cams = default_cameras(o.scale, o.noise_std)
     cams.marker_body = check_marker_body(o.marker_body)
     bush = _bush(o, plant, cams)
-    on_bush = list(bush.berries)
     canes = [b.curve() for b in bush.branches]  # the truth: contacts are scored on it
     watch = _watch(o, plant, canes)
     clock = SimClock([plant.advance, watch.sample])
     bank = _bank(plant, clock, recorder)
-    vision: CameraVision
-    gripper: SimGripper
-    if o.world in RENDERED:
-        parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
-        scene, vision, gripper, canes = _bush_world(
-            o, bush, plant, model, cams, parts, clock, recorder
-        )
-    else:
-        scene = None
-        vision = sim_vision(
-            cams, plant.pose, lambda: on_bush, cfg.grasp_offset, seed=o.seed, hidden=o.hidden
-        )
-        gripper = SimGripper(plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
-    stack = build_control_stack(cfg, control_inputs(o, model), canes, bank, clock.now)
+    parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
+    world = WORLDS[o.world](WorldParts(o, bush, canes, plant, model, cams, parts, clock, recorder))
+    stack = build_control_stack(
+        cfg, control_inputs(o, model), list(world.known_canes()), bank, clock.now
+    )
+    gripper = world.gripper
     sensor = gripper if recorder is None else RecordedSensor(gripper, recorder)
     machine = HarvestMachine(
-        clock, vision, controller or stack.controller, stack.actuator, gripper, sensor,
+        clock, world.vision, controller or stack.controller, stack.actuator, gripper, sensor,
         n_actuators=model.n_actuators, config=cfg, log=HarvestLog(o.log_path),
         ground_truth=gripper, planner=stack.planner,
     )  # fmt: skip
-    survey = None
-    if scene is not None and o.survey:
-        survey = CaneSurvey(machine, stack, scene.stereo_c1(), vision, parts, CANE_REACH)
-    return SimRig(
-        bush, model, plant, clock, bank, vision, gripper, watch, machine, scene, recorder, survey
-    )
+    survey = world.survey(machine, stack, parts)
+    return SimRig(bush, model, plant, clock, bank, world, watch, machine, recorder, survey)
+
+
+def sim_bush(options: SimRigOptions) -> Bush:
+    """The bush :func:`build_sim_rig` harvests for ``options``, without the rig: the same
+    seed draws the same plant and bush (a replay's scene needs no cameras or renderer)."""
+    plant = _plant(options, softarm.SoftArm.blackberry())
+    return _bush(options, plant, default_cameras(options.scale, options.noise_std))
 
 
 def control_inputs(o: SimRigOptions, model: softarm.SoftArm) -> ControlInputs:
@@ -326,9 +359,7 @@ def _pressure_map(o: SimRigOptions) -> PressureMap:
 def _bush(o: SimRigOptions, plant: ArmPlant, cams: SimCameras) -> Bush:
     """The bush of ``o``'s seed, in the true actuators' reach: 0-70 psi (or less if the
     regulators saturate lower) through each one's true elongation per psi."""
-    if o.world not in ("tags", *RENDERED):
-        raise ParameterError(f"world = {o.world!r}: must be 'tags', 'bush' or 'row'")
-    if o.look is not None and o.world != "row":
+    if o.look is not None and o.world is not WorldName.ROW:
         raise ParameterError(f"look = {o.look!r}: for the rendered row (world = 'row')")
     true_upper = min(MAX_PSI, o.plant.max_psi) * plant.sim.metres_per_psi
     return Bush.generate(
@@ -342,7 +373,7 @@ def _recorder(o: SimRigOptions) -> FrameRecorder | None:
     """The recorder of ``--record-frames`` (the rendered bush only)."""
     if o.record_frames is None:
         return None
-    if o.world not in RENDERED:
+    if not o.world.rendered:
         raise ParameterError(
             "record_frames: records the rendered worlds (world = 'bush' or 'row') only"
         )
@@ -385,50 +416,75 @@ def _watch(o: SimRigOptions, plant: ArmPlant, canes: list[softarm.PolynomialCurv
     return ArmWatch(plant, Clearance(plant.arm, canes, o.config.grasp_offset))
 
 
-#: The worlds drawn by the renderer: the bush, and the bush in the daylight row.
-RENDERED = ("bush", "row")
 #: C2's image in the rendered bush is rendered at half size (320 x 240): the berry
 #: fills much of it in the last centimetres, and the software rasteriser's cost goes
 #: with the pixels.
 C2_SCALE = 0.5
 
 
-def _bush_world(
-    o: SimRigOptions,
-    bush: Bush,
-    plant: ArmPlant,
-    model: softarm.SoftArm,
-    cams: SimCameras,
-    parts: FloatArray,
-    clock: SimClock,
-    recorder: FrameRecorder | None,
-) -> tuple[BushScene, BushVision, BushGripper, list[softarm.PolynomialCurve]]:
-    """The rendered bush and its map, the markerless vision, the gripper that closes on
-    the true berry a map entry stands for, and the canes the planner, the resolver and
-    the clearance avoid: fitted from C1 without the rig's own ``parts``. With ``recorder``
-    every frame is recorded, and the rig's hardware configuration written beside."""
-    cfg = o.config
+@dataclass(frozen=True)
+class WorldParts:
+    """What a world is built from: the options, the true bush and canes, the plant, the
+    controller's model, the cameras, the rig's own parts (C1's self-filter), the clock
+    and the recorder of ``record_frames``."""
+
+    o: SimRigOptions
+    bush: Bush
+    true_canes: list[softarm.PolynomialCurve]
+    plant: ArmPlant
+    model: softarm.SoftArm
+    cams: SimCameras
+    parts: FloatArray
+    clock: SimClock
+    recorder: FrameRecorder | None
+
+
+def _tag_world(w: WorldParts) -> TagWorld:
+    """The tagged bush seen by the synthetic cameras, its true canes mapped."""
+    cfg, on_bush = w.o.config, list(w.bush.berries)
+    vision = sim_vision(
+        w.cams, w.plant.pose, lambda: on_bush, cfg.grasp_offset, seed=w.o.seed, hidden=w.o.hidden
+    )
+    gripper = SimGripper(w.plant, vision, on_bush, cfg.grasp_offset, cfg.grasp_workspace)
+    return TagWorld(w.bush, vision, gripper, w.true_canes)
+
+
+def _rendered_world(w: WorldParts) -> RenderedWorld:
+    """The rendered bush (in the row for ``world = "row"``) and its map, the markerless
+    vision, the gripper that closes on the true berry a map entry stands for, and the
+    canes the planner, the resolver and the clearance avoid: fitted from C1 without the
+    rig's own parts. With a recorder every frame is recorded, and the rig's hardware
+    configuration written beside."""
+    o, cfg = w.o, w.o.config
     use_detector(o.detector)
     use_cane_source(o.cane_source)
-    scene = _bush_scene(bush, plant, cams, clock, recorder, _look(o, bush))
-    canes = scene.fit_canes(parts, CANE_REACH)
-    vision = _bush_vision(scene, cams, cfg.grasp_offset, recorder)
+    scene = _bush_scene(w.bush, w.plant, w.cams, w.clock, w.recorder, _look(o, w.bush))
+    canes = scene.fit_canes(w.parts, CANE_REACH)
+    vision = _bush_vision(scene, w.cams, cfg.grasp_offset, w.recorder)
     gripper = BushGripper(
-        scene, plant, vision, list(bush.berries), cfg.grasp_offset, cfg.grasp_workspace
+        scene, w.plant, vision, list(w.bush.berries), cfg.grasp_offset, cfg.grasp_workspace
     )
-    if recorder is not None:
-        identified = o.identified or declared_plant(o.plant, model.n_actuators, cfg.period)
+    if w.recorder is not None:
+        identified = o.identified or declared_plant(o.plant, w.model.n_actuators, cfg.period)
         rig = RigDescription(
-            model, cfg, dict(o.gains), identified, scene, scene.world.c2,
-            cams.T_ee_c2, cams.T_ee_cube, cams.berry_tag, cams.T_base_tag, o.survey,
+            w.model, cfg, dict(o.gains), identified, scene, scene.world.c2,
+            w.cams.T_ee_c2, w.cams.T_ee_cube, w.cams.berry_tag, w.cams.T_base_tag, o.survey,
         )  # fmt: skip
-        write_rig_files(recorder.folder, rig)
-    return scene, vision, gripper, canes
+        write_rig_files(w.recorder.folder, rig)
+    return RenderedWorld(o.world, scene, vision, gripper, canes, o.survey)
+
+
+#: How each world is built.
+WORLDS: dict[WorldName, Callable[[WorldParts], HarvestWorld]] = {
+    WorldName.TAGS: _tag_world,
+    WorldName.BUSH: _rendered_world,
+    WorldName.ROW: _rendered_world,
+}
 
 
 def _look(o: SimRigOptions, bush: Bush) -> RowLook | None:
     """The row's look of ``o`` (drawn from the bush's seed), None for the bush."""
-    return RowLook.named(o.look or "random", bush.seed) if o.world == "row" else None
+    return RowLook.named(o.look or "random", bush.seed) if o.world is WorldName.ROW else None
 
 
 def _bush_scene(

@@ -20,7 +20,6 @@ from softarm.errors import VisionError
 from softarm.harvest.control.stack import ControlStack
 from softarm.harvest.control.survey import SurveySettings, plan_survey
 from softarm.harvest.machine.harvest_machine import HarvestMachine
-from softarm.perception.bush_vision import BushVision
 from softarm.perception.c1 import StereoC1
 from softarm.perception.cane_metrics import DEFAULT_REACH
 from softarm.perception.cane_views import pixel_size, view_pair_points
@@ -60,10 +59,9 @@ class CaneSurvey:
         )  # fmt: skip
         views = self.machine.survey(plan, self.vision.view_c2)
         footprint = pixel_size(self.c1.stereo, centre)
-        if isinstance(self.vision, BushVision):  # the views also place what C1 could not
-            for pair in views:
-                for image, T_base_c2 in pair:
-                    self.vision.place_from_view(image, T_base_c2)
+        for pair in views:  # the views also place what C1 could not
+            for image, T_base_c2 in pair:
+                self.vision.place_from_view(image, T_base_c2)
         points = []
         for (first, T_first), (second, T_second) in views:
             try:

@@ -47,6 +47,7 @@ from softarm.sim.render.row import STAGE_RIPENESS
 from softarm.sim.render.row_look import LOOKS, RowLook
 from softarm.sim.render.silhouette import silhouette_area
 from softarm.sim.render.world import RenderedBush, arm_sections
+from softarm.sim.world import WorldName
 from softarm.vision.camera_model import CameraModel
 
 __all__ = ["DatasetRig", "render_sample", "write_dataset"]
@@ -82,19 +83,21 @@ class DatasetRig:
     #: "bush", the rendered bush; "row", the bush in a hedgerow in daylight
     #: (:mod:`softarm.sim.render.row`) with the look family ``look``
     #: (:data:`softarm.sim.render.row_look.LOOKS`) and its camera model.
-    world_kind: str = "bush"
+    world_kind: WorldName = WorldName.BUSH
     look: str = "random"
 
     def __post_init__(self) -> None:
-        if self.world_kind not in ("bush", "row"):
+        world = WorldName.parse(self.world_kind)
+        if not world.rendered:
             raise ParameterError(f"world must be 'bush' or 'row', got {self.world_kind!r}")
+        object.__setattr__(self, "world_kind", world)
         if self.look not in LOOKS:
             raise ParameterError(f"look must be one of {', '.join(LOOKS)}, got {self.look!r}")
 
     def world(self, bush: Bush) -> RenderedBush:
         """``bush`` rendered with these cameras (in the row: a look of the family drawn
         from the bush's seed)."""
-        look = RowLook.named(self.look, bush.seed) if self.world_kind == "row" else None
+        look = RowLook.named(self.look, bush.seed) if self.world_kind is WorldName.ROW else None
         return RenderedBush(
             bush, self.T_base_c1, self.c1, self.c2, self.T_ee_c2, self.T_ee_cube,
             self.T_base_tag, self.base_tag_id, self.base_tag, look=look,
@@ -351,7 +354,7 @@ def _coco(samples: list[dict[str, Any]], seed: int, rig: DatasetRig) -> dict[str
         },
         "images": [s["image"] for s in samples],
         "annotations": annotations,
-        "categories": ROW_CATEGORIES if rig.world_kind == "row" else CATEGORIES,
+        "categories": ROW_CATEGORIES if rig.world_kind is WorldName.ROW else CATEGORIES,
     }
 
 
