@@ -11,6 +11,7 @@ import softarm
 from softarm.cli import main
 from softarm.errors import ConfigError
 from softarm.sweep import gains_from, load_gains, load_spec, parse_spec, write_gains
+from softarm.sweep.perception_spec import load_perception_spec
 
 GOOD = {"sweep": {"seeds": [0, 1], "berries": 2, "plant": {"pressure_tau": [0.08, 0.3]}}}
 
@@ -114,9 +115,12 @@ def test_example_specs_parse() -> None:
     root = Path(__file__).parents[2] / "examples" / "sweeps"
     files = sorted(root.glob("*.toml"))
     specs = [f for f in files if "sweep" in tomllib.loads(f.read_text())]
-    assert specs
-    for path in set(files) - set(specs):  # tuned gains written by softarm tune
+    maps = [f for f in files if "perception" in tomllib.loads(f.read_text())]
+    assert specs and maps
+    for path in set(files) - set(specs) - set(maps):  # tuned gains written by softarm tune
         softarm.Gains(**load_gains(path))
+    for path in maps:  # the row's perception maps
+        assert load_perception_spec(path).trials()
     for path in specs:
         spec = load_spec(path)
         assert spec.trials()
