@@ -309,3 +309,16 @@ def test_no_function_of_the_package_is_over_80_lines() -> None:
         and node.end_lineno - node.lineno + 1 > MAX_FUNCTION_LINES
     ]
     assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
+
+
+def test_the_names_a_config_lists_are_the_modules_own() -> None:
+    """The config layer lists the names of what sits above it (so that reading a config
+    imports no perception or vision); each list must equal its module's."""
+    from softarm import config, perception_config
+    from softarm.perception.cane_source import CANE_SOURCES
+    from softarm.perception.detector.choice import DETECTORS
+    from softarm.vision.marker_body import MARKER_BODIES
+
+    assert tuple(config.MARKER_BODY_NAMES) == tuple(MARKER_BODIES)
+    assert tuple(perception_config.DETECTORS) == tuple(DETECTORS)
+    assert tuple(perception_config.CANE_SOURCES) == tuple(CANE_SOURCES)

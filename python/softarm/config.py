@@ -359,16 +359,18 @@ def _calibration(t: TomlTable) -> CalibrationConfig:
     return calibration
 
 
+#: The marker bodies' names (softarm.vision.marker_body.MARKER_BODIES, listed here so that
+#: reading a config imports neither the vision layer nor OpenCV; a test keeps them equal).
+MARKER_BODY_NAMES = ("cube", "frustum")
+
+
 def _marker_body(t: TomlTable, default: str) -> str:
     """``marker_body``: one of the bodies softarm.vision.marker_body names."""
     body = t.get("marker_body", default)
     if body == default:
         return default
-    # Imported here: the bodies' module loads OpenCV, which reading a config needs not.
-    from softarm.vision.marker_body import MARKER_BODIES
-
-    if body not in MARKER_BODIES:
-        raise t.error("marker_body", f"must be one of {', '.join(MARKER_BODIES)}")
+    if body not in MARKER_BODY_NAMES:
+        raise t.error("marker_body", f"must be one of {', '.join(MARKER_BODY_NAMES)}")
     return str(body)
 
 
