@@ -83,6 +83,7 @@ UNITS: dict[str, dict[str, str]] = {
     "waypoint_stalled": {"t": "s", "error": "m"},
     "transport_held": {"t": "s", "error": "m"},
     "fine_budget": {"t": "s", "error": "m"},
+    "fine_confident": {"t": "s", "samples": "-", "error": "m", "bound": "m"},
     "limit_grasp": {"t": "s", "error": "m"},
     "lost_grasp": {"t": "s", "error": "m"},
     "placement_limit": {"t": "s", "error": "m", "pointing": "rad"},
