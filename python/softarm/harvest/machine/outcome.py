@@ -41,7 +41,8 @@ class Fault(SoftarmError):
 class Ending(StrEnum):
     """Why a closed-loop stage handed over (every way but a fault)."""
 
-    #: Within the tolerances for ``settle_steps`` steps in a row.
+    #: Within the tolerances for ``settle_steps`` steps in a row (fine positioning under
+    #: ``fine_end_rule = "confidence"``: the error's upper confidence bound within them).
     SETTLED = "settled"
     #: Fine positioning ran out of its budget inside the grasp workspace (±1 cm).
     BUDGET = "budget"
