@@ -37,13 +37,13 @@ def one_trial(
     """Harvest one bush on one plant; returns the report as a dict plus the plant keys.
     With ``calibrate`` the plant is first calibrated (``softarm calibrate --sim``, 80
     poses) and the harvest runs on the fitted model, as on a real arm."""
-    from softarm.harvest.rigs import sim_rig
+    from softarm.harvest.rigs import sim_options, sim_rig
     from softarm.sim.arm import PlantConfig
 
     plant = PlantConfig(pressure_tau=tau, hysteresis_psi=hysteresis)
-    fields = {f.name for f in dataclasses.fields(sim_rig.SimRigOptions)}
+    fields = {f.name for f in dataclasses.fields(sim_options.SimRigOptions)}
     if "plant" in fields:
-        opts = sim_rig.SimRigOptions(n_berries=berries, seed=seed, plant=plant)
+        opts = sim_options.SimRigOptions(n_berries=berries, seed=seed, plant=plant)
         if "lag_control" in fields:
             opts.lag_control = lag_control
     else:  # a build older than the plant option: swap the plant's configuration in
@@ -54,7 +54,7 @@ def one_trial(
             return ArmPlant(SimulatedArm(model, config=plant, seed=s))
 
         ArmPlant.seeded = staticmethod(seeded)  # type: ignore[method-assign]
-        opts = sim_rig.SimRigOptions(n_berries=berries, seed=seed)
+        opts = sim_options.SimRigOptions(n_berries=berries, seed=seed)
     if calibrate:
         from softarm._core import SoftArm
         from softarm.calibration.sim import build_plant, calibrate_plant

@@ -16,7 +16,8 @@ from typing import Any
 
 import pytest
 
-from softarm.harvest.rigs.sim_rig import SimRig, SimRigOptions, build_sim_rig
+from softarm.harvest.rigs.sim_options import SimRigOptions
+from softarm.harvest.rigs.sim_rig import SimRig, build_sim_rig
 
 pytest.importorskip("foxglove")
 pytest.importorskip("websockets")

@@ -117,7 +117,8 @@ def bush() -> Any:
     """A small rendered bush (the sim rig's own map and canes), or a skip (a failure
     where the render is required)."""
     from render_required import rendering
-    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_options import SimRigOptions
+    from softarm.harvest.rigs.sim_rig import build_sim_rig
 
     with rendering():
         return build_sim_rig(SimRigOptions(n_berries=3, seed=330, world="bush"))

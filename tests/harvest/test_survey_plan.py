@@ -16,7 +16,7 @@ from softarm.harvest.control import stack as rig
 from softarm.harvest.control.clearance import Clearance
 from softarm.harvest.control.ik import ModelIK, planning_resolver
 from softarm.harvest.control.survey import SurveySettings, plan_survey
-from softarm.harvest.rigs import sim_rig
+from softarm.harvest.rigs import sim_options, sim_rig
 
 CENTRE = np.array([0.02, 0.37, 0.38])  # a bush's berries, as Bush.generate places them
 T_EE_C2 = np.eye(4)
@@ -106,7 +106,7 @@ def test_the_stack_avoids_the_canes_it_is_told_of(
         return built[-1]
 
     monkeypatch.setattr(sim_rig, "build_control_stack", record)
-    sim_rig.build_sim_rig(sim_rig.SimRigOptions(n_berries=1, seed=1, avoid_canes=avoid))
+    sim_rig.build_sim_rig(sim_options.SimRigOptions(n_berries=1, seed=1, avoid_canes=avoid))
     stack = built[0]
     cane = softarm.PolynomialCurve(np.zeros((3, 4)), (0.0, 1.0))
     before = list(stack.clearance.canes)

@@ -11,7 +11,9 @@ import pytest
 
 import softarm
 from softarm.errors import ParameterError
-from softarm.harvest.rigs.sim_rig import WORLDS, SimRigOptions, build_sim_rig, sim_bush
+from softarm.harvest.rigs.sim_options import SimRigOptions
+from softarm.harvest.rigs.sim_rig import build_sim_rig, sim_bush
+from softarm.harvest.rigs.sim_worlds import WORLDS
 from softarm.harvest.rigs.tag_world import TagWorld
 from softarm.sim.world import WorldName
 

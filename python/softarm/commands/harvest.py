@@ -290,7 +290,8 @@ def run_sim(
     more ``SimRigOptions`` (``plant``, ``identified``: see ``commands/_plant.py``). The
     log and the report open with the run's header (``args``: the parsed command line);
     ``bag``: the run as a ROS 2 bag."""
-    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_options import SimRigOptions
+    from softarm.harvest.rigs.sim_rig import build_sim_rig
 
     check_view(view, record)  # demo's path too: before the banner and the log
     if not quiet:

@@ -59,7 +59,8 @@ def simulate(
     """
     from softarm.harvest.records.header import HEADER, header_record
     from softarm.harvest.rigs.sim_header import sim_settings
-    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
+    from softarm.harvest.rigs.sim_options import SimRigOptions
+    from softarm.harvest.rigs.sim_rig import build_sim_rig
 
     _check_options(options, SimRigOptions)
     if options.get("world") in ("bush", "row"):  # before the log: a typed error, not MuJoCo's
