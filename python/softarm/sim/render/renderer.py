@@ -2,8 +2,12 @@
 from any camera of the scene, with the arm moved each frame.
 
 Rendering is MuJoCo's OpenGL rasteriser through EGL (``MUJOCO_GL=egl``; on machines
-without a GPU, Mesa's software rasteriser). No shadows: one directional light plus
-ambient. Lens distortion is applied afterwards (:mod:`softarm.sim.render.distortion`).
+without a GPU, Mesa's software rasteriser). The bush: one directional light plus
+ambient, no shadows; the row: a sun with a shadow map, which a small render (C2, a C1
+window) draws small, at the full map's texel pitch, about what it sees
+(:mod:`softarm.sim.render.shadow_map`). Geoms that cannot show in a render are left out
+of it (:mod:`softarm.sim.render.culling`). Lens distortion is applied afterwards
+(:mod:`softarm.sim.render.distortion`).
 """
 
 from __future__ import annotations
@@ -28,6 +32,12 @@ from softarm.sim.render.mjcf import (
     CameraSpec,
     SceneSpec,
     scene_xml,
+)
+from softarm.sim.render.shadow_map import (
+    BACKDROP_RADIUS,
+    LOCAL_MAX_PIXELS,
+    LOCAL_SIZE,
+    SunShadows,
 )
 from softarm.uninterrupted import uninterrupted
 
@@ -106,7 +116,7 @@ class BushRenderer:
         self.data = mujoco.MjData(self.model)
         self.cameras = {c.name: c for c in [*spec.world_cameras, *spec.hand_cameras]}
         self.labels = GeomLabels.from_model(self.model, mujoco)
-        self._renderers: dict[tuple[int, int], Any] = {}
+        self._renderers: dict[tuple[int, int, bool], Any] = {}
         self._mocap = {
             self.model.body(i).name: self.model.body_mocapid[i]
             for i in range(self.model.nbody)
@@ -125,10 +135,15 @@ class BushRenderer:
         # stale): only the rest of the scene is culled.
         self._groups = self.model.geom_group.copy()
         self._cullable = np.flatnonzero(self.labels.kind != KINDS.index("arm"))
+        self._arm = np.flatnonzero(self.labels.kind == KINDS.index("arm"))
+        self._backdrop = self.model.geom_rbound > BACKDROP_RADIUS
+        self._backdrop[self._arm] = False
         self._shadow_travel: FloatArray | None = None
+        self._sun: SunShadows | None = None
         if spec.row is not None and spec.shadows:
             sun = np.asarray(spec.look.light_direction, float)
             self._shadow_travel = sun / np.linalg.norm(sun)
+            self._sun = SunShadows(self.model, mujoco)
 
     def push_leaves(self, body: FloatArray, radius: FloatArray) -> None:
         """Move aside every leaf that the arm's body (spheres at ``body`` (N, 3) with
@@ -189,10 +204,10 @@ class BushRenderer:
         mj.mj_kinematics(self.model, self.data)
         mj.mj_camlight(self.model, self.data)  # camera and light poses from the bodies
         spec = self.cameras[camera]
-        r = self._renderer(spec)
         option = mj.MjvOption()
         option.geomgroup[OCCLUDER_GROUP] = int(occluders)
-        with self._culled(camera, spec.size, spec.principal):
+        with self._culled(camera, spec.size, spec.principal) as local:
+            r = self._renderer(spec, local)
             return self._render_passes(r, camera, option, depth, geoms)
 
     def _render_passes(
@@ -257,9 +272,9 @@ class BushRenderer:
             mj.mj_kinematics(m, self.data)
             mj.mj_camlight(m, self.data)
             window = CameraSpec(camera, spec.T_parent_camera, (side, side), spec.focal, (0, 0))
-            r = self._renderer(window)
             principal = (spec.principal[0] - origin[0], spec.principal[1] - origin[1])
-            with self._culled(camera, (side, side), principal):
+            with self._culled(camera, (side, side), principal) as local:
+                r = self._renderer(window, local)
                 r.update_scene(self.data, camera=camera)
                 return np.ascontiguousarray(r.render()[..., ::-1])
         finally:
@@ -268,28 +283,54 @@ class BushRenderer:
     @contextmanager
     def _culled(
         self, camera: str, size: tuple[int, int], principal: tuple[float, float]
-    ) -> Iterator[None]:
+    ) -> Iterator[bool]:
         """Within the block, every geom that cannot show in ``camera``'s ``size``
         picture with ``principal`` point (px) is in :data:`CULLED_GROUP`
         (:mod:`softarm.sim.render.culling`; the camera's pose is the data's, after
-        ``mj_camlight``)."""
+        ``mj_camlight``). Yields whether the render takes a small shadow map (the sun
+        moved for it: :mod:`softarm.sim.render.shadow_map`)."""
         mj, m, d = self._mj, self.model, self.data
         cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
         centres = (d.geom_xpos[self._cullable] - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
         radii = m.geom_rbound[self._cullable]
         focal = self.cameras[camera].focal
         shown = in_frustum(centres, radii, size, focal, principal)
+        local = False
+        light = None if self._sun is None else d.light_xpos[self._sun.light].copy()
+        if self._sun is not None and size[0] * size[1] <= LOCAL_MAX_PIXELS:
+            local = self._sun.place(d, *self._seen(cam, size, focal, principal))
         if self._shadow_travel is not None:  # a caster out of the picture may shade it
             travel = self._shadow_travel @ d.cam_xmat[cam].reshape(3, 3)
+            seen = shown.copy()
             for t in SHADOW_STEPS:
                 shown |= in_frustum(
                     centres + t * travel, radii + SHADOW_STEP, size, focal, principal
                 )
+            if local and self._sun is not None:  # a caster kept for its shadow alone
+                # must reach into the small map
+                shown &= seen | self._sun.in_map(d, d.geom_xpos[self._cullable], radii)
         m.geom_group[self._cullable[~shown]] = CULLED_GROUP
         try:
-            yield
+            yield local
         finally:
             m.geom_group[:] = self._groups
+            if self._sun is not None:
+                d.light_xpos[self._sun.light] = light
+
+    def _seen(
+        self, cam: int, size: tuple[int, int], focal: float, principal: tuple[float, float]
+    ) -> tuple[FloatArray, FloatArray]:
+        """The bounding spheres (world centres, radii) of what camera ``cam`` can see,
+        whatever the culling: every geom in its frustum but planes (unbounded) and the
+        backdrop (larger than BACKDROP_RADIUS); the arm's geoms change size as it bends,
+        so their size bounds their reach."""
+        m, d = self.model, self.data
+        radii = m.geom_rbound.copy()
+        radii[self._arm] = np.maximum(radii[self._arm], m.geom_size[self._arm].sum(axis=1))
+        centres = (d.geom_xpos - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
+        seen = in_frustum(centres, radii, size, focal, principal) & (radii > 0)
+        seen &= ~self._backdrop
+        return d.geom_xpos[seen], radii[seen]
 
     def close(self) -> None:
         """Free the OpenGL contexts; a stop waits until they are freed (a context left
@@ -298,16 +339,25 @@ class BushRenderer:
             while self._renderers:
                 self._renderers.popitem()[1].close()
 
-    def _renderer(self, spec: CameraSpec) -> Any:
+    def _renderer(self, spec: CameraSpec, local: bool = False) -> Any:
+        """The renderer (an OpenGL context) of ``spec``'s size; ``local``: with the
+        small shadow map (MuJoCo reads the map's settings when it makes the context)."""
         w, h = spec.size
-        if (w, h) not in self._renderers:
-            self.model.vis.global_.offwidth = max(self.model.vis.global_.offwidth, w)
-            self.model.vis.global_.offheight = max(self.model.vis.global_.offheight, h)
+        m = self.model
+        if (w, h, local) not in self._renderers:
+            m.vis.global_.offwidth = max(m.vis.global_.offwidth, w)
+            m.vis.global_.offheight = max(m.vis.global_.offheight, h)
+            full = (int(m.vis.quality.shadowsize), float(m.vis.map.shadowclip))
+            if local and self._sun is not None:
+                m.vis.quality.shadowsize = LOCAL_SIZE
+                m.vis.map.shadowclip = self._sun.local_shadowclip
             try:
-                self._renderers[(w, h)] = self._mj.Renderer(self.model, h, w)
+                self._renderers[(w, h, local)] = self._mj.Renderer(m, h, w)
             except (OSError, AttributeError, RuntimeError, self._mj.FatalError) as exc:  # no GL
                 raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
-        return self._renderers[(w, h)]
+            finally:
+                m.vis.quality.shadowsize, m.vis.map.shadowclip = full
+        return self._renderers[(w, h, local)]
 
     def _place(self, body: str, pos: FloatArray, R: FloatArray) -> None:
         x, y, z, w = Rotation.from_matrix(R).as_quat()
