@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 
 import softarm
-from softarm.harvest.rigs.sim_options import default_cameras
-from softarm.harvest.rigs.sim_worlds import C2_SCALE
+from softarm.harvest.rigs.sim.options import default_cameras
+from softarm.harvest.rigs.sim.worlds import C2_SCALE
 from softarm.sim.bush import Bush
 from softarm.sim.render.world import arm_sections, world_for
 from softarm.sim.rig_cameras import BASE_TAG_ID

@@ -49,7 +49,7 @@ import dataclasses, json, sys, time
 t0, c0 = time.perf_counter(), time.process_time()
 import cv2
 cv2.setNumThreads(1)
-import softarm.harvest.rigs.sim_rig as sr
+import softarm.harvest.rigs.sim.rig as sr
 seed, berries, crop, noise_offset, report = (
     int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], int(sys.argv[4]), sys.argv[5])
 if crop != "default":

@@ -110,8 +110,8 @@ def run_harvest(
     seeds: list[int], gravities: list[str], berries: int, models: list[str], out: Path
 ) -> None:
     from softarm.calibration import Calibration
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.sim.arm import PlantConfig
 
     print(

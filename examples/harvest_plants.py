@@ -37,7 +37,8 @@ def one_trial(
     """Harvest one bush on one plant; returns the report as a dict plus the plant keys.
     With ``calibrate`` the plant is first calibrated (``softarm calibrate --sim``, 80
     poses) and the harvest runs on the fitted model, as on a real arm."""
-    from softarm.harvest.rigs import sim_options, sim_rig
+    from softarm.harvest.rigs.sim import options as sim_options
+    from softarm.harvest.rigs.sim import rig as sim_rig
     from softarm.sim.arm import PlantConfig
 
     plant = PlantConfig(pressure_tau=tau, hysteresis_psi=hysteresis)
@@ -60,7 +61,7 @@ def one_trial(
         from softarm.calibration.sim import build_plant, calibrate_plant
 
         nominal = SoftArm.blackberry()
-        # The rig's plant is drawn from seed + 1000 (softarm.harvest.rigs.sim_rig).
+        # The rig's plant is drawn from seed + 1000 (softarm.harvest.rigs.sim.rig).
         opts.calibration = calibrate_plant(
             build_plant(nominal, plant, seed + 1000), plant, nominal, seed=seed
         )[0]

@@ -22,8 +22,8 @@ WORLDS = ("tags", "bush")
 
 def one_bush(world: str, seed: int, berries: int) -> dict[str, Any]:
     """One simulated harvest's ``rate`` record (its harvested berries, time and stages)."""
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     rig = build_sim_rig(SimRigOptions(n_berries=berries, seed=seed, world=world))
     try:

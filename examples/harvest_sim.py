@@ -22,8 +22,8 @@ from softarm.commands._args import Parser, int_range, non_negative_int, output_d
 
 def one_seed(seed: int, berries: int, out: Path, avoid: bool, gain: float | None) -> dict:
     """Run one bush and save its report; returns the report as a dict."""
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     opts = SimRigOptions(
         n_berries=berries,

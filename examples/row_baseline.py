@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 import softarm
-from softarm.harvest.rigs.sim_options import default_cameras
+from softarm.harvest.rigs.sim.options import default_cameras
 from softarm.perception import detect_berries
 from softarm.sim.bush import Bush
 from softarm.sim.render.labels import KINDS

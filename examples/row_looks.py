@@ -24,7 +24,7 @@ from typing import Any
 import cv2
 
 import softarm
-from softarm.harvest.rigs.sim_options import default_cameras
+from softarm.harvest.rigs.sim.options import default_cameras
 from softarm.sim.bush import Bush
 from softarm.sim.render.row_look import FAMILIES, RowLook
 from softarm.sim.render.world import RenderedBush

@@ -27,8 +27,8 @@ def main(argv: list[str] | None = None) -> int:
     import numpy as np
 
     from softarm.harvest import BerryTarget
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.vision.detector import square_marker_poses
 
     rig = build_sim_rig(SimRigOptions(n_berries=1, seed=args.seed))

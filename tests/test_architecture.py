@@ -212,13 +212,13 @@ def test_the_layer_table_can_fail() -> None:
     assert _layer_violations("config.py", "from softarm.identification.estimate import X\n")
     assert _layer_violations("units.py", "from softarm.so3 import exp\n")
     assert not _layer_violations("units.py", "from softarm.errors import InputError\n")
-    assert _layer_violations("harvest/rigs/sim_plots.py", "from softarm.viz.replay import replay\n")
-    assert not _layer_violations("harvest/rigs/sim_plots.py", "from softarm.viz.arm import X\n")
+    assert _layer_violations("harvest/rigs/sim/plots.py", "from softarm.viz.replay import replay\n")
+    assert not _layer_violations("harvest/rigs/sim/plots.py", "from softarm.viz.arm import X\n")
     assert _layer_violations(
         "harvest/machine/servo.py", "from softarm.harvest.rigs import sim_rig\n"
     )
     assert _layer_violations(
-        "harvest/runs/policy.py", "from softarm.harvest.rigs.hw_rig import X\n"
+        "harvest/runs/policy.py", "from softarm.harvest.rigs.hardware.rig import X\n"
     )
     assert not _layer_violations(
         "harvest/runs/policy.py", "from softarm.harvest.machine import X\n"

@@ -80,8 +80,8 @@ def test_clearance_gap_agrees_with_brute_force_sampling() -> None:
 
 
 def test_rod_clearance_measures_the_same_body() -> None:
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.sim.arm import PlantConfig
     from softarm.sim.cosserat.clearance import RodClearance
 

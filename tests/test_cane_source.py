@@ -36,7 +36,7 @@ SHADE = 0.6
 
 def _rendered_row(shadows: bool) -> Any:
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render import RenderedBush
     from softarm.sim.render.row_look import RowLook

@@ -12,7 +12,7 @@ from softarm.cli import main
 from softarm.commands.config import template
 from softarm.config import dump_config, parse_config
 from softarm.errors import ConfigError
-from softarm.harvest.rigs.sim_options import SimRigOptions
+from softarm.harvest.rigs.sim.options import SimRigOptions
 from softarm.perception.cane_source import CANE_SOURCES
 from softarm.perception_config import CANE_SOURCES as LISTED
 

@@ -104,7 +104,7 @@ def test_hardware_run_stopped_by_sigterm_vents_closes_and_logs(
 
     from softarm import cli
     from softarm.commands.config import template
-    from softarm.harvest.rigs import hw_rig
+    from softarm.harvest.rigs.hardware import rig as hw_rig
 
     config = tmp_path / "hw.toml"
     config.write_text(re.sub(r"(?m)^# ((T_C1_base|T_C2_EE|matrix) = )", r"\1", template()))

@@ -17,7 +17,7 @@ import pytest
 from softarm.errors import ConfigError, OutputError
 from softarm.harvest.records.frame_files import INDEX, FrameFolder, FrameRecorder
 from softarm.harvest.records.log import HarvestLog
-from softarm.harvest.rigs.replay_devices import ReplayDevices, compare_commands
+from softarm.harvest.rigs.replay.devices import ReplayDevices, compare_commands
 
 COMMANDS = [["set", 0.0, [1.0, 2.0]], ["set", 0.01, [1.5, 2.5]], ["vent", 0.02]]
 

@@ -11,8 +11,8 @@ import pytest
 
 from softarm.cli import main
 from softarm.harvest.records.rate import rate_line, rate_record, state_seconds
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_rig import build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.rig import build_sim_rig
 
 
 def _transition(t: float, old: str, new: str) -> dict[str, object]:

@@ -163,8 +163,8 @@ def test_the_harvest_takes_a_marker_body_in_the_simulator_only(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     from softarm.cli import main
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     with pytest.raises(SystemExit) as exit_:
         main(["harvest", "--sim", "--marker-body", "ball"])

@@ -22,9 +22,9 @@ from render_required import rendering
 from softarm.commands.harvest import line, summary
 from softarm.harvest.records.c1_picture import _brighten, _framed
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_plots import _named, plot_run, run_ids
-from softarm.harvest.rigs.sim_rig import build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.plots import _named, plot_run, run_ids
+from softarm.harvest.rigs.sim.rig import build_sim_rig
 from softarm.harvest_config import HarvestConfig
 
 os.environ.setdefault("MUJOCO_GL", "egl")

@@ -161,7 +161,7 @@ def test_a_sweep_trial_stopped_by_its_worker_vents_and_logs(
     """A Ray worker's SIGTERM handler exits with the signal number: the trial's arm is
     vented and the stop recorded on the way out."""
     from softarm.harvest.machine.harvest_machine import HarvestMachine
-    from softarm.harvest.rigs import sim_rig
+    from softarm.harvest.rigs.sim import rig as sim_rig
     from softarm.sweep import parse_spec
     from softarm.sweep.trial import run_trial
 

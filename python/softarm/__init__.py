@@ -117,7 +117,7 @@ _LAZY_NAMES = {
     "calibrate": ("softarm.calibration", "calibrate"),
     "Calibration": ("softarm.calibration", "Calibration"),
     # The simulated harvest, softarm.harvest.simulate: a report from one call.
-    "simulate_harvest": ("softarm.harvest.rigs.simulate", "simulate"),
+    "simulate_harvest": ("softarm.harvest.rigs.sim.simulate", "simulate"),
 }
 
 

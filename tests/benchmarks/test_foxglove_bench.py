@@ -16,8 +16,8 @@ from typing import Any
 
 import pytest
 
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_rig import SimRig, build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.rig import SimRig, build_sim_rig
 
 pytest.importorskip("foxglove")
 pytest.importorskip("websockets")

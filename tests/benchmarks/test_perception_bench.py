@@ -72,7 +72,7 @@ def test_render_cube_window(benchmark, world) -> None:  # type: ignore[no-untype
 def test_render_c2_frame(benchmark) -> None:  # type: ignore[no-untyped-def]
     """C2's frame at 320 x 240, as the harvest renders it, once per control period
     near the berry."""
-    from softarm.harvest.rigs.sim_worlds import C2_SCALE
+    from softarm.harvest.rigs.sim.worlds import C2_SCALE
 
     world = rendered_world(310, c2_scale=C2_SCALE)
     _arm_at_a_berry(world)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from softarm.hardware import protocols
 from softarm.harvest.machine import interfaces
-from softarm.harvest.rigs.sim_devices import SimGripper
+from softarm.harvest.rigs.sim.devices import SimGripper
 
 from .fakes import FakeGripper, make_rig
 

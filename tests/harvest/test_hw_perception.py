@@ -18,7 +18,8 @@ from softarm._core import PolynomialCurve
 from softarm.errors import ConfigError, ParameterError
 from softarm.hardware.simulated import SimulatedCamera
 from softarm.harvest.control import stack as rig
-from softarm.harvest.rigs import hw_devices, hw_rig
+from softarm.harvest.rigs.hardware import devices as hw_devices
+from softarm.harvest.rigs.hardware import rig as hw_rig
 from softarm.perception.bush_vision import BushVision
 from softarm.perception_config import PerceptionConfig
 from softarm.vision import CameraModel
@@ -117,8 +118,8 @@ def bush() -> Any:
     """A small rendered bush (the sim rig's own map and canes), or a skip (a failure
     where the render is required)."""
     from render_required import rendering
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     with rendering():
         return build_sim_rig(SimRigOptions(n_berries=3, seed=330, world="bush"))

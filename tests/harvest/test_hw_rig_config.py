@@ -17,7 +17,8 @@ from softarm.hardware.simulated import (
     SimulatedRipenessSensor,
 )
 from softarm.harvest import HarvestConfig
-from softarm.harvest.rigs import hw_devices, hw_rig
+from softarm.harvest.rigs.hardware import devices as hw_devices
+from softarm.harvest.rigs.hardware import rig as hw_rig
 
 
 class _Link:

@@ -16,8 +16,9 @@ from softarm.calibration.result import Calibration, GainMap
 from softarm.config import GainsConfig
 from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest.control import stack as rig
-from softarm.harvest.rigs import hw_rig, sim_rig
-from softarm.harvest.rigs.sim_options import SimRigOptions
+from softarm.harvest.rigs.hardware import rig as hw_rig
+from softarm.harvest.rigs.sim import rig as sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
 from softarm.identified_plant import IdentifiedPlant
 
 from .test_hw_rig_config import _config, no_devices  # noqa: F401  (the fixture)

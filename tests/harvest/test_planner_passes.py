@@ -73,7 +73,8 @@ def test_a_detour_goes_round_a_cane_the_straight_ramps_pass_too_near() -> None:
     from softarm.geometry import cone_axes
     from softarm.harvest.control.ik import DETOUR
     from softarm.harvest.machine.targets import approach_pose
-    from softarm.harvest.rigs import sim_options, sim_rig
+    from softarm.harvest.rigs.sim import options as sim_options
+    from softarm.harvest.rigs.sim import rig as sim_rig
 
     rig = sim_rig.build_sim_rig(sim_options.SimRigOptions(n_berries=8, seed=641))
     planner = rig.machine.planner

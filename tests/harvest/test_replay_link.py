@@ -9,7 +9,7 @@ import pytest
 from softarm.errors import HardwareError
 from softarm.hardware.arduino_devices import ArduinoRipenessSensor
 from softarm.harvest import BerryTarget, FaultReason, HarvestState
-from softarm.harvest.rigs.replay_devices import RecordingExhaustedError, ReplayLink
+from softarm.harvest.rigs.replay.devices import RecordingExhaustedError, ReplayLink
 from softarm.harvest.runs.policy import run_targets
 
 from .fakes import make_rig

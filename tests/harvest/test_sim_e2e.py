@@ -10,8 +10,8 @@ import pytest
 
 from softarm.cli import main
 from softarm.harvest import FaultReason, HarvestState, read_log
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_rig import build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.rig import build_sim_rig
 from softarm.harvest_config import HarvestConfig
 from softarm.sim.arm import PlantConfig
 

@@ -16,7 +16,8 @@ from softarm.harvest.control import stack as rig
 from softarm.harvest.control.clearance import Clearance
 from softarm.harvest.control.ik import ModelIK, planning_resolver
 from softarm.harvest.control.survey import SurveySettings, plan_survey
-from softarm.harvest.rigs import sim_options, sim_rig
+from softarm.harvest.rigs.sim import options as sim_options
+from softarm.harvest.rigs.sim import rig as sim_rig
 
 CENTRE = np.array([0.02, 0.37, 0.38])  # a bush's berries, as Bush.generate places them
 T_EE_C2 = np.eye(4)

@@ -11,10 +11,10 @@ import pytest
 
 import softarm
 from softarm.errors import ParameterError
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_rig import build_sim_rig, sim_bush
-from softarm.harvest.rigs.sim_worlds import WORLDS
-from softarm.harvest.rigs.tag_world import TagWorld
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.rig import build_sim_rig, sim_bush
+from softarm.harvest.rigs.sim.tag_world import TagWorld
+from softarm.harvest.rigs.sim.worlds import WORLDS
 from softarm.sim.world import WorldName
 
 PACKAGE = Path(softarm.__file__).parent

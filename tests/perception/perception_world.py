@@ -17,7 +17,7 @@ def rendered_world(seed: int, n_berries: int = 10, c2_scale: float = 1.0):  # ty
     """The rendered world of a fresh bush of ``seed`` seen by the simulated rig's cameras
     (C2's image scaled by ``c2_scale``), or a skip when this machine cannot render (a
     failure where the render is required)."""
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.render.world import world_for
     from softarm.sim.rig_cameras import BASE_TAG_ID
 

@@ -11,8 +11,8 @@ import os
 import pytest
 
 from render_required import rendering
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_rig import SimRig, build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.rig import SimRig, build_sim_rig
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 

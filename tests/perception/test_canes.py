@@ -231,7 +231,7 @@ def rendered():
 
     need_mujoco()
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render import RenderedBush
     from softarm.sim.rig_cameras import BASE_TAG_ID

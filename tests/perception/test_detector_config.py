@@ -11,7 +11,7 @@ from softarm.cli import main
 from softarm.commands.config import template
 from softarm.config import dump_config, parse_config
 from softarm.errors import ConfigError
-from softarm.harvest.rigs.sim_options import SimRigOptions
+from softarm.harvest.rigs.sim.options import SimRigOptions
 
 
 def _with(perception: str) -> str:

@@ -25,7 +25,7 @@ SCALE = 0.25
 
 
 def _world(look: RowLook, shadows: bool = True) -> Any:
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.render import RenderUnavailableError
     from softarm.sim.render.world import RenderedBush
     from softarm.sim.rig_cameras import BASE_TAG_ID
@@ -208,8 +208,8 @@ def test_the_row_dataset_has_stages(tmp_path: Path) -> None:
 
 
 def test_harvest_takes_a_look_for_the_row_only(capsys: pytest.CaptureFixture[str]) -> None:
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     with pytest.raises(SystemExit) as exit_:
         main(["harvest", "--sim", "--world", "row", "--look", "noon"])

@@ -135,8 +135,8 @@ def test_plant_runs_control_periods_with_gravity() -> None:
 
 
 def test_sim_rig_runs_on_the_rod() -> None:
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.sim.arm import PlantConfig
     from softarm.sim.cosserat.clearance import RodClearance
     from softarm.sim.cosserat.plant import CosseratPlant

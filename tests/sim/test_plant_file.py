@@ -116,8 +116,8 @@ def test_missing_file(tmp_path: Path) -> None:
 
 
 def test_sim_rig_builds_the_configured_plant() -> None:
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     plant = PlantConfig(pressure_tau=0.3, hysteresis_psi=4.0, max_psi=60.0)
     rig = build_sim_rig(SimRigOptions(n_berries=1, seed=3, plant=plant))

@@ -9,8 +9,8 @@ import pytest
 
 import softarm
 from softarm.errors import ConfigError
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_rig import build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.rig import build_sim_rig
 from softarm.sweep.spec import TrialSpec
 from softarm.sweep.trial import BERRY_COLUMNS, run_trial_rows
 

@@ -11,9 +11,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from softarm.harvest.rigs.sim_options import SimRigOptions
-from softarm.harvest.rigs.sim_plots import berry_paths, plot_run
-from softarm.harvest.rigs.sim_rig import build_sim_rig
+from softarm.harvest.rigs.sim.options import SimRigOptions
+from softarm.harvest.rigs.sim.plots import berry_paths, plot_run
+from softarm.harvest.rigs.sim.rig import build_sim_rig
 
 
 def _transition(t, berry, old, new):

@@ -1,6 +1,6 @@
 """``softarm harvest``'s dry run of the hardware path: ``--record-frames DIR`` with
 ``--sim --world bush`` records, ``--config DIR/hw.toml --frames DIR --dry-run``
-replays (:mod:`softarm.harvest.rigs.dry_run`, :mod:`softarm.harvest.rigs.replay_devices`)."""
+replays (:mod:`softarm.harvest.rigs.replay.dry_run`, :mod:`softarm.harvest.rigs.replay.devices`)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from softarm.sim.world import WorldName
 if TYPE_CHECKING:
     from softarm.harvest.records.log import HarvestLog
     from softarm.harvest.records.report import HarvestReport
-    from softarm.harvest.rigs.replay_devices import ReplayDevices
+    from softarm.harvest.rigs.replay.devices import ReplayDevices
 
 __all__ = [
     "add_dry_run_options",
@@ -77,7 +77,7 @@ def replay_devices(args: argparse.Namespace) -> ReplayDevices | None:
     if not args.dry_run:
         return None
     from softarm.harvest.records.frame_files import FrameFolder
-    from softarm.harvest.rigs.replay_devices import ReplayDevices
+    from softarm.harvest.rigs.replay.devices import ReplayDevices
 
     return ReplayDevices(FrameFolder(args.frames))
 
@@ -107,8 +107,8 @@ def log_commands(devices: ReplayDevices, log: HarvestLog) -> None:
 def dry_run_verdict(devices: ReplayDevices, sent: list[list[Any]], report: HarvestReport) -> int:
     """Compare what the dry run sent, and how each berry ended, with the recording;
     print the verdict and add it to ``report`` (``dry_run``). 0 when both match."""
-    from softarm.harvest.rigs.dry_run import BERRY_STATES, berry_outcome
-    from softarm.harvest.rigs.replay_devices import compare_commands, recorded_commands
+    from softarm.harvest.rigs.replay.devices import compare_commands, recorded_commands
+    from softarm.harvest.rigs.replay.dry_run import BERRY_STATES, berry_outcome
 
     found = compare_commands(sent, recorded_commands(devices.folder))
     ended = [berry_outcome(b) for b in report.berries]

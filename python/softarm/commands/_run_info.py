@@ -42,7 +42,7 @@ def sim_header(
 ) -> dict[str, Any]:
     """The header of a simulated run: the invocation and the rig's settings."""
     from softarm.harvest.records.header import header_record
-    from softarm.harvest.rigs.sim_header import sim_settings
+    from softarm.harvest.rigs.sim.header import sim_settings
 
     return header_record(**_invocation(args, command), **sim_settings(rig, rig_options))
 

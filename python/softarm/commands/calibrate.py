@@ -96,7 +96,7 @@ def _sim(args: argparse.Namespace, progress: Progress) -> Calibration:
     else:
         config = PlantConfig()
     nominal = SoftArm.blackberry()
-    # The harvest rig draws its plant from seed + 1000 (softarm.harvest.rigs.sim_rig).
+    # The harvest rig draws its plant from seed + 1000 (softarm.harvest.rigs.sim.rig).
     plant = build_plant(nominal, config, args.seed + 1000)
     cal, _, _ = calibrate_plant(
         plant, config, nominal, n_poses=args.poses, seed=args.seed, on_pose=progress,
@@ -111,7 +111,7 @@ def _hardware(args: argparse.Namespace, progress: Progress) -> Calibration | Non
     from softarm.calibration.collect import collect, paced_for
     from softarm.calibration.excitation import excitation_set
     from softarm.config import load_config
-    from softarm.harvest.rigs.hw_rig import build_hardware_rig
+    from softarm.harvest.rigs.hardware.rig import build_hardware_rig
     from softarm.identified_plant import identified_from_config
 
     config = load_config(args.config)

@@ -68,7 +68,7 @@ def default_rig(
 ) -> DatasetRig:
     """The simulated harvest's cameras and markers, images scaled by ``scale``; the
     ``world`` and its ``look`` (the row's)."""
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.render.dataset import DatasetRig
     from softarm.sim.rig_cameras import BASE_TAG_ID
 

@@ -54,9 +54,9 @@ if TYPE_CHECKING:
     from softarm.config import Config
     from softarm.harvest.records.log import HarvestLog
     from softarm.harvest.records.report import HarvestReport
-    from softarm.harvest.rigs.hw_rig import HardwareRig
-    from softarm.harvest.rigs.replay_devices import ReplayDevices
-    from softarm.harvest.rigs.sim_rig import SimRig
+    from softarm.harvest.rigs.hardware.rig import HardwareRig
+    from softarm.harvest.rigs.replay.devices import ReplayDevices
+    from softarm.harvest.rigs.sim.rig import SimRig
 
 #: Berries one command may ask for: as many as a simulated bush holds, a bush, not a field
 #: (softarm.sim.bush.MAX_BERRIES; not imported here, it pulls in OpenCV).
@@ -290,8 +290,8 @@ def run_sim(
     more ``SimRigOptions`` (``plant``, ``identified``: see ``commands/_plant.py``). The
     log and the report open with the run's header (``args``: the parsed command line);
     ``bag``: the run as a ROS 2 bag."""
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     check_view(view, record)  # demo's path too: before the banner and the log
     if not quiet:
@@ -408,7 +408,7 @@ def _plot(rig: SimRig, report: HarvestReport, path: Path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    from softarm.harvest.rigs.sim_plots import plot_run
+    from softarm.harvest.rigs.sim.plots import plot_run
 
     plot_run(rig, report, path)
 
@@ -517,7 +517,7 @@ def _hardware_rig(
 ) -> HardwareRig:
     """The hardware rig of ``args``, its header written to ``log`` first; ``devices``:
     the dry run's (default: the real drivers)."""
-    from softarm.harvest.rigs.hw_rig import build_hardware_rig
+    from softarm.harvest.rigs.hardware.rig import build_hardware_rig
     from softarm.identified_plant import identified_from_config, load_identified
 
     config = _hardware_config(args)

@@ -60,7 +60,7 @@ def fitted_length(fits: Sequence[CaneFit], reach: float = DEFAULT_REACH) -> floa
 def scene_rows(condition: str, seed: int, n_berries: int = 8) -> list[dict[str, Any]]:
     """One row per source for ``seed``'s bush in ``condition``."""
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.perception.cane_source import candidate_masks
     from softarm.sim.bush import Bush
     from softarm.sim.render import RenderedBush

@@ -121,7 +121,7 @@ def _tracked(
 ) -> tuple[list[Pose], float, list[int]]:
     """Every pose tracked, the seconds spent rendering windows and the windows' sides."""
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import arm_sections, world_for

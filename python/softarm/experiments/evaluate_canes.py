@@ -32,7 +32,7 @@ def evaluate_canes(
     """One row per seed: the cane map's scores, the number of true and fitted canes
     and the fastest of ``repeats`` timings of :func:`fit_canes` (ms, this machine)."""
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render import RenderedBush
     from softarm.sim.rig_cameras import BASE_TAG_ID

@@ -43,8 +43,8 @@ def evaluate_survey(seeds: Iterable[int], n_berries: int = 8) -> list[dict[str, 
     from softarm.harvest.control.clearance import Clearance
     from softarm.harvest.control.ik import ModelIK, planning_resolver
     from softarm.harvest.control.survey import plan_survey
-    from softarm.harvest.rigs.sim_options import default_cameras
-    from softarm.harvest.rigs.sim_worlds import C2_SCALE
+    from softarm.harvest.rigs.sim.options import default_cameras
+    from softarm.harvest.rigs.sim.worlds import C2_SCALE
     from softarm.harvest_config import HarvestConfig
     from softarm.sim.bush import Bush
     from softarm.sim.render.world import world_for

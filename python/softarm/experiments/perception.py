@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 
 import softarm
-from softarm.harvest.rigs.sim_options import default_cameras
+from softarm.harvest.rigs.sim.options import default_cameras
 from softarm.perception import stereo as stereo_module
 from softarm.perception.berries import BerryDetection
 from softarm.perception.net_berries import NetDetector

@@ -216,7 +216,7 @@ def rendered(seeds: Iterable[int]) -> Iterator[tuple[int, _U8, _U8]]:
     CLUTTER) of each bush, rendered as
     :func:`softarm.experiments.perception.evaluate_berries` renders it."""
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render.labels import KINDS
     from softarm.sim.render.world import world_for

@@ -18,7 +18,7 @@ from softarm.harvest.machine.interfaces import (
 from softarm.harvest.machine.states import FAULTS_THAT_STOP, FaultReason, HarvestState
 from softarm.harvest.records.log import HarvestLog, read_log
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.simulate import simulate
+from softarm.harvest.rigs.sim.simulate import simulate
 from softarm.harvest_config import HarvestConfig
 
 __all__ = [

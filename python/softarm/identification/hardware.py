@@ -3,7 +3,7 @@ the Arduino's pressure board as the pressure monitor: the lag is seen in its rea
 the eye-to-hand camera C1 tracking the marker cube for the end-effector pose, and the
 wall clock.
 
-Devices are opened as the harvest opens them (:mod:`softarm.harvest.rigs.hw_rig`); a missing
+Devices are opened as the harvest opens them (:mod:`softarm.harvest.rigs.hardware.rig`); a missing
 one closes and vents what was opened and raises
 :class:`~softarm.errors.HardwareUnavailableError` naming it.
 """

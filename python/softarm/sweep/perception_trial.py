@@ -76,7 +76,7 @@ def trial_look(trial: PerceptionTrial) -> Any:
 
 def _world(trial: PerceptionTrial) -> Any:
     import softarm
-    from softarm.harvest.rigs.sim_options import default_cameras
+    from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
     from softarm.sim.render.world import RenderedBush, scaled
     from softarm.sim.rig_cameras import BASE_TAG_ID

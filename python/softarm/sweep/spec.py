@@ -31,7 +31,7 @@ __all__ = [
     "parse_spec",
 ]
 
-#: ``[sweep]`` keys forwarded to :class:`~softarm.harvest.rigs.sim_options.SimRigOptions`, with the
+#: ``[sweep]`` keys forwarded to :class:`~softarm.harvest.rigs.sim.options.SimRigOptions`, with the
 #: type each must have (the rig's and the closed-loop controller's settings).
 RIG_KEYS: dict[str, type | tuple[type, ...]] = {
     "scale": float,
@@ -198,7 +198,7 @@ def parse_spec(data: Mapping[str, Any], source: str = "<spec>") -> SweepSpec:
 
 def _check_rig(rig: dict[str, Any], r: _Reader) -> None:
     """The rig's options are checked by building them once (the rig's own validation)."""
-    from softarm.harvest.rigs.sim_options import SimRigOptions
+    from softarm.harvest.rigs.sim.options import SimRigOptions
 
     try:
         SimRigOptions(**rig)

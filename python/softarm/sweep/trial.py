@@ -53,8 +53,8 @@ def _single_threaded() -> None:
 
 def run_trial(trial: TrialSpec) -> Any:
     """Build the simulated rig for ``trial`` and harvest its bush; returns the report."""
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.stops import vents_on_stop
     from softarm.sweep.plant_keys import plant_config
 

@@ -90,8 +90,8 @@ def _header_scene(path: Path, records: list[Any]) -> RunScene:
 def _bush(path: Path, records: list[Any], seed: int, berries: int) -> Bush:
     """The bush of ``harvest --sim --seed seed --berries berries``, checked against the
     berries the log estimated (a log of another run would draw a wrong scene)."""
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import sim_bush
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import sim_bush
 
     bush = sim_bush(SimRigOptions(n_berries=berries, seed=seed))
     true = {b.tag_id: np.asarray(b.position) for b in bush.berries}

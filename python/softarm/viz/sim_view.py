@@ -1,6 +1,6 @@
 """A live rerun view of the simulated harvest (``softarm harvest --sim --view``).
 
-:func:`attach` hooks a :class:`SimView` onto a built :class:`~softarm.harvest.rigs.sim_rig.
+:func:`attach` hooks a :class:`SimView` onto a built :class:`~softarm.harvest.rigs.sim.rig.
 SimRig` without changing how it runs: the simulated clock's ``on_advance`` callbacks (the
 same hook the plant and the cane watch use) draw the TRUE arm after every time step, and
 the cameras' frame functions and the marker detector are wrapped to pass each image and
@@ -32,7 +32,7 @@ from softarm.viz.rerun_sdk import TIMELINE, close_recording, open_recording, req
 from softarm.viz.scene import log_berries, log_canes
 
 if TYPE_CHECKING:
-    from softarm.harvest.rigs.sim_rig import SimRig
+    from softarm.harvest.rigs.sim.rig import SimRig
 
 __all__ = ["SimView", "attach"]
 

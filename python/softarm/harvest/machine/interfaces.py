@@ -1,7 +1,7 @@
 """What the harvesting state machine depends on, as structural ``Protocol`` classes.
 
 The machine never talks to a camera, a DAQ board or the simulated arm directly: the
-simulated rig (:mod:`softarm.harvest.rigs.sim_rig`), the hardware rig and the test fakes each
+simulated rig (:mod:`softarm.harvest.rigs.sim.rig`), the hardware rig and the test fakes each
 provide these few objects.
 
 The devices have one vocabulary, :mod:`softarm.hardware.protocols` (``PressureBank``,

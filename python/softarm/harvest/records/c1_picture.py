@@ -43,7 +43,7 @@ LEGEND = (
 
 
 def c1_picture(scene: Any, seed: int) -> Image:
-    """The picture of ``scene`` (a :class:`~softarm.harvest.rigs.bush_world.BushScene` whose
+    """The picture of ``scene`` (a :class:`~softarm.harvest.rigs.sim.bush_world.BushScene` whose
     C1 is registered) now, titled with the bush's ``seed``."""
     stereo = scene.c1()
     image = _brighten(scene.c1_whole(0.0))

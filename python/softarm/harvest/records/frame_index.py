@@ -31,7 +31,7 @@ COMMANDS = "commands"
 #: The stream of the ripeness sensor's readings.
 RIPENESS = "ripeness"
 #: The stream of how each berry ended: ``[final state, fault or null, harvested,
-#: skipped unripe]`` (:func:`softarm.harvest.rigs.dry_run.berry_outcome`).
+#: skipped unripe]`` (:func:`softarm.harvest.rigs.replay.dry_run.berry_outcome`).
 BERRY_STATES = "berry_states"
 #: The stream holding the recorded run's seed (one non-negative integer).
 SEED = "seed"

@@ -127,7 +127,7 @@ def header_record(
     """The header's fields (without ``kind``): version, commit, start time, the command,
     its arguments (``argv`` as typed, ``options`` as parsed), the run's ``settings``
     (seed, world, plant, arm, frames, cameras:
-    :func:`softarm.harvest.rigs.sim_header.sim_settings`) and :data:`UNITS`."""
+    :func:`softarm.harvest.rigs.sim.header.sim_settings`) and :data:`UNITS`."""
     return {
         "format": FORMAT,
         "softarm": softarm.__version__,

@@ -100,7 +100,7 @@ class RunScene:
     @classmethod
     def _defaults(cls) -> RunScene:
         from softarm.harvest.records.header import camera
-        from softarm.harvest.rigs.sim_options import default_cameras
+        from softarm.harvest.rigs.sim.options import default_cameras
 
         cams = default_cameras()
         return cls(

@@ -27,17 +27,17 @@ from softarm.harvest.records.frame_files import FrameRecorder
 from softarm.harvest.records.log import HarvestLog
 from softarm.harvest.records.rate import rate_record
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.bush_world import BushScene
-from softarm.harvest.rigs.dry_run import (
+from softarm.harvest.rigs.replay.dry_run import (
     BERRY_STATES,
     COMMANDS,
     CommandTap,
     RecordedSensor,
     berry_outcome,
 )
-from softarm.harvest.rigs.sim_devices import ArmWatch, SimClock, SimGripper
-from softarm.harvest.rigs.sim_options import SimRigOptions, declared_plant, default_cameras
-from softarm.harvest.rigs.sim_worlds import WORLDS, HarvestWorld, WorldParts
+from softarm.harvest.rigs.sim.bush_world import BushScene
+from softarm.harvest.rigs.sim.devices import ArmWatch, SimClock, SimGripper
+from softarm.harvest.rigs.sim.options import SimRigOptions, declared_plant, default_cameras
+from softarm.harvest.rigs.sim.worlds import WORLDS, HarvestWorld, WorldParts
 from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.perception.self_filter import rig_parts
 from softarm.sim.arm import SimulatedArm

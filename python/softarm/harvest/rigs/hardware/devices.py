@@ -1,7 +1,7 @@
-"""The hardware rig's device boundary: what :func:`~softarm.harvest.rigs.hw_rig.
+"""The hardware rig's device boundary: what :func:`~softarm.harvest.rigs.hardware.rig.
 build_hardware_rig` opens, and nothing else. :class:`DeviceDrivers` opens the real
 devices (the DAQ's analog outputs, the Arduino, the cameras, the wall clock); the dry
-run (:mod:`softarm.harvest.rigs.replay_devices`) puts recorded frames and readings in their
+run (:mod:`softarm.harvest.rigs.replay.devices`) puts recorded frames and readings in their
 place, so the rest of the hardware path runs as it does on the arm.
 """
 
@@ -20,7 +20,7 @@ from softarm.hardware.daq import NidaqPressureBank
 from softarm.hardware.pressure_map import VoltageMap
 from softarm.hardware.protocols import PressureBank
 from softarm.harvest.machine.interfaces import Clock
-from softarm.harvest.rigs.hw_stereo import open_stereo
+from softarm.harvest.rigs.hardware.stereo import open_stereo
 from softarm.perception.c1 import Pair
 from softarm.perception_config import PerceptionConfig
 from softarm.vision.two_cameras import Frame

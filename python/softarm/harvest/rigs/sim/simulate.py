@@ -34,7 +34,7 @@ def simulate(
     mm and deg, time; ``report.to_dict()`` is the JSON of ``softarm harvest --report``).
 
     A thin wrapper over ``build_sim_rig(SimRigOptions(...)).run(on_berry)``
-    (:mod:`softarm.harvest.rigs.sim_rig`): the same bush, plant, cameras and control stack as
+    (:mod:`softarm.harvest.rigs.sim.rig`): the same bush, plant, cameras and control stack as
     ``softarm harvest --sim --berries N --seed S``, with no output on the console.
 
     Args:
@@ -58,9 +58,9 @@ def simulate(
         softarm.errors.SoftarmError: a bad value (as the command line reports it).
     """
     from softarm.harvest.records.header import HEADER, header_record
-    from softarm.harvest.rigs.sim_header import sim_settings
-    from softarm.harvest.rigs.sim_options import SimRigOptions
-    from softarm.harvest.rigs.sim_rig import build_sim_rig
+    from softarm.harvest.rigs.sim.header import sim_settings
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     _check_options(options, SimRigOptions)
     if options.get("world") in ("bush", "row"):  # before the log: a typed error, not MuJoCo's

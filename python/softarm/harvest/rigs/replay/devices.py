@@ -1,5 +1,5 @@
 """The dry run's devices: the hardware rig's boundary (:class:`~softarm.harvest.
-hw_devices.Devices`) fed from a recording (:mod:`softarm.harvest.rigs.dry_run`).
+hw_devices.Devices`) fed from a recording (:mod:`softarm.harvest.rigs.replay.dry_run`).
 
 The cameras read the recorded frames, each at the time it was recorded; the Arduino
 answers the gripper's commands and gives the recorded ripeness readings; the pressure
@@ -22,8 +22,8 @@ from softarm.config import Config
 from softarm.errors import HardwareError
 from softarm.harvest.records.frame_files import FrameFolder
 from softarm.harvest.records.frame_index import COMMANDS, RIPENESS, SEED
-from softarm.harvest.rigs.dry_run import CommandTap
-from softarm.harvest.rigs.sim_devices import SimClock
+from softarm.harvest.rigs.replay.dry_run import CommandTap
+from softarm.harvest.rigs.sim.devices import SimClock
 from softarm.perception.c1 import Pair
 from softarm.perception_config import PerceptionConfig
 from softarm.vision.two_cameras import Frame

@@ -20,7 +20,7 @@ from softarm.harvest.machine.harvest_machine import HarvestMachine
 from softarm.harvest.machine.interfaces import BerryTarget
 from softarm.harvest.machine.states import FAULTS_THAT_STOP
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.sim_devices import SimGripper
+from softarm.harvest.rigs.sim.devices import SimGripper
 from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.harvest.runs.map_run import harvest_map
 from softarm.harvest.runs.policy import finish_run

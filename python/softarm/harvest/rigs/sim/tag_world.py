@@ -13,7 +13,7 @@ from softarm.harvest.control.stack import ControlStack
 from softarm.harvest.machine.harvest_machine import HarvestMachine
 from softarm.harvest.machine.interfaces import BerryTarget
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.sim_devices import SimGripper
+from softarm.harvest.rigs.sim.devices import SimGripper
 from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.harvest.runs.policy import run_targets
 from softarm.sim.bush import Berry, Bush

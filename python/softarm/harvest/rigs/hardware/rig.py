@@ -31,8 +31,8 @@ from softarm.harvest.machine.interfaces import BerryTarget, Clock
 from softarm.harvest.machine.states import FAULTS_THAT_STOP
 from softarm.harvest.records.log import HarvestLog
 from softarm.harvest.records.report import HarvestReport
-from softarm.harvest.rigs.hw_devices import DeviceDrivers, Devices
-from softarm.harvest.rigs.hw_stereo import stereo_camera
+from softarm.harvest.rigs.hardware.devices import DeviceDrivers, Devices
+from softarm.harvest.rigs.hardware.stereo import stereo_camera
 from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.harvest.runs.map_run import harvest_map
 from softarm.harvest.runs.policy import finish_run, run_targets

@@ -13,8 +13,8 @@ from softarm.harvest.records.header import (
     pressure_settings,
     world_settings,
 )
-from softarm.harvest.rigs.sim_options import SimRigOptions, default_cameras
-from softarm.harvest.rigs.sim_rig import SimRig
+from softarm.harvest.rigs.sim.options import SimRigOptions, default_cameras
+from softarm.harvest.rigs.sim.rig import SimRig
 
 __all__ = ["sim_settings"]
 

@@ -77,7 +77,7 @@ class SimRigOptions:
     gains: Mapping[str, Any] = field(default_factory=dict)
     #: A folder to record the rendered bush's frames, the ripeness readings and the
     #: pressure commands in, with the rig's hw.toml: the dry run's input
-    #: (:mod:`softarm.harvest.rigs.dry_run`).
+    #: (:mod:`softarm.harvest.rigs.replay.dry_run`).
     record_frames: str | Path | None = None
     #: The gripper's marker body C1 tracks (softarm.vision.marker_body.MARKER_BODIES;
     #: ``--marker-body``), drawn in every world; hw.toml's ``[calibration] marker_body``.

@@ -15,7 +15,7 @@ import numpy.typing as npt
 
 from softarm.checks import FloatArray
 from softarm.harvest.records.report import HarvestReport
-from softarm.harvest.rigs.sim_rig import SimRig
+from softarm.harvest.rigs.sim.rig import SimRig
 from softarm.viz.arm import arm_line, clip_to_box
 from softarm.viz.gripper import gripper_polylines
 
@@ -81,7 +81,7 @@ def berry_paths(
     rest (ramps to and from the ready pose).
 
     ``trajectory`` holds one position after every clock step of ``period`` seconds (the
-    rig's :class:`~softarm.harvest.rigs.sim_devices.ArmWatch`); the stages' times come from the
+    rig's :class:`~softarm.harvest.rigs.sim.devices.ArmWatch`); the stages' times come from the
     run log's transitions."""
     path = np.asarray(trajectory, dtype=np.float64).reshape(-1, 3)
     times = period * np.arange(1, len(path) + 1)

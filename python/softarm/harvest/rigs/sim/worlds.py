@@ -14,14 +14,14 @@ from softarm.harvest.control.stack import ControlStack
 from softarm.harvest.machine.harvest_machine import HarvestMachine
 from softarm.harvest.records.frame_files import FrameRecorder
 from softarm.harvest.records.report import BerryResult, HarvestReport
-from softarm.harvest.rigs.bush_world import BushGripper, BushScene, RenderedWorld
-from softarm.harvest.rigs.dry_run import (
+from softarm.harvest.rigs.replay.dry_run import (
     RigDescription,
     write_rig_files,
 )
-from softarm.harvest.rigs.sim_devices import SimClock, SimGripper
-from softarm.harvest.rigs.sim_options import SimRigOptions, declared_plant
-from softarm.harvest.rigs.tag_world import TagWorld
+from softarm.harvest.rigs.sim.bush_world import BushGripper, BushScene, RenderedWorld
+from softarm.harvest.rigs.sim.devices import SimClock, SimGripper
+from softarm.harvest.rigs.sim.options import SimRigOptions, declared_plant
+from softarm.harvest.rigs.sim.tag_world import TagWorld
 from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.perception.bush_map import BushMap
 from softarm.perception.bush_vision import BushVision
@@ -43,8 +43,8 @@ __all__ = ["C2_SCALE", "WORLDS", "HarvestWorld", "WorldParts"]
 
 class HarvestWorld(World, Protocol):
     """A :class:`~softarm.sim.world.World` the simulated rig harvests: its berry source
-    run by the run policy (:class:`~softarm.harvest.rigs.tag_world.TagWorld`,
-    :class:`~softarm.harvest.rigs.bush_world.RenderedWorld`)."""
+    run by the run policy (:class:`~softarm.harvest.rigs.sim.tag_world.TagWorld`,
+    :class:`~softarm.harvest.rigs.sim.bush_world.RenderedWorld`)."""
 
     def harvest(
         self, machine: HarvestMachine, on_berry: Callable[[int, BerryResult], None] | None

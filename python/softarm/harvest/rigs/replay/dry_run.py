@@ -7,7 +7,7 @@ ripeness sensor's readings, and every pressure command sent. It writes ``DIR/hw.
 the hardware configuration of the simulated rig (arm, channels, calibration, the
 plant's declared lag, ``[perception]``) with its camera files. ``softarm harvest
 --config DIR/hw.toml --frames DIR --dry-run`` then builds the hardware rig on
-:class:`~softarm.harvest.rigs.replay_devices.ReplayDevices` and must send the same commands.
+:class:`~softarm.harvest.rigs.replay.devices.ReplayDevices` and must send the same commands.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from softarm.config import (
 from softarm.harvest.records.frame_files import FrameRecorder
 from softarm.harvest.records.frame_index import BERRY_STATES, COMMANDS, RIPENESS
 from softarm.harvest.records.report import BerryResult
-from softarm.harvest.rigs.bush_world import BushScene
+from softarm.harvest.rigs.sim.bush_world import BushScene
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.perception_config import PerceptionConfig, StereoSource

@@ -1,0 +1,2 @@
+"""The dry run: a simulated harvest recorded, and replayed through the hardware rig with
+the recorded frames and readings in the devices' place."""
