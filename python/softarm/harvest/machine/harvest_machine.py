@@ -26,7 +26,6 @@ not relax the arm through the canes; after a stall it re-approaches along anothe
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -47,6 +46,7 @@ from softarm.harvest.machine.interfaces import (
 )
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault
+from softarm.harvest.machine.reapproach import Reapproach
 from softarm.harvest.machine.servo import Servo
 from softarm.harvest.machine.states import FaultReason, HarvestState
 from softarm.harvest.records.bush_map_record import map_record
@@ -220,38 +220,22 @@ class HarvestMachine:
         before the fault: vented in the bush, the arm would relax to its rest shape
         through the canes."""
         c = self.config
-        tried: list[FloatArray] = []
-        nearest: _Attempt | None = None  # the fine-positioning stall nearest the berry
-        back_to: _Attempt | None = None  # coming back to it
+        policy = Reapproach(
+            c.reapproaches, c.stall_progress, c.grasp_workspace, self.planner is not None
+        )
         while True:
-            waypoints, self.axis, back_to = self._next_plan(watch, tried, nearest, back_to)
-            more = back_to is None and self.planner is not None and len(tried) < c.reapproaches
-            if more:
-                grasp_within = c.stall_progress  # the stall rule's resolution: try another
-            elif back_to is None and nearest is not None:
-                grasp_within = nearest.grasp_error  # no worse than the nearest attempt
-            else:
-                grasp_within = c.grasp_workspace
+            waypoints, self.axis = self._next_plan(watch, policy)
             try:
                 self.servo.place(watch, self.state, self.q, self.axis, waypoints)
                 self._transition(HarvestState.FINE_POSITIONING, berry, "pre-grasp pose reached")
-                self.servo.fine(watch, self.state, self.q, self.axis, grasp_within)
+                self.servo.fine(watch, self.state, self.q, self.axis, policy.grasp_within())
                 return waypoints
             except Fault as fault:
                 if fault.retreat_from is None:
                     raise
-                stalled = fault.reason is FaultReason.UNREACHABLE
-                error = fault.grasp_error
-                if stalled and error is not None and error <= c.grasp_workspace:
-                    if nearest is None or error < nearest.grasp_error:
-                        nearest = _Attempt(error, self.axis, waypoints)
-                if stalled and more:
-                    again, why = True, "re-approach"
-                elif stalled and back_to is None and nearest is not None:
-                    again, why, back_to = True, "back to the nearest attempt", nearest
-                else:
-                    again, why = False, "backing out before the fault"
-                self._transition(HarvestState.RETURN_HOME, berry, f"{why}: {fault}")
+                why = policy.after(fault, self.axis, waypoints)
+                leaving = why or "backing out before the fault"
+                self._transition(HarvestState.RETURN_HOME, berry, f"{leaving}: {fault}")
                 try:
                     self.servo.go_home(
                         watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
@@ -259,45 +243,35 @@ class HarvestMachine:
                 except Fault as failed:
                     self.log.event("retreat_failed", t=self.clock.now(), detail=str(failed))
                     raise fault from failed
-                if not again:
+                if why is None:
                     raise
-                if back_to is None:
-                    tried.append(self.axis)
+                reason = policy.again(self.axis)
                 self.servo.wait_visible(watch, self.state, self.q)
-                self._transition(
-                    HarvestState.INITIAL_PLACEMENT,
-                    berry,
-                    f"re-approach {len(tried)}: another axis"
-                    if back_to is None
-                    else f"back to the axis that ended {1e3 * back_to.grasp_error:.1f} mm off",
-                )
+                self._transition(HarvestState.INITIAL_PLACEMENT, berry, reason)
 
     def _next_plan(
-        self,
-        watch: BerryWatch,
-        tried: list[FloatArray],
-        nearest: _Attempt | None,
-        back_to: _Attempt | None,
-    ) -> tuple[tuple[FloatArray, ...], FloatArray, _Attempt | None]:
-        """The next attempt's waypoints and axis, and the earlier attempt it comes back
-        to (None for a new plan): ``back_to``'s plan; else a new plan along an axis not
-        ``tried``; when a re-approach finds none, the ``nearest`` earlier attempt inside
-        the gripper's reach, come back to as after a last stall (without it the berry is
-        UNREACHABLE); without a planner, the configured axis."""
-        if back_to is not None:
-            return back_to.waypoints, back_to.axis, back_to
+        self, watch: BerryWatch, policy: Reapproach
+    ) -> tuple[tuple[FloatArray, ...], FloatArray]:
+        """The next attempt's waypoints and axis: the plan of the attempt ``policy``
+        comes back to; else a new plan along an axis not tried; when a re-approach finds
+        none, the nearest earlier attempt inside the gripper's reach, come back to as
+        after a last stall (without it the berry is UNREACHABLE); without a planner, the
+        configured axis."""
+        if policy.back_to is not None:
+            return policy.back_to.waypoints, policy.back_to.axis
         if self.planner is None:
-            return (), self.config.approach_axis, None
+            return (), self.config.approach_axis
         try:
-            waypoints, axis = self.servo.plan(watch, self.q, self.planner, tried)
+            return self.servo.plan(watch, self.q, self.planner, policy.tried)
         except Fault as fault:
-            if not tried or nearest is None or fault.reason is not FaultReason.UNREACHABLE:
+            nearest = policy.nearest
+            if not policy.tried or nearest is None or fault.reason is not FaultReason.UNREACHABLE:
                 raise
             self.log.event(
                 "no_other_axis", t=self.clock.now(), back_to_mm=1e3 * nearest.grasp_error
             )
-            return nearest.waypoints, nearest.axis, nearest
-        return waypoints, axis, None
+            policy.back_to = nearest
+            return nearest.waypoints, nearest.axis
 
     def _finish(self, result: BerryResult, watch: BerryWatch, start: float) -> BerryResult:
         """Record what the stages observed, the final state and the time into ``result``."""
@@ -395,13 +369,3 @@ def _reason(exc: BaseException) -> FaultReason:
 def _detail(exc: BaseException) -> str:
     """What the fault log says of ``exc``: a stage's own message, else the error."""
     return str(exc) if isinstance(exc, Fault) else repr(exc)
-
-
-@dataclass(frozen=True)
-class _Attempt:
-    """An approach that stalled in fine positioning ``grasp_error`` (m) from the berry,
-    inside the gripper's reach: its ``axis`` and placement ``waypoints``, to come back to."""
-
-    grasp_error: float
-    axis: FloatArray
-    waypoints: tuple[FloatArray, ...]
