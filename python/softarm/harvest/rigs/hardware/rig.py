@@ -206,7 +206,8 @@ def _rig_parts(config: Config, cfg: HarvestConfig, model: SoftArm) -> FloatArray
     cube and (where the config places it) the base tag."""
     cal = config.calibration
     tag = None if cal.T_base_tag is None else np.array(cal.T_base_tag)
-    return rig_parts(model, cfg, np.array(cal.T_EE_cube), tag)
+    body = marker_body(cal.marker_body, cal.marker_length)
+    return rig_parts(model, cfg, np.array(cal.T_EE_cube), tag, body)
 
 
 def _vision(

@@ -46,7 +46,7 @@ from softarm.sim.plant import ArmPlant
 from softarm.sim.rig_cameras import SimCameras
 from softarm.sim.world import WorldName
 from softarm.units import MAX_PSI
-from softarm.vision.marker_body import check_marker_body
+from softarm.vision.marker_body import check_marker_body, marker_body
 from softarm.vision.two_cameras import CameraVision
 
 __all__ = ["SimRig", "build_sim_rig", "control_inputs", "sim_bush"]
@@ -152,7 +152,8 @@ def _build_sim_rig(
     watch = _watch(o, plant, canes)
     clock = SimClock([plant.advance, watch.sample])
     bank = _bank(plant, clock, recorder)
-    parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag)
+    body = marker_body(cams.marker_body, cams.cube_marker)
+    parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag, body)
     world = WORLDS[o.world](WorldParts(o, bush, canes, plant, model, cams, parts, clock, recorder))
     stack = build_control_stack(
         cfg, control_inputs(o, model), list(world.known_canes()), bank, clock.now
