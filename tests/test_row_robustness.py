@@ -142,13 +142,15 @@ def test_a_cell_pools_its_seeds_and_counts_failures() -> None:
     def row(t: Tally, located: int) -> dict[str, Any]:
         stereo = {"targets": 4, "located": located, "errors_mm": [2.0, 8.0]}
         det = {"tally": asdict(t), "stereo": stereo}
-        canes = {"coverage": 0.5, "precision": 1.0, "median_mm": 2.0, "length_m": 1.0, "fits": 2}
+        canes = {"coverage": 0.5, "precision": 1.0, "median_mm": 2.0, "median_all_mm": 9.0,
+                 "length_m": 1.0, "fits": 2}  # fmt: skip
         return {"error": None, "fruit_in_view": 10, "ripe_targets": 4,
                 "detectors": {"colour": det}, "canes": canes}  # fmt: skip
 
     no_fit = row(b, 1)
-    no_fit["canes"] = {"coverage": 0.0, "precision": 0.0, "median_mm": None, "length_m": 1.0,
-                       "fits": 0}  # fmt: skip
+    # Two fits, both beyond the workspace: none in it (cane_map_error's precision 0).
+    no_fit["canes"] = {"coverage": 0.0, "precision": 0.0, "median_mm": None,
+                       "median_all_mm": None, "length_m": 1.0, "fits": 2}  # fmt: skip
     rows = [row(a, 2), row(b, 1), no_fit, {"error": "RuntimeError: x"}]
     rows[0]["detectors"]["colour"]["wrong_ripe_on"] = {"clutter": 1}
     rows[1]["detectors"]["colour"]["wrong_ripe_on"] = {"clutter": 2, "turning": 1}
@@ -158,7 +160,7 @@ def test_a_cell_pools_its_seeds_and_counts_failures() -> None:
     assert colour["ripe_precision"] == round(5 / 8, 3) and colour["recall_ripe"] == round(5 / 11, 3)
     assert colour["located"] == round(4 / 12, 3) and colour["stereo_median_mm"] == 5.0
     assert colour["wrong_ripe_on"] == {"clutter": 3, "turning": 1}
-    # A frame without any cane fit lowers the coverage, not the precision.
+    # A frame without a fitted cane in the workspace lowers the coverage, not the precision.
     assert cell["canes"] == {"coverage": round(1 / 3, 3), "precision": 1.0, "median_mm": 2.0,
                              "frames_without_fit": 1}  # fmt: skip
 

@@ -115,7 +115,8 @@ def _detector_summary(frames: list[Mapping[str, Any]]) -> dict[str, Any]:
 def _cane_summary(canes: list[Mapping[str, Any]]) -> dict[str, Any]:
     length = np.array([c["length_m"] for c in canes])
     medians = [c["median_mm"] for c in canes if c["median_mm"] is not None]
-    fitted = [c["precision"] for c in canes if c.get("fits", 1)]  # a frame with no fit has none
+    # A frame with no fitted cane in the workspace has no distances and no precision.
+    fitted = [c["precision"] for c in canes if c["median_all_mm"] is not None]
     coverage = np.sum(length * [c["coverage"] for c in canes]) / np.sum(length)
     return {
         "coverage": round(float(coverage), 3) if np.sum(length) > 0 else None,
@@ -129,8 +130,8 @@ def cell_summary(rows: Sequence[Mapping[str, Any]], detectors: Sequence[str]) ->
     """One cell's figures pooled over its seeds' ``rows`` (trial results; failed ones
     counted, not scored): per detector the pooled tallies' ripe precision, ripe recall,
     precision, stage right and the stereo's located share and median error; the cane
-    map's length-weighted coverage, mean precision over the frames with a fit, median of
-    the frames' medians and the frames without any fit."""
+    map's length-weighted coverage, mean precision over the frames with a fit in the
+    workspace, median of the frames' medians and the frames without one."""
     good = [r for r in rows if r.get("error") is None]
     out: dict[str, Any] = {
         "frames": len(good),
