@@ -283,6 +283,13 @@ def markdown_table(doc: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _dumps(doc: dict[str, Any]) -> str:
+    """``doc`` as JSON, one line per cell (small, and a cell's change one line of diff)."""
+    head = json.dumps({k: v for k, v in doc.items() if k != "cells"}, indent=1)
+    cells = ",\n  ".join(json.dumps(c, separators=(",", ":")) for c in doc["cells"])
+    return f'{head[:-2]},\n "cells": [\n  {cells}\n ]\n}}\n'
+
+
 def write_outputs(doc: dict[str, Any], out: str | Path, picture: bool = True) -> list[Path]:
     """``row_robustness.json``, ``.md`` and (``picture``) ``row_robustness_map.png`` in
     ``out``; returns their paths."""
@@ -291,7 +298,7 @@ def write_outputs(doc: dict[str, Any], out: str | Path, picture: bool = True) ->
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / "row_robustness.json", out / "row_robustness.md"]
-    write_text(paths[0], json.dumps(doc, indent=1) + "\n", "out")
+    write_text(paths[0], _dumps(doc), "out")
     write_text(paths[1], markdown_table(doc), "out")
     if picture:
         from softarm.sweep.perception_plot import plot_map
