@@ -126,7 +126,7 @@ class HarvestConfig:
     home_elongation: float = 0.0167
     arrival_tolerance: float = 0.001
     follow_blind_time: float = 0.15
-    handover_tolerance: float = 0.01
+    handover_tolerance: float = 0.001
     lead_cap: float = 1.5
     transport_margin: float = 0.01
 
