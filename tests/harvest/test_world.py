@@ -79,3 +79,13 @@ def test_the_switch_check_can_fail() -> None:
     assert _name_switches('if o.world == "bush":\n    pass\n') == [1]
     assert _name_switches('if args.world in ("bush", "row"):\n    pass\n') == []  # a tuple
     assert _name_switches("if o.world is WorldName.ROW:\n    pass\n") == []
+
+
+def test_the_lag_control_mode_is_an_enum_checked_where_it_is_made() -> None:
+    from softarm.harvest.control.stack import ControlInputs, LagControl
+
+    arm = softarm.SoftArm.blackberry()
+    assert ControlInputs(arm, lag_control="bound").lag_control is LagControl.BOUND  # type: ignore[arg-type]
+    assert ControlInputs(arm).lag_control is LagControl.PREDICTOR
+    with pytest.raises(ParameterError, match="lag_control = 'fast'"):
+        ControlInputs(arm, lag_control="fast")  # type: ignore[arg-type]

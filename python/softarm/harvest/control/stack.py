@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
 import numpy as np
@@ -35,10 +36,16 @@ from softarm.harvest.control.plant_model import MEASUREMENT_LAG_PERIODS
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 
-__all__ = ["ControlInputs", "ControlStack", "build_control_stack", "gains_over"]
+__all__ = ["ControlInputs", "ControlStack", "LagControl", "build_control_stack", "gains_over"]
 
-#: The lag-control modes (docs/control.md, section 6).
-LAG_CONTROLS = ("predictor", "bound")
+
+class LagControl(StrEnum):
+    """How the loop handles the plant's lag (docs/control.md, section 6): ``predictor``
+    (a lag model of every command, its motion in flight taken out of the error) or
+    ``bound`` (the gain bounded by the whole lag)."""
+
+    PREDICTOR = "predictor"
+    BOUND = "bound"
 
 
 @dataclass(frozen=True)
@@ -61,10 +68,17 @@ class ControlInputs:
     lag_s: float | None = None
     play_m: Any = 0.0
     gains: Mapping[str, Any] = field(default_factory=dict)
-    lag_control: str = "predictor"
+    lag_control: LagControl = LagControl.PREDICTOR
     joint_limit_gain: float | None = None
     avoid_canes: bool = True
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.lag_control not in LagControl._value2member_map_:
+            raise ParameterError(
+                f"lag_control = {self.lag_control!r}: must be 'predictor' or 'bound'"
+            )
+        object.__setattr__(self, "lag_control", LagControl(self.lag_control))
 
     @classmethod
     def of_plant(
@@ -85,7 +99,7 @@ class ControlInputs:
     @property
     def predicts(self) -> bool:
         """Whether the loop runs on a lag model (a known lag, in predictor mode)."""
-        return self.lag_control == "predictor" and self.lag_s is not None
+        return self.lag_control is LagControl.PREDICTOR and self.lag_s is not None
 
 
 @dataclass
@@ -145,10 +159,6 @@ def build_control_stack(
 ) -> ControlStack:
     """The control stack on ``bank`` (behind its safety layer), timed by ``now``, with
     ``canes`` (the known obstacles, possibly none) avoided by planner and controller."""
-    if inputs.lag_control not in LAG_CONTROLS:
-        raise ParameterError(
-            f"lag_control = {inputs.lag_control!r}: must be 'predictor' or 'bound'"
-        )
     actuator = _actuator(cfg, inputs, bank, now)
     # The model arm's gap to the known canes: the planner checks its plans with it, the
     # controller keeps the lagging arm's way to each command clear with it.

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from softarm.calibration.result import Calibration
+from softarm.harvest.control.stack import LagControl
 from softarm.harvest_config import HarvestConfig
 from softarm.identified_plant import IdentifiedPlant
 from softarm.sim.arm import PlantConfig
@@ -54,7 +55,7 @@ class SimRigOptions:
     #: lag model of every command sent, regulators then pose filter, whose motion still
     #: in flight each step takes out of the measured error; the mode's gain) or "bound"
     #: (no model: the gain bounded by the whole lag, `Gains.for_lag`).
-    lag_control: str = "predictor"
+    lag_control: LagControl = LagControl.PREDICTOR
     #: "tags": every berry wears an ArUco tag and the canes are mapped (fast, for
     #: controller sweeps); "bush": the rendered bush, berries and canes found by
     #: perception (softarm.perception), the markerless harvest; "row": the same in
