@@ -311,6 +311,23 @@ def test_no_function_of_the_package_is_over_80_lines() -> None:
     assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
 
 
+MAX_CLASS_LINES = 300
+
+
+def test_no_class_of_the_package_is_over_300_lines() -> None:
+    """Small objects (issue 38 item 5): a class over 300 lines holds more than one job."""
+    long = [
+        f"{path.relative_to(PACKAGE).as_posix()}:{node.lineno} {node.name} "
+        f"({node.end_lineno - node.lineno + 1} lines)"
+        for path in _modules(PACKAGE)
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.ClassDef)
+        and node.end_lineno is not None
+        and node.end_lineno - node.lineno + 1 > MAX_CLASS_LINES
+    ]
+    assert not long, f"classes over {MAX_CLASS_LINES} lines: {long}"
+
+
 def test_the_names_a_config_lists_are_the_modules_own() -> None:
     """The config layer lists the names of what sits above it (so that reading a config
     imports no perception or vision); each list must equal its module's."""

@@ -113,18 +113,8 @@ class SyntheticCamera:
         self.noise_std, self.blur = float(noise_std), float(blur)
         self.supersample = int(supersample)
         self.lighting = lighting or Lighting()
-        self._rng = np.random.default_rng(seed)
-        self._bank: npt.NDArray[np.float32] | None = None
-        # Normalised coordinates (x/z, y/z) of every pixel corner: pixel (r, c) spans
-        # corners [r, r+1] x [c, c+1], i.e. pixel positions c - 0.5 .. c + 0.5.
-        grid = np.stack(
-            np.meshgrid(np.arange(self.width + 1) - 0.5, np.arange(self.height + 1) - 0.5), -1
-        )
-        # float32 is ample: 6e-8 relative error is 5e-5 px at f = 900 px.
-        self._corners = model.normalize(grid.reshape(-1, 2)).reshape(grid.shape).astype(np.float32)
-        s = self.supersample
-        self._offsets = ((np.arange(s) + 0.5) / s).astype(np.float32)  # sub-sample centres
-        self._ray_table: npt.NDArray[np.float32] | None = None
+        self._noise = NoiseBank(self.width, self.height, seed)
+        self._pixel_rays = PixelRays(model, self.width, self.height, self.supersample)
         self._patches: OrderedDict[tuple[object, ...], Any] = OrderedDict()
         self._planes: dict[tuple[object, ...], tuple[TexturedPlane, Box | None]] = {}
         self._vignette_cache: tuple[float, npt.NDArray[np.float32]] | None = None
@@ -237,7 +227,7 @@ class SyntheticCamera:
         if self.blur > 0:
             img = np.asarray(cv2.GaussianBlur(img, (0, 0), self.blur), dtype=np.float32)
         if self.noise_std > 0:
-            frame, flip = self._noise(y1 - y0, x1 - x0)
+            frame, flip = self._noise.draw(y1 - y0, x1 - x0)
             noise = np.float32(self.noise_std) * frame
             img += -noise if flip else noise
         np.maximum(img, 0.0, out=img)
@@ -282,7 +272,7 @@ class SyntheticCamera:
         pose = item.T_camera_plane
         rot, t = pose[:3, :3], pose[:3, 3]
         x0, y0, x1, y1 = layer.box
-        rays = self._rays(layer.box)
+        rays = self._pixel_rays.of(layer.box)
         # Ray-plane intersection as a homography: (u, v, 1) ∝ [r1 r2 t]⁻¹ (x, y, 1).
         hinv = np.linalg.inv(np.column_stack([rot[:, 0], rot[:, 1], t]))
         tex = item.texture
@@ -324,50 +314,6 @@ class SyntheticCamera:
         color = ink * alpha + paper * refl
         return alpha, color
 
-    def _rays(self, box: Box) -> npt.NDArray[np.float32]:
-        """Normalised (x, y) of the sub-samples of ``box`` (rows of sub-samples, columns,
-        2), a view of the whole frame's table where it is kept."""
-        x0, y0, x1, y1 = box
-        s = self.supersample
-        if self._ray_table is None and 8 * self.width * self.height * s * s <= MAX_RAY_TABLE_BYTES:
-            self._ray_table = self._interpolate((0, 0, self.width, self.height))
-        if self._ray_table is not None:
-            return self._ray_table[y0 * s : y1 * s, x0 * s : x1 * s]
-        return self._interpolate(box)
-
-    def _interpolate(self, box: Box) -> npt.NDArray[np.float32]:
-        """Sub-sample rays of ``box`` by bilinear interpolation of the corner table
-        (distortion is smooth on a one-pixel scale, so this is exact to far below a
-        micro-pixel); the same arithmetic for a box as for the whole frame."""
-        x0, y0, x1, y1 = box
-        s = self.supersample
-        c = self._corners
-        c00, c01 = c[y0:y1, x0:x1], c[y0:y1, x0 + 1 : x1 + 1]
-        c10, c11 = c[y0 + 1 : y1 + 1, x0:x1], c[y0 + 1 : y1 + 1, x0 + 1 : x1 + 1]
-        a = self._offsets[None, None, None, :, None]  # along x
-        b = self._offsets[None, :, None, None, None]  # along y
-        top = c00[:, None, :, None] * (1 - a) + c01[:, None, :, None] * a
-        bot = c10[:, None, :, None] * (1 - a) + c11[:, None, :, None] * a
-        rays = (top * (1 - b) + bot * b).reshape((y1 - y0) * s, (x1 - x0) * s, 2)
-        return cast(npt.NDArray[np.float32], rays)  # float32 throughout; the stubs widen
-
-    def _noise(self, height: int, width: int) -> tuple[npt.NDArray[np.float32], bool]:
-        """(height, width) of N(0, 1) noise and whether to negate it: a random window of a
-        bank of two full frames of normals, with a random sign, a quarter of the window's
-        size redrawn at a random place of the bank each frame. Drawing a whole frame of
-        normals costs ~12 ms; this costs ~2 ms for a full frame (less for a crop), and each
-        pixel is still N(0, 1), nearly independent from frame to frame."""
-        size = 2 * self.width * self.height
-        if self._bank is None:
-            self._bank = self._rng.standard_normal(size, dtype=np.float32)
-        n = height * width
-        chunk = n // 4
-        start = int(self._rng.integers(0, size - chunk))
-        self._bank[start : start + chunk] = self._rng.standard_normal(chunk, dtype=np.float32)
-        offset = int(self._rng.integers(0, size - n))
-        frame = self._bank[offset : offset + n].reshape(height, width)
-        return frame, bool(self._rng.integers(0, 2))
-
     def _bbox(self, plane: TexturedPlane) -> Box | None:
         """Pixel bounding box [x0, x1) x [y0, y1) of the plane's projection, or None."""
         outline = _UNIT_OUTLINE * [plane.width, plane.height]
@@ -405,6 +351,75 @@ class SyntheticCamera:
         self._vignette_cache = (amount, table)
         result: npt.NDArray[np.float32] = table
         return result
+
+
+class PixelRays:
+    """The normalised rays (x/z, y/z) through a camera's pixels' sub-samples: the
+    distorted pixel grid's corners, interpolated, kept whole when the table fits."""
+
+    def __init__(self, model: CameraModel, width: int, height: int, supersample: int) -> None:
+        self.width, self.height, self.supersample = width, height, supersample
+        # Normalised coordinates (x/z, y/z) of every pixel corner: pixel (r, c) spans
+        # corners [r, r+1] x [c, c+1], i.e. pixel positions c - 0.5 .. c + 0.5.
+        grid = np.stack(np.meshgrid(np.arange(width + 1) - 0.5, np.arange(height + 1) - 0.5), -1)
+        # float32 is ample: 6e-8 relative error is 5e-5 px at f = 900 px.
+        self._corners = model.normalize(grid.reshape(-1, 2)).reshape(grid.shape).astype(np.float32)
+        s = supersample
+        self._offsets = ((np.arange(s) + 0.5) / s).astype(np.float32)  # sub-sample centres
+        self._ray_table: npt.NDArray[np.float32] | None = None
+
+    def of(self, box: Box) -> npt.NDArray[np.float32]:
+        """Normalised (x, y) of the sub-samples of ``box`` (rows of sub-samples, columns,
+        2), a view of the whole frame's table where it is kept."""
+        x0, y0, x1, y1 = box
+        s = self.supersample
+        if self._ray_table is None and 8 * self.width * self.height * s * s <= MAX_RAY_TABLE_BYTES:
+            self._ray_table = self._interpolate((0, 0, self.width, self.height))
+        if self._ray_table is not None:
+            return self._ray_table[y0 * s : y1 * s, x0 * s : x1 * s]
+        return self._interpolate(box)
+
+    def _interpolate(self, box: Box) -> npt.NDArray[np.float32]:
+        """Sub-sample rays of ``box`` by bilinear interpolation of the corner table
+        (distortion is smooth on a one-pixel scale, so this is exact to far below a
+        micro-pixel); the same arithmetic for a box as for the whole frame."""
+        x0, y0, x1, y1 = box
+        s = self.supersample
+        c = self._corners
+        c00, c01 = c[y0:y1, x0:x1], c[y0:y1, x0 + 1 : x1 + 1]
+        c10, c11 = c[y0 + 1 : y1 + 1, x0:x1], c[y0 + 1 : y1 + 1, x0 + 1 : x1 + 1]
+        a = self._offsets[None, None, None, :, None]  # along x
+        b = self._offsets[None, :, None, None, None]  # along y
+        top = c00[:, None, :, None] * (1 - a) + c01[:, None, :, None] * a
+        bot = c10[:, None, :, None] * (1 - a) + c11[:, None, :, None] * a
+        rays = (top * (1 - b) + bot * b).reshape((y1 - y0) * s, (x1 - x0) * s, 2)
+        return cast(npt.NDArray[np.float32], rays)  # float32 throughout; the stubs widen
+
+
+class NoiseBank:
+    """Pixel noise for a ``width`` x ``height`` camera, drawn from a bank of normals."""
+
+    def __init__(self, width: int, height: int, seed: int | None) -> None:
+        self.width, self.height = width, height
+        self._rng = np.random.default_rng(seed)
+        self._bank: npt.NDArray[np.float32] | None = None
+
+    def draw(self, height: int, width: int) -> tuple[npt.NDArray[np.float32], bool]:
+        """(height, width) of N(0, 1) noise and whether to negate it: a random window of a
+        bank of two full frames of normals, with a random sign, a quarter of the window's
+        size redrawn at a random place of the bank each frame. Drawing a whole frame of
+        normals costs ~12 ms; this costs ~2 ms for a full frame (less for a crop), and each
+        pixel is still N(0, 1), nearly independent from frame to frame."""
+        size = 2 * self.width * self.height
+        if self._bank is None:
+            self._bank = self._rng.standard_normal(size, dtype=np.float32)
+        n = height * width
+        chunk = n // 4
+        start = int(self._rng.integers(0, size - chunk))
+        self._bank[start : start + chunk] = self._rng.standard_normal(chunk, dtype=np.float32)
+        offset = int(self._rng.integers(0, size - n))
+        frame = self._bank[offset : offset + n].reshape(height, width)
+        return frame, bool(self._rng.integers(0, 2))
 
 
 def _unit_outline() -> FloatArray:
