@@ -22,15 +22,21 @@ from softarm.commands._args import Parser, int_range, non_negative_int
 RULES = ("steps", "confidence")
 
 
-def one_bush(world: str, seed: int, berries: int, rule: str) -> dict[str, Any]:
-    """One simulated harvest under ``rule``: its report's figures this table needs."""
-    from softarm.harvest.rigs.sim_rig import SimRigOptions, build_sim_rig
+def one_bush(world: str, seed: int, berries: int, rule: str, body: str) -> dict[str, Any]:
+    """One simulated harvest under ``rule`` with the marker ``body`` on the gripper: its
+    report's figures this table needs."""
+    from softarm.harvest.rigs.sim.options import SimRigOptions
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.harvest_config import HarvestConfig
     from softarm.sim.world import WorldName
 
     config = HarvestConfig(fine_end_rule=rule)
     options = SimRigOptions(
-        n_berries=berries, seed=seed, world=WorldName.parse(world), config=config
+        n_berries=berries,
+        seed=seed,
+        world=WorldName.parse(world),
+        config=config,
+        marker_body=body,
     )
     rig = build_sim_rig(options)
     try:
@@ -43,6 +49,7 @@ def one_bush(world: str, seed: int, berries: int, rule: str) -> dict[str, Any]:
         "world": world,
         "seed": seed,
         "rule": rule,
+        "body": body,
         "ripe": report.get("ripe_in_reach", report["attempted"]),
         "harvested": rate["harvested"],
         "unripe_picked": report.get("unripe_picked", 0),
@@ -63,11 +70,15 @@ def summary(rows: list[dict[str, Any]]) -> str:
         "| true <= 0.5 mm | harvested | unripe | contacts | berries > 12 s |",
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    for world in sorted({r["world"] for r in rows}):
+    worlds = sorted({(r["world"], r.get("body", "cube")) for r in rows})
+    for world, body in worlds:
         for rule in RULES:
-            group = [r for r in rows if r["world"] == world and r["rule"] == rule]
+            group = [
+                r for r in rows
+                if (r["world"], r.get("body", "cube"), r["rule"]) == (world, body, rule)
+            ]  # fmt: skip
             if group:
-                out.append(_line(world, rule, group))
+                out.append(_line(f"{world} ({body})", rule, group))
     return "\n".join(out)
 
 
@@ -95,6 +106,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=non_negative_int, nargs="+", default=[1260])
     parser.add_argument("--berries", type=int_range(1, 20), default=3)
     parser.add_argument("--rules", choices=RULES, nargs="+", default=list(RULES))
+    parser.add_argument("--marker-body", choices=("cube", "frustum"), default="cube")
     parser.add_argument("--out", type=Path, default=Path("out/fine_rule.jsonl"))
     parser.add_argument("--summary", type=Path, nargs="+", help="print the table of these")
     args = parser.parse_args()
@@ -105,7 +117,7 @@ def main() -> None:
     args.out.parent.mkdir(parents=True, exist_ok=True)
     for seed in args.seeds:
         for rule in args.rules:
-            row = one_bush(args.world, seed, args.berries, rule)
+            row = one_bush(args.world, seed, args.berries, rule, args.marker_body)
             with args.out.open("a") as f:
                 f.write(json.dumps(row) + "\n")
             print(json.dumps(row), flush=True)
