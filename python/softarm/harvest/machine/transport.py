@@ -12,7 +12,7 @@ import numpy as np
 
 from softarm.errors import NonFiniteError, ParameterError
 from softarm.harvest.machine.arm_link import ArmLink
-from softarm.harvest.machine.interfaces import FloatArray
+from softarm.harvest.machine.interfaces import FloatArray, Observation
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault
 from softarm.harvest.machine.states import FaultReason, HarvestState
@@ -67,7 +67,6 @@ class Transport:
         saturates on the joint limits, which is why the plan's q leads."""
         c = self.link.cfg
         model_pose = self.link.controller.model_pose
-        lower, upper = self.link.controller.limits()
         step = c.home_speed * c.period
         nominal = np.asarray(q, dtype=np.float64).copy()  # the plan's point now
         goal_final = model_pose(q_way)
@@ -78,17 +77,8 @@ class Transport:
             seen = self.link.look(watch, q, need_fix=False)
             on_plan_end = bool(np.all(nominal == q_way))
             if seen.pose is None:
-                # A period without the cube's pose (a frame dropped, or a fast move's
-                # pose refused as a jump): the plan's feedforward goes on, open loop and
-                # its way checked, for up to ``follow_blind_time``; then the arm waits.
-                advance = straight_step(nominal, q_way, step)
-                if on_plan_end or seen.t - posed > c.follow_blind_time:
-                    advance = np.zeros_like(advance)
-                q_next = self.clear_way(q, (np.clip(q + advance, lower, upper),))
-                if q_next is not q:
-                    nominal = nominal + advance
-                watch.log_step(stage, seen, q_next, None, None, False)
-                q = self.link.hold(q_next)
+                blind = on_plan_end or seen.t - posed > c.follow_blind_time
+                q, nominal = self._blind(watch, stage, seen, q, nominal, q_way, blind)
                 continue
             posed = seen.t
             err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
@@ -117,12 +107,7 @@ class Transport:
             goal = model_pose(nominal)
             q_fb, saturated = self.link.controller.follow_step(q, goal, seen.pose)
             advance = straight_step(nominal, q_way, step)
-            # Feedforward of the plan's motion on top of the closed-loop correction, kept
-            # inside the limits the resolver's own command respects.
-            q_next = np.clip(np.asarray(q_fb, dtype=np.float64) + advance, lower, upper)
-            if not np.all(np.isfinite(q_next)):
-                raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
-            q_next = self.clear_way(q, (q_next, np.clip(q + advance, lower, upper)))
+            q_next = self._led(q, q_fb, advance)
             if q_next is q:  # held: the plan waits for the arm
                 if not held:
                     self.link.log.event("transport_held", t=seen.t, error=err)
@@ -134,6 +119,36 @@ class Transport:
                 stage, seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
             )
             q = self.link.hold(q_next)  # goes on from what was sent
+
+    def _blind(
+        self, watch: BerryWatch, stage: HarvestState, seen: Observation, q: FloatArray,
+        nominal: FloatArray, q_way: FloatArray, wait: bool,
+    ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
+        """A period without the cube's pose (a frame dropped, or a fast move's pose
+        refused as a jump): the plan's feedforward goes on, open loop and its way
+        checked, unless the arm must ``wait`` (past ``follow_blind_time``, or the plan
+        done). The q sent and the plan's point."""
+        lower, upper = self.link.controller.limits()
+        c = self.link.cfg
+        advance = straight_step(nominal, q_way, c.home_speed * c.period)
+        if wait:
+            advance = np.zeros_like(advance)
+        q_next = self.clear_way(q, (np.clip(q + advance, lower, upper),))
+        if q_next is not q:
+            nominal = nominal + advance
+        watch.log_step(stage, seen, q_next, None, None, False)
+        return self.link.hold(q_next), nominal
+
+    def _led(self, q: FloatArray, q_fb: FloatArray, advance: FloatArray) -> FloatArray:
+        """The command of a period with the pose: the plan's motion (feedforward) on top
+        of the closed-loop correction ``q_fb``, inside the limits the resolver's own
+        command respects, its way clear of the canes; else the plan's motion alone, else
+        ``q`` held."""
+        lower, upper = self.link.controller.limits()
+        q_next = np.clip(np.asarray(q_fb, dtype=np.float64) + advance, lower, upper)
+        if not np.all(np.isfinite(q_next)):
+            raise NonFiniteError(f"controller returned q = {q_next.tolist()!r}")
+        return self.clear_way(q, (q_next, np.clip(q + advance, lower, upper)))
 
     def _handover(self) -> bool:
         """Whether the lag model has every actuator within ``handover_tolerance`` of the
