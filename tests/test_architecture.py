@@ -215,7 +215,7 @@ def test_the_layer_table_can_fail() -> None:
     assert _layer_violations("harvest/rigs/sim/plots.py", "from softarm.viz.replay import replay\n")
     assert not _layer_violations("harvest/rigs/sim/plots.py", "from softarm.viz.arm import X\n")
     assert _layer_violations(
-        "harvest/machine/servo.py", "from softarm.harvest.rigs import sim_rig\n"
+        "harvest/machine/stages/servo.py", "from softarm.harvest.rigs import sim_rig\n"
     )
     assert _layer_violations(
         "harvest/runs/policy.py", "from softarm.harvest.rigs.hardware.rig import X\n"

@@ -14,8 +14,8 @@ from softarm import Resolver, SoftArm
 from softarm.harvest import HarvestConfig, HarvestLog
 from softarm.harvest.control.clearance import Clearance
 from softarm.harvest.control.controller import ResolverController
-from softarm.harvest.machine.servo import Servo
-from softarm.harvest.machine.transport import WAY_SLACK, straight_step
+from softarm.harvest.machine.stages.servo import Servo
+from softarm.harvest.machine.stages.transport import WAY_SLACK, straight_step
 from softarm.sim.bush import Bush
 
 from .fakes import FakeClock, FakeController

@@ -9,7 +9,7 @@ import pytest
 
 from softarm.harvest import BerryTarget, HarvestConfig, HarvestLog
 from softarm.harvest.machine.outcome import Fault
-from softarm.harvest.machine.servo import Servo
+from softarm.harvest.machine.stages.servo import Servo
 from softarm.harvest.machine.states import FaultReason, HarvestState
 
 from .fakes import FakeClock, FakeController, make_rig

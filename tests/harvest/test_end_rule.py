@@ -1,5 +1,5 @@
-"""Fine positioning's "confidence" end rule (:func:`~softarm.harvest.machine.end_rules.
-confidently_within`, its offsets kept by :class:`~softarm.harvest.machine.servo_goal.Progress`):
+"""Fine positioning's "confidence" end rule (:func:`~softarm.harvest.machine.stages.end_rules.
+confidently_within`, its offsets kept by :class:`~softarm.harvest.machine.stages.goal.Progress`):
 a noisy measurement of an arm on the berry ends within a window of steps where three
 values in a row under the tolerance do not come; a biased measurement never ends where
 the values alone do; frames read again are no new measurement; ``fine_end_rule = "steps"``
@@ -13,10 +13,10 @@ from typing import Any, cast
 import numpy as np
 import pytest
 
-from softarm.harvest.machine.end_rules import confidently_within, settled_or_out_of_time
 from softarm.harvest.machine.interfaces import BerryFix, FloatArray, Observation
 from softarm.harvest.machine.outcome import Ending
-from softarm.harvest.machine.servo_goal import Aim, Progress, ServoGoal
+from softarm.harvest.machine.stages.end_rules import confidently_within, settled_or_out_of_time
+from softarm.harvest.machine.stages.goal import Aim, Progress, ServoGoal
 from softarm.harvest.machine.states import HarvestState
 from softarm.harvest_config import HarvestConfig
 

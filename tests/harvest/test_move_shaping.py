@@ -14,9 +14,9 @@ from softarm.hardware.pressure_map import METRES_PER_PSI
 from softarm.harvest import BerryTarget, HarvestConfig, HarvestLog, SafeActuator
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault
-from softarm.harvest.machine.servo import Servo
+from softarm.harvest.machine.stages.servo import Servo
+from softarm.harvest.machine.stages.transport import straight_step
 from softarm.harvest.machine.states import FaultReason, HarvestState
-from softarm.harvest.machine.transport import straight_step
 
 from .fakes import (
     BERRIES,

@@ -1,10 +1,10 @@
-"""The harvest's stall rule (:class:`~softarm.harvest.machine.servo_goal.Progress`): a stage
+"""The harvest's stall rule (:class:`~softarm.harvest.machine.stages.goal.Progress`): a stage
 stalls only when the resolver has been saturated *and* the error has made no progress,
 each for longer than ``stall_time``; a saturation that began at t = 0.0 counts from 0.0."""
 
 from __future__ import annotations
 
-from softarm.harvest.machine.servo_goal import Progress
+from softarm.harvest.machine.stages.goal import Progress
 
 STALL_TIME = 1.0
 STALL_PROGRESS = 1e-3

@@ -47,7 +47,7 @@ from softarm.harvest.machine.interfaces import (
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault
 from softarm.harvest.machine.reapproach import Reapproach
-from softarm.harvest.machine.servo import Servo
+from softarm.harvest.machine.stages.servo import Servo
 from softarm.harvest.machine.states import FaultReason, HarvestState
 from softarm.harvest.records.bush_map_record import map_record
 from softarm.harvest.records.log import HarvestLog

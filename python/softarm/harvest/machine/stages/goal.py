@@ -1,4 +1,4 @@
-"""What one closed-loop stage of :class:`~softarm.harvest.machine.servo.Servo` servos to and
+"""What one closed-loop stage of :class:`~softarm.harvest.machine.stages.servo.Servo` servos to and
 how it may end (:class:`ServoGoal`), where the grasp point is against it each step
 (:class:`Aim`), and how the stage has progressed (:class:`Progress`)."""
 
@@ -16,7 +16,7 @@ __all__ = ["Aim", "Progress", "ServoGoal"]
 @dataclass(frozen=True)
 class ServoGoal:
     """A closed-loop stage on the berry (see :meth:`Servo._servo
-    <softarm.harvest.machine.servo.Servo._servo>`).
+    <softarm.harvest.machine.stages.servo.Servo._servo>`).
 
     ``distance``: how far short of the berry along the approach axis the end effector
     goes (m); ``tol``: the position tolerance (m); ``timeout``: the stage's time (s).

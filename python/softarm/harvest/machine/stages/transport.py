@@ -11,10 +11,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from softarm.errors import NonFiniteError, ParameterError
-from softarm.harvest.machine.arm_link import ArmLink
 from softarm.harvest.machine.interfaces import FloatArray, Observation
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault
+from softarm.harvest.machine.stages.arm_link import ArmLink
 from softarm.harvest.machine.states import FaultReason, HarvestState
 from softarm.harvest.machine.targets import pointing_error
 
@@ -39,7 +39,7 @@ def straight_step(q: FloatArray, goal: FloatArray, step: float) -> FloatArray:
 
 class Transport:
     """The moves of the harvest that are not the loop on the berry, on the shared
-    :class:`~softarm.harvest.machine.arm_link.ArmLink`."""
+    :class:`~softarm.harvest.machine.stages.arm_link.ArmLink`."""
 
     def __init__(self, link: ArmLink) -> None:
         self.link = link

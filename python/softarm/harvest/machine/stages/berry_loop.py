@@ -1,5 +1,5 @@
 """The loop on the berry (eq. 21-22): the end effector driven along the approach axis to
-a :class:`~softarm.harvest.machine.servo_goal.ServoGoal` short of the berry, one resolver
+a :class:`~softarm.harvest.machine.stages.goal.ServoGoal` short of the berry, one resolver
 step a period, until one of the stage's end rules (:mod:`.end_rules`) ends it. Placement,
 fine positioning and the back-out of the way home are this loop with different goals."""
 
@@ -10,12 +10,12 @@ from dataclasses import replace
 import numpy as np
 
 from softarm.errors import NonFiniteError
-from softarm.harvest.machine.arm_link import ArmLink
-from softarm.harvest.machine.end_rules import lost_near, settled_or_out_of_time, stalled
 from softarm.harvest.machine.interfaces import BerryFix, FloatArray, Observation
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault, StageOutcome
-from softarm.harvest.machine.servo_goal import Aim, Progress, ServoGoal
+from softarm.harvest.machine.stages.arm_link import ArmLink
+from softarm.harvest.machine.stages.end_rules import lost_near, settled_or_out_of_time, stalled
+from softarm.harvest.machine.stages.goal import Aim, Progress, ServoGoal
 from softarm.harvest.machine.states import HarvestState
 from softarm.harvest.machine.targets import grasp_point, pointing_error, tool_pose
 

@@ -12,11 +12,11 @@ from functools import lru_cache
 import numpy as np
 from scipy import stats
 
-from softarm.harvest.machine.arm_link import ArmLink
 from softarm.harvest.machine.interfaces import FloatArray, Observation
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Ending, Fault, StageOutcome
-from softarm.harvest.machine.servo_goal import Aim, Progress, ServoGoal
+from softarm.harvest.machine.stages.arm_link import ArmLink
+from softarm.harvest.machine.stages.goal import Aim, Progress, ServoGoal
 from softarm.harvest.machine.states import FaultReason, HarvestState
 
 __all__ = ["Estimate", "confidently_within", "lost_near", "settled_or_out_of_time", "stalled"]

@@ -7,8 +7,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from softarm.harvest.machine.arm_link import ArmLink
-from softarm.harvest.machine.berry_loop import BerryLoop
 from softarm.harvest.machine.interfaces import (
     Clock,
     Controller,
@@ -19,9 +17,11 @@ from softarm.harvest.machine.interfaces import (
 )
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault, StageOutcome
-from softarm.harvest.machine.servo_goal import ServoGoal
+from softarm.harvest.machine.stages.arm_link import ArmLink
+from softarm.harvest.machine.stages.berry_loop import BerryLoop
+from softarm.harvest.machine.stages.goal import ServoGoal
+from softarm.harvest.machine.stages.transport import Transport
 from softarm.harvest.machine.states import FaultReason, HarvestState
-from softarm.harvest.machine.transport import Transport
 from softarm.harvest.records.log import HarvestLog
 from softarm.harvest_config import HarvestConfig
 
