@@ -1,0 +1,68 @@
+"""What a small render of the daylight row costs (issue 37 item 6): C2's frame (at the
+harvest's half scale) and a 184-pixel window of C1's left eye around the marker cube,
+the arm reaching for a berry, drawn with the small shadow map (the harvest's way) and
+with the full one, on the same world."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+
+import softarm
+from softarm.sim.bush import Bush
+
+SEED = 4
+WINDOW = 184
+
+
+@pytest.fixture(scope="module")
+def row() -> Iterator[Any]:
+    pytest.importorskip("mujoco")
+    from softarm.harvest.rigs.sim.rig import default_cameras
+    from softarm.sim.render import RenderUnavailableError
+    from softarm.sim.render.row_look import RowLook
+    from softarm.sim.render.world import arm_sections, world_for
+    from softarm.sim.rig_cameras import BASE_TAG_ID
+
+    cams = default_cameras()
+    arm = softarm.SoftArm.blackberry()
+    bush = Bush.generate(arm, 6, SEED, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.3)
+    try:
+        world = world_for(bush, cams, BASE_TAG_ID, RowLook.named("overcast", SEED), 0.5)
+    except RenderUnavailableError as exc:
+        pytest.skip(str(exc))
+    q = np.asarray(bush.berries[0].q) * 0.9
+    world.set_arm(arm_sections(arm, q), arm.forward(q))
+    yield world
+    world.close()
+
+
+def _window_origin(world: Any) -> tuple[int, int]:
+    """The top-left pixel of the window centred on the marker cube (placed by set_arm)."""
+    renderer = world.renderer
+    cube = renderer.data.mocap_pos[renderer._mocap["arm_cube"]]
+    c1 = renderer.cameras["c1_left"]
+    x, y, z = (np.linalg.inv(c1.T_parent_camera) @ np.append(cube, 1.0))[:3]
+    u, v = c1.focal * x / z + c1.principal[0], c1.focal * y / z + c1.principal[1]
+    return int(u - WINDOW / 2), int(v - WINDOW / 2)
+
+
+@pytest.mark.parametrize("shadow_map", ["small", "full"])
+@pytest.mark.parametrize("view", ["c2", "c1_window"])
+def test_row_small_render(benchmark, row: Any, view: str, shadow_map: str) -> None:  # type: ignore[no-untyped-def]
+    renderer = row.renderer
+    place = renderer._sun.place
+    if shadow_map == "full":
+        renderer._sun.place = lambda *a: False
+    try:
+        if view == "c2":
+            image = benchmark(lambda: renderer.render("c2").colour)
+        else:
+            origin = _window_origin(row)
+            image = benchmark(lambda: renderer.render_window("c1_left", origin, WINDOW))
+    finally:
+        renderer._sun.place = place
+    assert image.ndim == 3
