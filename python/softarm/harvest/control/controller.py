@@ -54,6 +54,13 @@ class ResolverController:
         self.transport = transport
         self.clearance = clearance
 
+    def avoid(self, clearance: Clearance) -> None:
+        """Keep the arm from ``clearance``'s canes from now on (the resolver's obstacles
+        and the way check), unless this controller avoids none."""
+        if self.clearance is not None:
+            self.clearance = clearance
+            self.obstacles = list(clearance.canes)
+
     def follow_step(
         self, q: FloatArray, target: FloatArray, current: FloatArray
     ) -> tuple[FloatArray, bool]:

@@ -94,6 +94,12 @@ class ModelIK:
         #: then follows it with the canes it cleared).
         self.on_plan: Callable[[bool], None] | None = None
 
+    def fall_back_on(self, fallback: Clearance, on_plan: Callable[[bool], None]) -> None:
+        """Where no plan clears the canes of a refined map, plan around ``fallback``'s
+        (the canes known before); ``on_plan(fell_back)`` after each plan."""
+        self.fallback = fallback
+        self.on_plan = on_plan
+
     def plan(
         self,
         q: FloatArray,

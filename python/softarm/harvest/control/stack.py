@@ -116,9 +116,8 @@ class ControlStack:
         check's clearance, and the controller's obstacles unless it avoids none. The
         canes known before stay the planner's fallback (:meth:`ModelIK.plan`), and a
         plan that falls back on them is followed avoiding them alone (:meth:`_follow`)."""
-        c = self.clearance
-        self.planner.fallback = Clearance(c.arm, c.canes, c.offset)
-        self.planner.on_plan = self._follow
+        c = self.clearance  # the stack's, shared by its planner and controller
+        self.planner.fall_back_on(Clearance(c.arm, c.canes, c.offset), self._follow)
         c.canes = list(canes)
         self._follow(False)
 
@@ -129,10 +128,7 @@ class ControlStack:
         through a cane of the refined map, on the model; the way check would hold the
         arm on its planned way before that cane until the placement timed out."""
         fallback = self.planner.fallback
-        use = fallback if fell_back and fallback is not None else self.clearance
-        if self.controller.clearance is not None:
-            self.controller.clearance = use
-            self.controller.obstacles = list(use.canes)
+        self.controller.avoid(fallback if fell_back and fallback is not None else self.clearance)
 
 
 def gains_over(base: Gains, values: Mapping[str, Any]) -> Gains:
