@@ -14,6 +14,8 @@ The public surface, what the harvest and a user call:
   :class:`SightLine` objects placed by C2 (:func:`sight_lines`, :func:`crossing`,
   :class:`Placing`), the fix near the berry (:class:`RayCrossing`), the vision of the
   markerless harvest (:class:`BushVision`) and :func:`draw_bush_map`;
+* C1 on either rig: :class:`StereoC1` (its looks merged into the map, its canes fitted
+  without the rig's own parts); the cane pixels' source, :func:`use_cane_source`;
 * the calibrated pair: :class:`StereoCamera` and its :class:`Rectification`.
 
 Every entry point checks its arguments and raises a typed
@@ -36,9 +38,11 @@ from softarm.perception.berries import (
 )
 from softarm.perception.bush_map import BushMap, MappedBerry
 from softarm.perception.bush_vision import BushVision
+from softarm.perception.c1 import StereoC1
 from softarm.perception.cane_curves import CurveSearch
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.perception.cane_pixels import CaneLook
+from softarm.perception.cane_source import use_cane_source
 from softarm.perception.cane_views import view_pair_points
 from softarm.perception.canes import CaneFit, CaneSettings, cane_points, fit_cane_points, fit_canes
 from softarm.perception.detector.choice import detect_berries, fruit_mask, use_detector
@@ -65,6 +69,7 @@ __all__ = [
     "Rectification",
     "Ripeness",
     "SightLine",
+    "StereoC1",
     "StereoCamera",
     "cane_map_error",
     "cane_points",
@@ -79,6 +84,7 @@ __all__ = [
     "locate_berries",
     "ripe_by_votes",
     "sight_lines",
+    "use_cane_source",
     "use_detector",
     "view_pair_points",
 ]
