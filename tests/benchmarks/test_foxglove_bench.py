@@ -8,6 +8,7 @@ within 5 % (BENCHMARKS.md, "The Foxglove live view")."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import time
@@ -84,7 +85,9 @@ def _bench(benchmark: Any, view: bool) -> None:
     def harvest(rig: SimRig) -> None:
         assert rig.run().berries
 
-    benchmark.pedantic(harvest, setup=setup, rounds=3, iterations=1)
+    benchmark.pedantic(
+        harvest, setup=setup, rounds=int(os.environ.get("FOXGLOVE_BENCH_ROUNDS", "3")), iterations=1
+    )
     for s in served:
         frames = s.close()
         assert not view or frames > 0, "the client received nothing"
