@@ -72,7 +72,7 @@ def test_a_ramp_goes_on_from_what_the_safety_layer_let_through() -> None:
     cfg = HarvestConfig()
     servo = Servo(FakeClock(), FakeController(), limited, cfg, HarvestLog())  # type: ignore[arg-type]
     goal = np.array([0.02, 0.01, 0.0])
-    end = servo.ramp(_Blind(), None, np.zeros(3), goal, deadline=60.0)  # type: ignore[arg-type]
+    end = servo.transport.ramp(_Blind(), None, np.zeros(3), goal, deadline=60.0)  # type: ignore[arg-type]
     np.testing.assert_array_equal(end, goal)
     # The ramp asked from where the arm was let go, never from where it had asked: each
     # command is within one step of the last one sent, and it took 20 periods, not 9.
@@ -84,5 +84,5 @@ def test_a_ramp_goes_on_from_what_the_safety_layer_let_through() -> None:
 def test_a_ramp_the_safety_layer_holds_short_ends_in_a_timeout() -> None:
     servo = Servo(FakeClock(), FakeController(), _Clamping(0.01), HarvestConfig(), HarvestLog())  # type: ignore[arg-type]
     with pytest.raises(Fault) as info:
-        servo.ramp(_Blind(), HarvestState.RETURN_HOME, np.zeros(3), np.full(3, 0.02), 5.0)  # type: ignore[arg-type]
+        servo.transport.ramp(_Blind(), HarvestState.RETURN_HOME, np.zeros(3), np.full(3, 0.02), 5.0)  # type: ignore[arg-type]
     assert info.value.reason is FaultReason.TIMEOUT

@@ -179,7 +179,7 @@ def test_the_way_home_passes_a_waypoint_the_arm_is_already_at() -> None:
     watch = BerryWatch(vision, clock, BerryTarget(1), log, config.marker_timeout)
     q_way, home = np.array([0.02, 0.015, 0.025]), np.full(3, 0.0167)
     q = q_way + np.array([0.002, -0.002, 0.001])  # its pose 9 mm from the waypoint's
-    servo.ramp(watch, HarvestState.RETURN_HOME, np.zeros(3), q, 10.0)
+    servo.transport.ramp(watch, HarvestState.RETURN_HOME, np.zeros(3), q, 10.0)
     q = servo.transport.way_back(watch, HarvestState.RETURN_HOME, q, (q_way, home), clock.now())
     np.testing.assert_array_equal(q, home)
     commanded = [np.array(r["q"]) for r in log.records if r["kind"] == "step"]

@@ -40,4 +40,4 @@ def test_a_ramp_refuses_an_unbounded_deadline() -> None:
 
     watch = BerryWatch(m.vision, m.clock, BerryTarget(1), m.log, 1.0)
     with pytest.raises(ParameterError, match="deadline"):
-        m.servo.ramp(watch, HarvestState.IDLE, m.q, m.home, float("inf"))
+        m.servo.transport.ramp(watch, HarvestState.IDLE, m.q, m.home, float("inf"))

@@ -144,7 +144,7 @@ class HarvestMachine:
         try:
             self.vision.select(berry)
             idle_deadline = self.clock.now() + self.config.idle_timeout
-            servo.ramp(watch, self.state, self.q, self.home, idle_deadline)
+            servo.transport.ramp(watch, self.state, self.q, self.home, idle_deadline)
             servo.wait_visible(watch, self.state, self.q)
             self._transition(HarvestState.INITIAL_PLACEMENT, berry, "cube and berry in view")
             waypoints = self._reach(watch, berry)
@@ -186,7 +186,7 @@ class HarvestMachine:
                 if views[0] is not None and views[1] is not None:
                     pairs.append((views[0], views[1]))
             deadline = self.clock.now() + self.config.idle_timeout
-            self.servo.ramp(watch, self.state, self.q, self.home, deadline)
+            self.servo.transport.ramp(watch, self.state, self.q, self.home, deadline)
             self._transition(HarvestState.IDLE, SURVEY, f"survey done: {len(pairs)} pairs of views")
         except STAGE_ERRORS as exc:
             self._fault(SURVEY, BerryResult(SURVEY.tag_id), _reason(exc), _detail(exc))
@@ -199,7 +199,7 @@ class HarvestMachine:
         """Ramp to ``q``, settle, and take ``view`` there (None: C1 lost the cube or C2
         gave no frame)."""
         deadline = self.clock.now() + self.config.idle_timeout
-        self.servo.ramp(watch, self.state, self.q, q, deadline)
+        self.servo.transport.ramp(watch, self.state, self.q, q, deadline)
         taken = view(self.clock.now())
         self.log.event("survey_view", t=self.clock.now(), taken=taken is not None)
         return taken

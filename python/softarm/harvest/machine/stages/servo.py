@@ -57,19 +57,6 @@ class Servo:
     def controller(self, controller: Controller) -> None:
         self.link.controller = require_controller(controller)
 
-    def ramp(
-        self,
-        watch: BerryWatch,
-        stage: HarvestState,
-        q: FloatArray,
-        goal: FloatArray,
-        deadline: float,
-        observe: bool = False,
-        settle: bool = True,
-    ) -> FloatArray:
-        """An open-loop ramp to ``goal`` (:meth:`Transport.ramp`)."""
-        return self.transport.ramp(watch, stage, q, goal, deadline, observe, settle)
-
     # -- stages ---------------------------------------------------------------------
 
     def wait_visible(self, watch: BerryWatch, stage: HarvestState, q: FloatArray) -> None:

@@ -82,7 +82,7 @@ class SimRig:
     @property
     def scene(self) -> BushScene | None:
         """The rendered world's scene and map (C1's picture), None in the tag world."""
-        return getattr(self.world, "scene", None)
+        return self.world.scene
 
     def run(self, on_berry: Callable[[int, BerryResult], None] | None = None) -> HarvestReport:
         """Harvest the world's berries by the run policy both rigs follow

@@ -32,6 +32,8 @@ class TagWorld:
     gripper: SimGripper
     canes: list[PolynomialCurve] = field(default_factory=list)
     name: WorldName = WorldName.TAGS
+    #: No rendered scene: the tags are drawn by the synthetic cameras.
+    scene: None = None
 
     def known_canes(self) -> Sequence[PolynomialCurve]:
         """The true canes: the tag world maps them."""

@@ -58,6 +58,11 @@ class HarvestWorld(World, Protocol):
         ...
 
     @property
+    def scene(self) -> BushScene | None:
+        """The rendered world's scene and map (C1's picture); None in the tag world."""
+        ...
+
+    @property
     def gripper(self) -> SimGripper:
         """The simulated gripper, closing on the world's true berries."""
         ...
