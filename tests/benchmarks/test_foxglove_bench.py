@@ -47,6 +47,15 @@ print(frames, flush=True)
 """
 
 
+def _client_cpus() -> None:
+    """With ``FOXGLOVE_CLIENT_CPU=N``, the client process runs on CPU N only: a Foxglove
+    app on another computer does not take the robot's cores, and on a 2-vCPU machine an
+    unpinned client competes with the loop for them (BENCHMARKS.md)."""
+    cpu = os.environ.get("FOXGLOVE_CLIENT_CPU")
+    if cpu is not None:
+        os.sched_setaffinity(0, {int(cpu)})
+
+
 class Served:
     """A rig, and with ``view`` the live view of its log and a client process reading it."""
 
@@ -60,7 +69,7 @@ class Served:
             tests = str(Path(__file__).parents[1])
             self.client = subprocess.Popen(
                 [sys.executable, "-c", CLIENT, self.live.url, tests],
-                stdout=subprocess.PIPE, text=True,
+                stdout=subprocess.PIPE, text=True, preexec_fn=_client_cpus,
             )  # fmt: skip
             assert self.client.stdout is not None
             assert self.client.stdout.readline().strip() == "subscribed"
