@@ -7,7 +7,8 @@ C1's right eye, and those behind the leaves C1 looks through.
 The pair is rectified from the two poses (:class:`~softarm.vision.stereo_camera.
 StereoCamera` with the second view as the right eye), and the cane pixels of the first
 view (from the same source as C1's, :mod:`softarm.perception.cane_source`) are matched
-and lifted to the centre line as C1's are (:func:`softarm.perception.canes.cane_points`).
+and lifted to the centre line as C1's are (:func:`softarm.perception.canes.cane_points`):
+the points beyond the settings' ``reach`` of the base dropped before the budget.
 """
 
 from __future__ import annotations
@@ -82,7 +83,9 @@ def view_pair_points(
         own = float(np.median(surface[:, 2])) / rect.focal
         step = max(1, round((footprint / own) ** 2))
         surface, radius = surface[::step], radius[::step]
-    return centre_line_points(surface, radius, T_base_first, VIEW_DEPTHS, settings.max_points)
+    return centre_line_points(
+        surface, radius, T_base_first, VIEW_DEPTHS, settings.max_points, settings.reach
+    )
 
 
 def pixel_size(stereo: StereoCamera, point: FloatArray) -> float:

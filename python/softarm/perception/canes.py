@@ -12,7 +12,11 @@ The pipeline (:func:`fit_canes`):
 3. the camera sees the front of each tube, on average π r / 4 nearer than its centre
    line for pixels spread evenly across it: each point is pushed back along its ray by
    that much, r from the local width of the mask;
-4. in the base frame, sequential RANSAC splits the points into canes
+4. the points beyond ``CaneSettings.reach`` of the base dropped, and only then the rest
+   evenly subsampled to the fit's budget (``max_points``): in a row most cane pixels are
+   the next row's and the hedge's, and a budget spread over the whole image left the
+   canes in reach a few points each;
+5. in the base frame, sequential RANSAC splits the points into canes
    (:mod:`softarm.perception.cane_curves`) and each becomes a cubic in u ∈ [0, 1]
    fitted by least squares with arc-length parameters.
 """
@@ -33,6 +37,7 @@ from softarm.perception._inputs import bgr_image, depth_metres, instance, instan
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
 from softarm.perception.cane_pixels import CaneLook, half_width_px, stereo_disparity
 from softarm.perception.cane_source import check_cane_source, source_mask
+from softarm.perception.self_filter import CANE_REACH
 from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = [
@@ -63,14 +68,19 @@ class CaneFit:
 class CaneSettings:
     """``look``: which pixels are canes; ``search``: how points become canes;
     ``depth_range``: nearest and farthest depth (m) a cane is looked for at;
-    ``max_points``: points kept for the fit (an even subsample beyond that);
+    ``reach``: points farther than this (m) from the base origin are dropped before the
+    budget is spent (the map's own reach, :data:`softarm.perception.self_filter.
+    CANE_REACH`: canes beyond it cannot touch the arm; None: every point shares the
+    budget, as before the reach was used); ``max_points``: points kept for the fit, an
+    even subsample of those within ``reach`` beyond that;
     ``smoothness``: StereoSGBM's penalties P1, P2 (see
     :func:`softarm.perception.cane_pixels.stereo_disparity`); ``source``: where the cane
     pixels come from (:data:`softarm.perception.cane_source.CANE_SOURCES`; None: this
     process's choice, :func:`~softarm.perception.cane_source.use_cane_source`).
 
     Raises:
-        ParameterError: ``source`` is not None or one of CANE_SOURCES.
+        ParameterError: ``source`` is not None or one of CANE_SOURCES; ``reach`` is not
+            None or a finite number > 0.
     """
 
     look: CaneLook = field(default_factory=CaneLook)
@@ -79,10 +89,20 @@ class CaneSettings:
     max_points: int = 4000
     smoothness: tuple[int, int] = (4, 16)
     source: str | None = None
+    reach: float | None = CANE_REACH
 
     def __post_init__(self) -> None:
         if self.source is not None:
             check_cane_source(self.source, "settings.source")
+        if self.reach is not None and not (
+            isinstance(self.reach, (int, float))
+            and not isinstance(self.reach, bool)
+            and np.isfinite(self.reach)
+            and self.reach > 0
+        ):
+            raise ParameterError(
+                f"settings.reach must be None or a number > 0 m, got {self.reach!r}"
+            )
 
 
 def fit_canes(
@@ -124,8 +144,8 @@ def cane_points(
     settings: CaneSettings | None = None,
 ) -> FloatArray:
     """(n, 4) rows, at most ``settings.max_points``: a point on a cane's centre line C1
-    sees (base frame, m) and the cane's radius there (m); arguments and errors as
-    :func:`fit_canes`."""
+    sees (base frame, m) within ``settings.reach`` of the base and the cane's radius
+    there (m); arguments and errors as :func:`fit_canes`."""
     settings = instance_or_default(settings, CaneSettings, "settings")
     _check_inputs(left, right, stereo, depth)
     if depth is None:
@@ -133,7 +153,7 @@ def cane_points(
         rect_left, rect_right = stereo.rectification.rectify(left, right)
         mask = source_mask(rect_left, settings.look, settings.source)
         return mask_points(rect_left, rect_right, stereo, mask, settings)
-    return _to_base(_depth_points(left, depth, stereo, settings), stereo)
+    return _depth_points(left, depth, stereo, settings)
 
 
 def _to_base(camera_points: FloatArray, stereo: StereoCamera) -> FloatArray:
@@ -187,23 +207,24 @@ def mask_points(
         rect_left, rect_right, rect, mask, settings.depth_range, settings.smoothness
     )
     mask = mask & np.isfinite(disparity)
-    rows, cols = _subsample(np.nonzero(mask), settings.max_points)
+    rows, cols = _whole_view_budget(np.nonzero(mask), settings)
     pixels = np.column_stack([cols, rows]).astype(np.float64)
     surface = rect.triangulate(pixels, disparity[rows, cols])
     radius = half_width_px(mask)[rows, cols] * surface[:, 2] / rect.focal
-    return _to_base(_to_centre_line(surface, radius, settings.depth_range), stereo)
+    centre = _to_base(_to_centre_line(surface, radius, settings.depth_range), stereo)
+    return _within_budget(centre, settings.reach, settings.max_points)
 
 
 def _depth_points(
     left: npt.NDArray[np.uint8], depth: npt.NDArray[np.floating[Any]],
     stereo: StereoCamera, settings: CaneSettings,
 ) -> FloatArray:  # fmt: skip
-    """(n, 4) rows as :func:`mask_points` gives them but in the left camera frame,
-    from a depth image aligned with the left eye."""
+    """(n, 4) rows as :func:`mask_points` gives them, from a depth image aligned with the
+    left eye."""
     near, far = settings.depth_range
     z = np.nan_to_num(depth.astype(np.float32), nan=0.0)
     mask = source_mask(left, settings.look, settings.source) & (z >= near) & (z <= far)
-    rows, cols = _subsample(np.nonzero(mask), settings.max_points)
+    rows, cols = _whole_view_budget(np.nonzero(mask), settings)
     if rows.size == 0:
         return np.zeros((0, 4))
     pixels = np.column_stack([cols, rows]).astype(np.float64)
@@ -212,14 +233,30 @@ def _depth_points(
     zs = z[rows, cols].astype(np.float64)
     surface = np.column_stack([rays.reshape(-1, 2) * zs[:, None], zs])
     radius = half_width_px(mask)[rows, cols] * zs / float(cam.matrix[0, 0])
-    return _to_centre_line(surface, radius, settings.depth_range)
+    centre = _to_base(_to_centre_line(surface, radius, settings.depth_range), stereo)
+    return _within_budget(centre, settings.reach, settings.max_points)
 
 
-def _subsample(
-    indices: tuple[npt.NDArray[np.intp], ...], limit: int
+def _whole_view_budget(
+    indices: tuple[npt.NDArray[np.intp], ...], settings: CaneSettings
 ) -> tuple[npt.NDArray[np.intp], ...]:
-    step = max(1, int(np.ceil(len(indices[0]) / limit)))
+    """The pixels ``indices`` as they are when a reach is set (every one is placed, and
+    the budget spent after those out of reach are dropped); without a reach, an even
+    subsample of them to ``max_points`` (the budget over the whole view: no need to
+    place the pixels it drops)."""
+    if settings.reach is not None:
+        return indices
+    step = max(1, int(np.ceil(len(indices[0]) / settings.max_points)))
     return tuple(i[::step] for i in indices)
+
+
+def _within_budget(points: FloatArray, reach: float | None, max_points: int) -> FloatArray:
+    """The rows of ``points`` (n, 4), base frame, within ``reach`` (m) of the base
+    origin (all of them for None), then evenly subsampled to at most ``max_points``:
+    the points out of reach are dropped first, so that they take none of the budget."""
+    if reach is not None:
+        points = points[np.linalg.norm(points[:, :3], axis=1) <= reach]
+    return points[:: max(1, int(np.ceil(len(points) / max_points)))]
 
 
 def _to_centre_line(
@@ -240,14 +277,16 @@ def centre_line_points(
     T_base_camera: FloatArray,
     depth_range: tuple[float, float],
     max_points: int,
+    reach: float | None = None,
 ) -> FloatArray:
     """(n, 4) rows as :func:`cane_points`: the ``surface`` points (camera frame, m) of
     canes of ``radius`` (m) moved to their centre lines, those within ``depth_range``
-    kept, evenly subsampled to at most ``max_points`` and placed by ``T_base_camera``."""
+    kept, placed by ``T_base_camera``, those within ``reach`` (m) of the base origin
+    kept (None: all) and only then evenly subsampled to at most ``max_points``."""
     centre = _to_centre_line(surface, radius, depth_range)
-    centre = centre[:: max(1, int(np.ceil(len(centre) / max_points)))]
     T = np.asarray(T_base_camera, dtype=np.float64)
-    return np.column_stack([centre[:, :3] @ T[:3, :3].T + T[:3, 3], centre[:, 3]])
+    placed = np.column_stack([centre[:, :3] @ T[:3, :3].T + T[:3, 3], centre[:, 3]])
+    return _within_budget(placed, reach, max_points)
 
 
 def _fit_all(points: FloatArray, radius: FloatArray, settings: CaneSettings) -> list[CaneFit]:
