@@ -27,6 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import ParameterError
+from softarm.sim.render.motion_blur import check_flow, flow_blur
 
 __all__ = ["CameraEffects", "StereoEffects", "blur_kernel"]
 
@@ -145,17 +146,27 @@ class CameraEffects:
         velocity_px: tuple[float, float] = (0.0, 0.0),
         exposure: float | None = None,
         offset_px: tuple[float, float] = (0.0, 0.0),
+        flow_px_s: npt.NDArray[np.float32] | None = None,
+        still: npt.NDArray[np.bool_] | None = None,
     ) -> npt.NDArray[np.uint8]:
         """``image`` (H, W, 3) BGR uint8 as this camera delivers it. ``velocity_px``: the
-        image's motion (px/s) during the exposure; ``exposure``: the gain to use (a
-        window of a frame keeps its frame's auto-exposure), None: :meth:`exposure_of`;
-        ``offset_px``: a shift of the image (a rectification error)."""
+        image's motion (px/s) during the exposure, the same everywhere; ``exposure``:
+        the gain to use (a window of a frame keeps its frame's auto-exposure), None:
+        :meth:`exposure_of`; ``offset_px``: a shift of the image (a rectification
+        error); ``flow_px_s``: (H, W, 2) each pixel's own motion (px/s) during the
+        exposure (:mod:`softarm.sim.render.motion_blur`), before ``velocity_px``'s;
+        ``still``: (H, W) pixels that move with the camera (no blur, nor light lent)."""
         if image.ndim != 3 or image.shape[2] != 3:
             raise ParameterError(f"image must be (H, W, 3), got {image.shape}")
         gain = self.exposure_of(image) if exposure is None else exposure
         light = image.astype(np.float32)
         if offset_px != (0.0, 0.0):
             light = _shifted(light, offset_px)
+        if flow_px_s is not None:
+            flow = check_flow(flow_px_s, image.shape)
+            if still is not None and np.shape(still) != image.shape[:2]:
+                raise ParameterError(f"still must be {image.shape[:2]}, got {np.shape(still)}")
+            light = flow_blur(light, flow * np.float32(self.exposure_s), still)
         kernel = blur_kernel(velocity_px, self.exposure_s)
         if kernel.size > 1:
             light = cast(

@@ -5,8 +5,16 @@ repeatable. C1's left eye meters (auto-exposure) and the right eye exposes with 
 left's exposure times its own bias, shifted by the pair's rectification error (the
 ground truth is not shifted: it is where the scene is). A window of C1's left eye (the
 cube tracking's) keeps that eye's last exposure and has no vignetting of its own.
-Motion blur: the look's ``blur_px_s`` in a random direction each frame (the camera's
-and the arm's motion, which the renderer does not know).
+
+Motion blur comes from the motion (:class:`~softarm.sim.render.rig_motion.RigMotion`,
+given by the world with the rig's geometry and the simulation's clock): C2's frames
+smear as a whole along the scene's image velocity from C2's own twist; in C1's only the
+arm smears, by its image velocity over what it sweeps. C1 also takes the look's
+``blur_px_s`` in a random direction each frame: its mount's own shake (wind, the
+platform), which the arm's motion does not give. A still arm, or no motion given, adds
+no blur to C2: its frame is then the same, bit for bit, as a frame blurred by
+nothing (the random draw that once blurred C2 is still drawn, and unused, so that the
+noise that follows is the same).
 """
 
 from __future__ import annotations
@@ -17,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.sim.render.camera_effects import CameraEffects
+from softarm.sim.render.rig_motion import RigMotion
 from softarm.sim.render.row_look import RowLook
 
 __all__ = ["RowCameras"]
@@ -26,10 +35,11 @@ _CAMERAS = ("c1_left", "c1_right", "c2", "c1_window")
 
 class RowCameras:
     """Applies ``look``'s camera model to the frames of each camera (see the module
-    docstring)."""
+    docstring); ``motion``: the rig's motion (None: no motion blur from it)."""
 
-    def __init__(self, look: RowLook) -> None:
+    def __init__(self, look: RowLook, motion: RigMotion | None = None) -> None:
         self.look = look
+        self.motion = motion
         self._count = dict.fromkeys(_CAMERAS, 0)
         self._exposure: float | None = None
 
@@ -42,19 +52,37 @@ class RowCameras:
         speed = self.look.blur_px_s * rng.uniform(0.0, 1.0)
         return float(speed * np.cos(angle)), float(speed * np.sin(angle))
 
-    def apply(self, camera: str, image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
-        """``image`` of ``camera`` (c1_left, c1_right, c2 or c1_window) as delivered."""
+    def _c1_flow(
+        self, eye: str, image: npt.NDArray[np.uint8], origin: tuple[int, int], exposure_s: float
+    ) -> npt.NDArray[np.float32] | None:
+        if self.motion is None:
+            return None
+        size = (image.shape[1], image.shape[0])
+        return self.motion.c1_flow(eye, size, origin, exposure_s)
+
+    def apply(
+        self, camera: str, image: npt.NDArray[np.uint8], origin: tuple[int, int] = (0, 0)
+    ) -> npt.NDArray[np.uint8]:
+        """``image`` of ``camera`` (c1_left, c1_right, c2 or c1_window) as delivered;
+        ``origin``: a window's top-left pixel in the whole image."""
         rng = self._rng(camera)
-        velocity = self._velocity(rng)
+        shake = self._velocity(rng)
         stereo = self.look.stereo
         if camera == "c2":
-            return self.look.c2.apply(image, rng, velocity)
+            flow = None if self.motion is None else self.motion.c2_flow()
+            still = None if flow is None or self.motion is None else self.motion.c2_still()
+            return self.look.c2.apply(image, rng, flow_px_s=flow, still=still)
+        exposure_s = stereo.left.exposure_s
         if camera == "c1_left":
             self._exposure = stereo.left.exposure_of(image)
-            return stereo.left.apply(image, rng, velocity, exposure=self._exposure)
+            flow = self._c1_flow("left", image, origin, exposure_s)
+            return stereo.left.apply(image, rng, shake, self._exposure, flow_px_s=flow)
         if camera == "c1_right":
             left = self._exposure or stereo.left.exposure_of(image)
             exposure = left * stereo.right_exposure
-            return stereo.right().apply(image, rng, velocity, exposure, stereo.right_offset_px)
+            flow = self._c1_flow("right", image, origin, exposure_s)
+            right = stereo.right()
+            return right.apply(image, rng, shake, exposure, stereo.right_offset_px, flow)
         window: CameraEffects = replace(stereo.left, vignetting=0.0)
-        return window.apply(image, rng, velocity, exposure=self._exposure)
+        flow = self._c1_flow("left", image, origin, exposure_s)
+        return window.apply(image, rng, shake, exposure=self._exposure, flow_px_s=flow)

@@ -10,17 +10,18 @@ the right eye sits ``baseline`` along its +x, as the ZED2's do.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import cv2
 import numpy as np
+import numpy.typing as npt
 
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
 from softarm.sim.bush import PLUS_Y, Branch, Bush
 from softarm.sim.render.distortion import Distorter
-from softarm.sim.render.labels import GeomLabels
+from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.look import BushLook
 from softarm.sim.render.mjcf import (
     ARM_SEGMENTS_PER_SECTION,
@@ -29,7 +30,8 @@ from softarm.sim.render.mjcf import (
     SceneSpec,
 )
 from softarm.sim.render.renderer import BushRenderer, RenderedFrame
-from softarm.sim.render.row import Row
+from softarm.sim.render.rig_motion import RigMotion
+from softarm.sim.render.row import ROW_Y, Row
 from softarm.sim.render.row_camera import RowCameras
 from softarm.sim.render.row_look import RowLook
 from softarm.vision.camera_model import CameraModel
@@ -120,10 +122,13 @@ class RenderedBush:
         self.bush = bush
         self.look = look or BushLook.random(bush.seed)
         self.row = Row.generate(bush, self.look) if isinstance(self.look, RowLook) else None
-        self.effects = RowCameras(self.look) if isinstance(self.look, RowLook) else None
         T_left_right = np.eye(4)
         T_left_right[0, 3] = baseline
         self.stereo = StereoCamera(c1, c1, T_base_c1, T_left_right)
+        self.motion = RigMotion(self.stereo, c2, T_ee_c2, _face(bush), rig_in_c2=self._rig_in_c2)
+        self.effects = (
+            RowCameras(self.look, self.motion) if isinstance(self.look, RowLook) else None
+        )
         self.c2 = c2
         self.T_ee_cube = T_ee_cube
         outline = panel_corners(make_body(marker_body, cube_marker)).reshape(-1, 3)
@@ -170,6 +175,12 @@ class RenderedBush:
             np.array([GRIPPER_REACH]),
         ]
         self.renderer.push_leaves(np.vstack(body), np.concatenate(radius))
+        self.motion.moved(T_base_ee, np.vstack(body), np.concatenate(radius))
+
+    def set_clock(self, clock: Callable[[], float]) -> None:
+        """Stamp each drawing of the arm with ``clock()`` (s): the row's frames then
+        blur by the motion between drawings (:mod:`softarm.sim.render.rig_motion`)."""
+        self.motion.clock = clock
 
     def hide_arm(self) -> None:
         """An empty view of the bush (no arm)."""
@@ -226,12 +237,20 @@ class RenderedBush:
             pin, mx - px0, my - py0, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
         )
         if self.effects is not None:
-            colour = self.effects.apply("c1_window", np.asarray(colour, np.uint8))
+            colour = self.effects.apply("c1_window", np.asarray(colour, np.uint8), (x0, y0))
         return ImageCrop(colour, (x0, y0), (w, h))
 
     def c2_frame(self, truth: bool = False) -> RenderedFrame:
         """C2's image from where the arm is drawn."""
         return self._frame("c2", "c2", truth)
+
+    def _rig_in_c2(self) -> npt.NDArray[np.bool_]:
+        """C2's pixels of the rig (fingers, marker body): the same in every C2 frame."""
+        drawn = self.renderer.render("c2", geoms=True).geoms
+        assert drawn is not None  # asked for
+        geoms = self._distort["c2"].nearest(drawn)
+        result: npt.NDArray[np.bool_] = self.labels.kinds(geoms) == KINDS.index("arm")
+        return result
 
     def berry_outlines(self) -> RenderedFrame:
         """C1's left eye with only the berries drawn (geoms only): each berry's whole
@@ -301,6 +320,14 @@ def _spec(name: str, pose: FloatArray, camera: CameraModel) -> CameraSpec:
     K = camera.matrix
     size = camera.image_size or (int(2 * K[0, 2] + 1), int(2 * K[1, 2] + 1))
     return CameraSpec(name, pose, size, float(K[0, 0]), (float(K[0, 2]), float(K[1, 2])))
+
+
+def _face(bush: Bush) -> tuple[FloatArray, FloatArray]:
+    """The bush's face: the plane through its berries' centre facing the arm (-Y), the
+    scene C2 looks at (its motion blur's depth)."""
+    if not bush.berries:
+        return np.array([0.0, ROW_Y, 0.0]), PLUS_Y
+    return np.mean([b.position for b in bush.berries], axis=0), PLUS_Y
 
 
 def _approach_lines(bush: Bush) -> list[tuple[FloatArray, FloatArray]]:

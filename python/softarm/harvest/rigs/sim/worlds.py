@@ -157,6 +157,7 @@ def _bush_scene(
     """The rendered bush (in the row with ``look``), C1 registered on its base tag, the
     first C1 look merged into its map."""
     world = world_for(bush, cams, BASE_TAG_ID, look=look, c2_scale=C2_SCALE)
+    world.set_clock(clock.now)  # the row's motion blur: the arm's steps in sim time
     scene = BushScene(world, BushMap(), bush, plant)
     if recorder is not None:
         scene.read_pair = recorder.wrap_pair(scene.pair, clock.now)

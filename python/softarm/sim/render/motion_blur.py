@@ -1,0 +1,203 @@
+"""Motion blur from real motion: how fast each pixel of a frame moves during the
+exposure, and the frame smeared along that motion.
+
+Two sources. A camera that moves (C2 on the end effector) sees every static point
+move: :func:`camera_twist` takes the camera's velocity from two of its poses, and
+:func:`twist_flow` the image velocity of each pixel from it and the scene's inverse
+depth there (the standard image Jacobian of a point: translation scales with 1/Z,
+rotation does not depend on depth). A fixed camera (C1) sees only what moves in front
+of it: :func:`swept_flow` paints each moving part's image velocity over the pixels it
+sweeps during the exposure, zero elsewhere.
+
+:func:`flow_blur` then averages each pixel's light along the segment it moved over
+(a gather: each pixel takes the mean of the image sampled along its own motion, which
+for a moving object over a still background also gives the background it slides over
+its share of the object's colour). Every pixel's weights sum to 1: blur moves light,
+it makes none. Motions under a pixel during the exposure are no blur at all, as
+:func:`~softarm.sim.render.camera_effects.blur_kernel` has it.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from softarm.checks import FloatArray
+from softarm.errors import ParameterError
+
+__all__ = [
+    "MIN_DEPTH",
+    "camera_twist",
+    "check_flow",
+    "flow_blur",
+    "plane_inverse_depth",
+    "swept_flow",
+    "twist_flow",
+]
+
+#: The nearest depth (m) a scene point is taken at: nothing C2 sees in focus is nearer
+#: (the fingers' tips reach 4 cm in front of it), and 1/Z stays bounded.
+MIN_DEPTH = 0.04
+#: At most this many samples along a pixel's motion: a longer smear is sampled sparser.
+MAX_SAMPLES = 48
+
+Flow = npt.NDArray[np.float32]
+
+
+def camera_twist(
+    T_before: FloatArray, T_now: FloatArray, dt: float
+) -> tuple[FloatArray, FloatArray]:
+    """The camera's linear (m/s) and angular (rad/s) velocity, both in its own frame
+    now, from its poses ``T_before`` and ``T_now`` (base frame) ``dt`` s apart.
+
+    Raises:
+        ParameterError: ``dt`` not positive, or a pose not finite.
+    """
+    if not (np.isfinite(dt) and dt > 0):
+        raise ParameterError(f"dt must be a positive time, got {dt}")
+    if not (np.all(np.isfinite(T_before)) and np.all(np.isfinite(T_now))):
+        raise ParameterError("T_before and T_now must be finite poses")
+    R_now = T_now[:3, :3]
+    v = R_now.T @ (T_now[:3, 3] - T_before[:3, 3]) / dt
+    # The rotation vector of R_before^T R_now is its own axis in either frame.
+    rotvec, _ = cv2.Rodrigues(np.ascontiguousarray(T_before[:3, :3].T @ R_now))
+    w: FloatArray = np.asarray(rotvec, np.float64).ravel() / dt
+    return v, w
+
+
+def _grid(
+    focal: float, principal: tuple[float, float], size: tuple[int, int]
+) -> tuple[FloatArray, FloatArray]:
+    """The normalised image coordinates (x/z, y/z) of every pixel (pinhole)."""
+    w, h = size
+    x = (np.arange(w, dtype=np.float64) - principal[0]) / focal
+    y = (np.arange(h, dtype=np.float64) - principal[1]) / focal
+    return np.meshgrid(x, y)
+
+
+def twist_flow(
+    v: FloatArray,
+    w: FloatArray,
+    focal: float,
+    principal: tuple[float, float],
+    size: tuple[int, int],
+    inverse_depth: float | FloatArray,
+) -> Flow:
+    """(H, W, 2) image velocity (px/s) of the static scene seen by a pinhole camera
+    (``focal`` px, ``principal`` point, ``size`` (W, H)) moving at ``v`` (m/s), ``w``
+    (rad/s) in its own frame; ``inverse_depth``: 1/Z (1/m) of the scene at each pixel
+    (0: at infinity, the sky), or one value for all."""
+    x, y = _grid(focal, principal, size)
+    iz = np.broadcast_to(np.asarray(inverse_depth, np.float64), x.shape)
+    vx, vy, vz = (float(c) for c in v)
+    wx, wy, wz = (float(c) for c in w)
+    du = focal * ((-vx + x * vz) * iz + x * y * wx - (1 + x * x) * wy + y * wz)
+    dv = focal * ((-vy + y * vz) * iz + (1 + y * y) * wx - x * y * wy - x * wz)
+    return np.stack([du, dv], axis=-1).astype(np.float32)
+
+
+def plane_inverse_depth(
+    T_base_camera: FloatArray,
+    point: FloatArray,
+    normal: FloatArray,
+    focal: float,
+    principal: tuple[float, float],
+    size: tuple[int, int],
+) -> FloatArray:
+    """(H, W) 1/Z (1/m) at each pixel of a scene that is the plane through ``point``
+    with ``normal`` (base frame): a hedge's face to first order. A pixel whose ray
+    misses the plane sees the sky (0); none is nearer than :data:`MIN_DEPTH`."""
+    R, p = T_base_camera[:3, :3], T_base_camera[:3, 3]
+    n = R.T @ np.asarray(normal, float)
+    h = float(n @ (R.T @ (np.asarray(point, float) - p)))  # the plane's offset, camera frame
+    x, y = _grid(focal, principal, size)
+    facing = n[0] * x + n[1] * y + n[2]  # n . (x, y, 1): the ray's approach to the plane
+    if abs(h) < 1e-9:
+        inverse = np.where(facing != 0, np.inf, 0.0)
+    else:
+        inverse = facing / h
+    result: FloatArray = np.clip(inverse, 0.0, 1.0 / MIN_DEPTH)
+    return result
+
+
+def swept_flow(
+    size: tuple[int, int],
+    centres: FloatArray,
+    velocities: FloatArray,
+    radii: FloatArray,
+    exposure_s: float,
+    origin: tuple[int, int] = (0, 0),
+) -> Flow:
+    """(H, W, 2) image velocity (px/s) of a frame of ``size`` (W, H) whose top-left
+    pixel is ``origin`` of the whole image: each moving part, a disc at ``centres``
+    (N, 2) px of ``radii`` (N,) px moving at ``velocities`` (N, 2) px/s, paints its
+    velocity over the band it sweeps during ``exposure_s``; the rest is still (0).
+    Later parts paint over earlier ones (list the fast end last)."""
+    w, h = size
+    flow = np.zeros((h, w, 2), np.float32)
+    for c, vel, r in zip(centres, velocities, radii, strict=True):
+        half = 0.5 * exposure_s * np.asarray(vel, float)
+        if not np.all(np.isfinite(np.append(c, half))) or float(np.hypot(*half)) < 0.5:
+            continue  # not drawn, or sweeping under a pixel
+        a = np.round(c - half - origin).astype(int)
+        b = np.round(c + half - origin).astype(int)
+        thick = max(1, round(2 * float(r)) + 1)
+        cv2.line(flow, (int(a[0]), int(a[1])), (int(b[0]), int(b[1])),
+                 (float(vel[0]), float(vel[1])), thick)  # fmt: skip
+    return flow
+
+
+def flow_blur(
+    light: npt.NDArray[np.float32], shift: Flow, still: npt.NDArray[np.bool_] | None = None
+) -> npt.NDArray[np.float32]:
+    """``light`` (H, W, C) float with each pixel averaged along its ``shift`` (H, W, 2):
+    its motion (px) during the exposure, centred on where it is drawn. ``still``: pixels
+    of a part that moves with the camera (C2's fingers): they stay sharp, and the scene
+    sliding behind them takes none of their light (their samples are left out). Only
+    the box around the pixels that move a pixel or more is touched; ``light`` back as
+    it was when none does."""
+    length = np.hypot(shift[..., 0], shift[..., 1])
+    moving = length >= 1.0
+    if still is not None:
+        moving &= ~still
+    if not moving.any():
+        return light
+    rows, cols = np.flatnonzero(moving.any(axis=1)), np.flatnonzero(moving.any(axis=0))
+    y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    box = np.where(moving[y0:y1, x0:x1, None], shift[y0:y1, x0:x1], np.float32(0.0))
+    n = int(min(MAX_SAMPLES, max(2, np.ceil(float(length[y0:y1, x0:x1].max())) + 1)))
+    gx, gy = np.meshgrid(np.arange(x0, x1, dtype=np.float32), np.arange(y0, y1, dtype=np.float32))
+    weight = np.ones(light.shape[:2], np.float32) if still is None else (~still).astype(np.float32)
+    lit = light if still is None else light * weight[..., None]
+    total = np.zeros((y1 - y0, x1 - x0, light.shape[2]), np.float32)
+    count = np.zeros((y1 - y0, x1 - x0), np.float32)
+    for s in np.linspace(-0.5, 0.5, n, dtype=np.float32):
+        mx, my = gx + s * box[..., 0], gy + s * box[..., 1]
+        flags, border = cv2.INTER_LINEAR, cv2.BORDER_REPLICATE
+        total += cv2.remap(lit, mx, my, flags, borderMode=border).reshape(total.shape)
+        if still is not None:
+            count += cv2.remap(weight, mx, my, flags, borderMode=border)
+    out = light.copy()
+    inner = out[y0:y1, x0:x1]
+    if still is None:
+        inner[moving[y0:y1, x0:x1]] = total[moving[y0:y1, x0:x1]] / np.float32(n)
+        return out
+    # A pixel whose every sample fell on the still part keeps its light.
+    blurred = moving[y0:y1, x0:x1] & (count > 1e-3)
+    inner[blurred] = total[blurred] / count[blurred, None]
+    return out
+
+
+def check_flow(flow: object, shape: tuple[int, ...]) -> Flow:
+    """``flow`` as an (H, W, 2) float32 array of the image's ``shape[:2]``.
+
+    Raises:
+        ParameterError: another shape, or a value not finite.
+    """
+    array = np.asarray(flow, np.float32)
+    if array.shape != (*shape[:2], 2):
+        raise ParameterError(f"flow_px_s must be {(*shape[:2], 2)}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ParameterError("flow_px_s must be finite")
+    return array
