@@ -28,6 +28,21 @@ def disc(cx: int, cy: int, r: int) -> np.ndarray:
     return np.asarray((xx - cx) ** 2 + (yy - cy) ** 2 <= r**2)
 
 
+def sphere_depth(
+    cx: int, cy: int, r_px: int, surface_m: float, focal: float, behind_m: float = 0.2
+) -> np.ndarray:
+    """(H, W) depth (m) of a sphere whose outline is the disc (cx, cy, r_px) and whose
+    near surface is ``surface_m`` away (a fruit's cap; orthographic, small angles), in
+    front of a wall ``behind_m`` farther."""
+    radius = r_px * surface_m / focal
+    yy, xx = np.mgrid[:H, :W]
+    rho = np.hypot(xx - cx, yy - cy) * surface_m / focal
+    depth = np.full((H, W), surface_m + behind_m)
+    inside = rho <= radius
+    depth[inside] = surface_m + radius - np.sqrt(radius**2 - rho[inside] ** 2)
+    return depth
+
+
 def polygon(mask: np.ndarray) -> list[list[float]]:
     contours, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     return [[float(v) for v in c.reshape(-1)] for c in contours]

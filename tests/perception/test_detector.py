@@ -11,7 +11,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from detector_scenes import H, W, disc, draw
+from detector_scenes import H, W, disc, draw, sphere_depth
 
 from softarm.cli import main
 from softarm.errors import InputError, ParameterError, VisionError
@@ -170,7 +170,10 @@ def test_detect_with_depth_prints_positions(
     image = tmp_path / "bush.png"
     cv2.imwrite(str(image), draw([("ripe", disc(80, 60, 12))]))
     depth = tmp_path / "bush_depth.png"
-    cv2.imwrite(str(depth), np.full((H, W), 1000, np.uint16))  # 1 m
+    # A fruit's cap 1 m away (a flat depth is no fruit: the depth check drops it).
+    cv2.imwrite(
+        str(depth), np.round(1000 * sphere_depth(80, 60, 12, 1.0, 1500.0)).astype(np.uint16)
+    )
     camera = tmp_path / "camera.json"
     CameraModel.ideal(1500.0, W, H).save(camera)  # 24 px across at 1 m: a 16 mm fruit
     args = ["detect", str(image), "--depth", str(depth), "--camera", str(camera)]

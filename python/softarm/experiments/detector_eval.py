@@ -1,8 +1,10 @@
 """The berry detectors side by side, per condition: every detector of
 :data:`~softarm.perception.detector.choice.DETECTORS` (and optionally a network file of
-one's own) on each labelled folder (``softarm dataset`` output), scored as ``softarm
-detector evaluate`` scores; the figures written as JSON (docs/data/detector_eval.json)
-and printed as the table of docs/perception.md ("The learned detector").
+one's own) on each labelled folder (``softarm dataset`` output), and ``colour+depth`` and
+``net+colour+depth``, the same detectors given the folder's depth images (``depth/``),
+scored as ``softarm detector evaluate`` scores; the figures written as JSON
+(docs/data/detector_eval.json) and printed as the table of docs/perception.md ("The
+learned detector").
 
     python -m softarm.experiments.detector_eval NAME=FOLDER ... --out docs/data/detector_eval.json
 
@@ -25,7 +27,7 @@ from softarm.perception.detector.choice import DETECTORS, BerryDetector, detecto
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 
-__all__ = ["main", "table"]
+__all__ = ["WITH_DEPTH", "candidates", "main", "table"]
 
 _SHOWN = ("precision", "ripe_precision", "recall_ripe", "recall", "stage_right")
 
@@ -49,6 +51,11 @@ class _Timed:
         return self.inner.fruit_mask(image, settings)
 
 
+#: The candidates: each detector of the harvest's choice on the colour image alone, and
+#: two of them with the frame's depth as a check (:mod:`~softarm.perception.detector.depth_check`).
+WITH_DEPTH = ("colour", "net+colour")
+
+
 def _detectors(weights: Path | None) -> dict[str, BerryDetector]:
     if weights is None:
         return {name: detector(name) for name in DETECTORS}
@@ -59,18 +66,29 @@ def _detectors(weights: Path | None) -> dict[str, BerryDetector]:
     }
 
 
+def candidates(weights: Path | None = None) -> dict[str, tuple[BerryDetector, bool]]:
+    """{name: (detector, given depth)}: every detector without depth, then
+    ``colour+depth`` and ``net+colour+depth``."""
+    dets = _detectors(weights)
+    out = {name: (det, False) for name, det in dets.items()}
+    out.update({f"{name}+depth": (dets[name], True) for name in WITH_DEPTH})
+    return out
+
+
 def run(conditions: dict[str, Path], weights: Path | None = None) -> dict[str, Any]:
-    """{condition: {detector: figures}} with ``ms_per_image``."""
+    """{condition: {candidate: figures}} with ``ms_per_image``; a ``+depth`` candidate
+    reads each folder's ``depth/``."""
     cv2.setNumThreads(1)
     out: dict[str, Any] = {}
     for name, folder in conditions.items():
         out[name] = {}
-        for det_name, det in _detectors(weights).items():
+        for cand, (det, with_depth) in candidates(weights).items():
             timed = _Timed(det)
-            figures = evaluate(timed, folder / "annotations.json", folder)
+            depth = folder / "depth" if with_depth else None
+            figures = evaluate(timed, folder / "annotations.json", folder, depth)
             figures.pop("per_image")
             figures["ms_per_image"] = round(1000.0 * float(np.median(timed.seconds)), 1)
-            out[name][det_name] = figures
+            out[name][cand] = figures
     return out
 
 
@@ -79,14 +97,19 @@ def _cell(value: object) -> str:
 
 
 def table(results: dict[str, Any]) -> str:
-    """A markdown table: one row per condition and detector."""
-    head = "| condition | detector | " + " | ".join(_SHOWN) + " | ripe counted | ms/image |"
-    lines = [head, "|" + " --- |" * (len(_SHOWN) + 4)]
+    """A markdown table: one row per condition and candidate (loc. mm: the median
+    distance of a matched detection's position from the fruit's, where depth was given)."""
+    head = (
+        "| condition | detector | " + " | ".join(_SHOWN) + " | ripe counted | loc. mm | ms/image |"
+    )
+    lines = [head, "|" + " --- |" * (len(_SHOWN) + 5)]
     for condition, by_detector in results.items():
         for det_name, f in by_detector.items():
             cells = " | ".join(_cell(f[k]) for k in _SHOWN)
             ripe = f["fruit_counted"]["ripe"]
-            lines.append(f"| {condition} | {det_name} | {cells} | {ripe} | {f['ms_per_image']} |")
+            loc = _cell((f.get("localisation_mm") or {}).get("median"))
+            ms = f["ms_per_image"]
+            lines.append(f"| {condition} | {det_name} | {cells} | {ripe} | {loc} | {ms} |")
     return "\n".join(lines)
 
 

@@ -5,7 +5,9 @@ mulch, an irrigation line, stones), saturated towards purple. Unripe fruit is re
 yellow-green, brighter and yellower than the leaves. Each colour class is thresholded
 in HSV, closed over the gaps between drupelets and the specular highlights, and split
 into connected blobs; a blob is a berry when it is compact (a fruit, not a cane or a
-leaf edge) and of a fruit's size (in pixels, or in metres when depth is given).
+leaf edge) and of a fruit's size in pixels; where depth is given, when depth agrees
+(:mod:`softarm.perception.detector.depth_check`: a fruit's metric size, in the working
+range, on one fruit-sized surface).
 The ripeness of a blob is the share of its pixels in the ripe colour class; the NIR
 sensor in the gripper keeps the last word at the grasp.
 """
@@ -22,6 +24,7 @@ import numpy.typing as npt
 from softarm.checks import FloatArray
 from softarm.errors import VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
+from softarm.perception.detector.depth_check import DepthCheck, rejection
 from softarm.vision.camera_model import CameraModel
 
 __all__ = [
@@ -65,8 +68,9 @@ class DetectorSettings:
     min_area_px: int = 40
     min_solidity: float = 0.75
     max_elongation: float = 2.6
-    #: Physical size (m) of a fruit's equivalent diameter when depth is known.
-    diameter_m: tuple[float, float] = (0.008, 0.04)
+    #: What a depth image must say of a detection where one is given
+    #: (:mod:`softarm.perception.detector.depth_check`); None: depth only places it.
+    depth_check: DepthCheck | None = field(default_factory=DepthCheck)
 
 
 @dataclass(frozen=True)
@@ -191,7 +195,11 @@ def _check(image: object, depth: object, camera: CameraModel | None = None) -> N
     """``image`` a BGR frame (of ``camera``'s image size when it has one) and ``depth``
     None or float metres of its size."""
     checked = bgr_image(image, "image")
-    depth_metres(depth, checked.shape)
+    metres = depth_metres(depth, checked.shape)
+    # NaN, 0 and +-inf are unknown (ROS REP 118's float depth); a negative depth is no
+    # depth at all: a wrong unit or sign, refused rather than read as "unknown".
+    if metres is not None and bool(np.any(metres < 0)):
+        raise VisionError("depth holds negative values: give metres in front of the camera")
     if camera is not None:
         bgr_image(checked, "image", camera.image_size)
 
@@ -294,9 +302,11 @@ def _detection(
     radius = float(np.sqrt(m["m00"] / np.pi))
     position = None
     if depth is not None:
-        position = _position(inside, (cx, cy), radius, camera, depth[box])
-        if position is not None and not _fruit_sized(radius, position[2], camera, s):
+        if s.depth_check is not None and rejection(
+            inside, radius, depth[box], camera.focal, s.depth_check
+        ):
             return None
+        position = _position(inside, (cx, cy), radius, camera, depth[box])
     purity = (n_ripe + n_unripe) / m["m00"]
     solidity = m["m00"] / max(cv2.contourArea(cv2.convexHull(contour)), 1.0)
     ripeness: Ripeness = "ripe" if p_ripe >= 0.5 else "unripe"
@@ -337,8 +347,3 @@ def _position(
     radius_m = radius_px * surface / camera.focal
     centre_z = surface + 2.0 / 3.0 * radius_m
     return direction * centre_z
-
-
-def _fruit_sized(radius_px: float, z: float, camera: CameraModel, s: DetectorSettings) -> bool:
-    diameter = 2.0 * radius_px * z / camera.focal
-    return s.diameter_m[0] <= diameter <= s.diameter_m[1]
