@@ -167,25 +167,27 @@ def flow_blur(
     y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     box = np.where(moving[y0:y1, x0:x1, None], shift[y0:y1, x0:x1], np.float32(0.0))
     n = int(min(MAX_SAMPLES, max(2, np.ceil(float(length[y0:y1, x0:x1].max())) + 1)))
-    gx, gy = np.meshgrid(np.arange(x0, x1, dtype=np.float32), np.arange(y0, y1, dtype=np.float32))
-    weight = np.ones(light.shape[:2], np.float32) if still is None else (~still).astype(np.float32)
-    lit = light if still is None else light * weight[..., None]
-    total = np.zeros((y1 - y0, x1 - x0, light.shape[2]), np.float32)
-    count = np.zeros((y1 - y0, x1 - x0), np.float32)
+    grid = np.dstack(
+        np.meshgrid(np.arange(x0, x1, dtype=np.float32), np.arange(y0, y1, dtype=np.float32))
+    )
+    # With a still part the light is sampled with its weight (1 off the part, 0 on it)
+    # as a last channel: one remap a sample gives both.
+    source = light if still is None else np.dstack([light * ~still[..., None], ~still])
+    total = np.zeros((y1 - y0, x1 - x0, source.shape[2]), np.float32)
     for s in np.linspace(-0.5, 0.5, n, dtype=np.float32):
-        mx, my = gx + s * box[..., 0], gy + s * box[..., 1]
-        flags, border = cv2.INTER_LINEAR, cv2.BORDER_REPLICATE
-        total += cv2.remap(lit, mx, my, flags, borderMode=border).reshape(total.shape)
-        if still is not None:
-            count += cv2.remap(weight, mx, my, flags, borderMode=border)
+        # One (H, W, 2) map, no second one: the stubs want an array where None works.
+        sample = cv2.remap(source, grid + s * box, None, cv2.INTER_LINEAR,  # type: ignore[call-overload]
+                           borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
+        total += sample.reshape(total.shape)
     out = light.copy()
     inner = out[y0:y1, x0:x1]
     if still is None:
-        inner[moving[y0:y1, x0:x1]] = total[moving[y0:y1, x0:x1]] / np.float32(n)
+        np.copyto(inner, total / np.float32(n), where=moving[y0:y1, x0:x1, None])
         return out
+    count = total[..., -1:]
     # A pixel whose every sample fell on the still part keeps its light.
-    blurred = moving[y0:y1, x0:x1] & (count > 1e-3)
-    inner[blurred] = total[blurred] / count[blurred, None]
+    blurred = moving[y0:y1, x0:x1, None] & (count > 1e-3)
+    np.copyto(inner, total[..., :-1] / np.maximum(count, np.float32(1e-3)), where=blurred)
     return out
 
 
