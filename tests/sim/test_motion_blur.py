@@ -201,3 +201,16 @@ def test_a_zero_flow_changes_nothing_and_a_bad_flow_is_refused() -> None:
         effects.apply(image, np.random.default_rng(1), flow_px_s=zero[:10])
     with pytest.raises(ParameterError, match="still"):
         effects.apply(image, np.random.default_rng(1), flow_px_s=zero, still=np.zeros((2, 2), bool))
+
+
+def test_an_arm_drawn_with_another_body_is_no_step_for_c1() -> None:
+    clock = [0.0]
+    rig = _rig(clock)
+    _draw(rig, clock, _pose(0.0))
+    rig.moved(_pose(0.01), np.tile([0.0, 0.4, 0.0], (2, 1)), np.full(2, 0.03))
+    assert rig.c1_flow("left", SIZE, (0, 0), 0.05) is None
+
+
+def test_a_sweep_far_outside_the_frame_paints_nothing() -> None:
+    flow = swept_flow(SIZE, np.array([[1e12, 5.0]]), np.array([[1e9, 0.0]]), np.array([2.0]), 0.01)
+    assert not flow.any()

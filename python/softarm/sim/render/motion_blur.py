@@ -140,8 +140,9 @@ def swept_flow(
         half = 0.5 * exposure_s * np.asarray(vel, float)
         if not np.all(np.isfinite(np.append(c, half))) or float(np.hypot(*half)) < 0.5:
             continue  # not drawn, or sweeping under a pixel
-        a = np.round(c - half - origin).astype(int)
-        b = np.round(c + half - origin).astype(int)
+        # Clipped far outside the frame: cv2.line takes 32-bit coordinates.
+        a = np.clip(np.round(c - half - origin), -1e6, 1e6).astype(int)
+        b = np.clip(np.round(c + half - origin), -1e6, 1e6).astype(int)
         thick = max(1, round(2 * float(r)) + 1)
         cv2.line(flow, (int(a[0]), int(a[1])), (int(b[0]), int(b[1])),
                  (float(vel[0]), float(vel[1])), thick)  # fmt: skip

@@ -10,8 +10,9 @@ was last drawn before ``t`` it has held still since, and nothing blurs. Without 
 (single renders: datasets, pictures, the robustness map) there is no motion.
 
 C2 rides on the end effector: its frames move as a whole, each pixel at the image
-velocity of the scene there given C2's twist (:func:`camera_twist`, :func:`twist_flow`),
-the scene taken as the plane of the bush's berries facing the arm
+velocity of the scene there given C2's twist (:func:`camera_twist`, :func:`twist_flow`,
+on the pinhole grid: the lens's mild distortion moves a smear by a fraction of its
+length), the scene taken as the plane of the bush's berries facing the arm
 (:func:`plane_inverse_depth`: C2's frames look at the bush's face, the target berry
 on it; past its edge, the sky). What of the rig C2 sees (the fingers, the marker
 body's panels) moves with it and stays sharp: its pixels, the same in every C2 frame,
@@ -133,11 +134,13 @@ class RigMotion:
         T_base_eye = self.stereo.T_base_left
         if eye != "left":
             T_base_eye = T_base_eye @ self.stereo.T_left_right
+        if now.body.shape != before.body.shape:
+            return None  # another arm drawn: no step to take
         T_eye_base = invert(T_base_eye)
         p_now = now.body @ T_eye_base[:3, :3].T + T_eye_base[:3, 3]
         p_before = before.body @ T_eye_base[:3, :3].T + T_eye_base[:3, 3]
         front = (p_now[:, 2] > 0.05) & (p_before[:, 2] > 0.05)
-        if len(p_now) != len(p_before) or not front.any():
+        if not front.any():
             return None
         centres = model.project(p_now[front])
         velocity = (centres - model.project(p_before[front])) / dt
