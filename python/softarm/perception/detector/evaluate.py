@@ -6,7 +6,7 @@ Depth: a folder with, for each image, a file of the same stem: a 16-bit PNG in
 millimetres (as ``softarm dataset`` and RealSense tools write it) or a ``.npy`` in metres,
 aligned with the colour image. The camera: a file (``CameraModel.load``'s formats), else
 each image record's ``camera`` (``softarm dataset``), else an ideal camera whose focal
-length is the image's longer side (only the physical-size check and positions use it)."""
+length is the image's longer side (only the depth check and positions use it)."""
 
 from __future__ import annotations
 
