@@ -1,0 +1,68 @@
+"""A fruit's centre from its silhouette with the edge pixels counted by their share of
+fruit (softarm.perception.berry_centre): a dark fruit half in front of a bright leaf and
+half in front of dark ground, drawn with its edge pixels mixed in proportion to their
+cover, is centred to a twentieth of a pixel, where the thresholded mask's centroid
+leans towards the dark ground."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from softarm.perception.berries import detect_berries
+from softarm.perception.berry_centre import silhouette_centre
+from softarm.vision.camera_model import CameraModel
+
+CAMERA = CameraModel.ideal(300.0, 160, 120)
+FRUIT = np.array([40.0, 8.0, 25.0])  # BGR: black-purple
+LEAF = np.array([60.0, 150.0, 80.0])  # BGR: a lit leaf
+GROUND = np.array([22.0, 30.0, 26.0])  # BGR: shaded ground
+
+
+def fruit_image(centre: tuple[float, float], radius: float, split: float) -> np.ndarray:
+    """A disc of fruit at ``centre`` (px) on the leaf left of column ``split`` and on the
+    ground right of it; each pixel the mix of the two in the share the disc covers
+    (8 x 8 samples a pixel, their centres at the pixel's integer coordinates)."""
+    n = 8
+    offsets = (np.arange(n) + 0.5) / n - 0.5
+    yy, xx = np.mgrid[0:120, 0:160].astype(float)
+    cover = np.zeros((120, 160))
+    for dy in offsets:
+        for dx in offsets:
+            cover += (xx + dx - centre[0]) ** 2 + (yy + dy - centre[1]) ** 2 < radius**2
+    cover /= n * n
+    ground = np.where((xx < split)[..., None], LEAF, GROUND)
+    image = cover[..., None] * FRUIT + (1.0 - cover[..., None]) * ground
+    return np.asarray(np.round(image), np.uint8)
+
+
+def mask_centroid(det: object) -> tuple[float, float]:
+    """What the detector returned before: the centroid of the thresholded mask."""
+    m = cv2.moments(det.mask.astype(np.uint8), binaryImage=True)  # type: ignore[attr-defined]
+    ox, oy = det.mask_offset  # type: ignore[attr-defined]
+    return ox + m["m10"] / m["m00"], oy + m["m01"] / m["m00"]
+
+
+@pytest.mark.parametrize("centre", [(80.37, 60.62), (79.81, 58.15), (81.5, 61.05)])
+def test_a_fruit_in_front_of_two_grounds_is_centred_where_it_is(
+    centre: tuple[float, float],
+) -> None:
+    [det] = detect_berries(fruit_image(centre, 9.3, 80.0), CAMERA)
+    old = mask_centroid(det)
+    assert abs(old[0] - centre[0]) > 0.15  # the mask leans to the dark ground
+    assert det.center == pytest.approx(centre, abs=0.06)
+
+
+def test_without_contrast_the_mask_centroid_stands() -> None:
+    # Fruit and ground of one brightness: nothing tells the edge's shares apart.
+    mask = np.zeros((30, 30), bool)
+    mask[10:20, 8:18] = True
+    colour = np.full((30, 30, 3), 12, np.uint8)
+    assert silhouette_centre(mask, colour, (100, 50), (112.5, 64.5)) == pytest.approx((112.5, 64.5))
+
+
+def test_a_window_too_small_for_a_background_keeps_the_centroid() -> None:
+    mask = np.ones((6, 6), bool)  # the fruit fills the window: no ring around it
+    colour = np.zeros((6, 6, 3), np.uint8)
+    assert silhouette_centre(mask, colour, (0, 0), (2.5, 2.5)) == (2.5, 2.5)
