@@ -5,6 +5,8 @@ the colour-and-shape detector on the same frames."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import cv2
 import numpy as np
 import pytest
@@ -58,8 +60,8 @@ def _with_depth(width: int, height: int, focal: float) -> tuple[np.ndarray, np.n
 @pytest.mark.parametrize("with_depth", [False, True], ids=["image", "depth"])
 @pytest.mark.parametrize("size", [(1280, 720), (320, 240)], ids=["c1", "c2"])
 def test_colour_detector_with_the_depth_check(
-    benchmark, size: tuple[int, int], with_depth: bool
-) -> None:  # type: ignore[no-untyped-def]
+    benchmark: Any, size: tuple[int, int], with_depth: bool
+) -> None:
     focal = 900.0 * size[0] / 1280
     image, depth = _with_depth(*size, focal)
     camera = CameraModel.ideal(focal, *size)

@@ -5,6 +5,8 @@ is a typed error naming it. And the network's stage rule: ripe by majority."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from detector_scenes import H, W, disc, draw, sphere_depth
@@ -113,7 +115,7 @@ def test_bad_depth_is_a_vision_error_naming_depth(depth: np.ndarray) -> None:
         {"min_relief": -0.1},
     ],
 )
-def test_bad_depth_check_settings_are_an_input_error_naming_them(kwargs: dict) -> None:
+def test_bad_depth_check_settings_are_an_input_error_naming_them(kwargs: dict[str, Any]) -> None:
     with pytest.raises(InputError, match=next(iter(kwargs))):
         DepthCheck(**kwargs)
 
@@ -138,7 +140,8 @@ def test_the_fruit_size_is_the_renderer_fruit_size() -> None:
 
 def test_ripe_needs_the_majority_of_the_stage_mass() -> None:
     # The plurality would call this ripe: turning and unripe split the rest.
-    assert instance_stage(np.array([0.45, 0.35, 0.20])) == ("turning", pytest.approx(0.45))
+    stage, p_ripe = instance_stage(np.array([0.45, 0.35, 0.20]))
+    assert stage == "turning" and p_ripe == pytest.approx(0.45)
     assert instance_stage(np.array([0.45, 0.15, 0.40]))[0] == "unripe"
     assert instance_stage(np.array([RIPE_SHARE, 0.2, 0.2]) / (RIPE_SHARE + 0.4))[0] == "ripe"
 
