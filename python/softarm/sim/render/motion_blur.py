@@ -168,16 +168,23 @@ def flow_blur(
     y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     box = np.where(moving[y0:y1, x0:x1, None], shift[y0:y1, x0:x1], np.float32(0.0))
     n = int(min(MAX_SAMPLES, max(2, np.ceil(float(length[y0:y1, x0:x1].max())) + 1)))
-    grid = np.dstack(
-        np.meshgrid(np.arange(x0, x1, dtype=np.float32), np.arange(y0, y1, dtype=np.float32))
-    )
-    # With a still part the light is sampled with its weight (1 off the part, 0 on it)
-    # as a last channel: one remap a sample gives both.
-    source = light if still is None else np.dstack([light * ~still[..., None], ~still])
+    grid = np.empty((y1 - y0, x1 - x0, 2), np.float32)
+    grid[..., 0] = np.arange(x0, x1, dtype=np.float32)
+    grid[..., 1] = np.arange(y0, y1, dtype=np.float32)[:, None]
+    source = light
+    if still is not None:
+        # The light is sampled with its weight (1 off the still part, 0 on it) as a
+        # last channel: one remap a sample gives both.
+        source = np.empty((*light.shape[:2], light.shape[2] + 1), np.float32)
+        source[..., -1] = ~still
+        np.multiply(light, source[..., -1:], out=source[..., :-1])
     total = np.zeros((y1 - y0, x1 - x0, source.shape[2]), np.float32)
+    shifted = np.empty_like(grid)
     for s in np.linspace(-0.5, 0.5, n, dtype=np.float32):
+        np.multiply(box, s, out=shifted)
+        shifted += grid
         # One (H, W, 2) map, no second one: the stubs want an array where None works.
-        sample = cv2.remap(source, grid + s * box, None, cv2.INTER_LINEAR,  # type: ignore[call-overload]
+        sample = cv2.remap(source, shifted, None, cv2.INTER_LINEAR,  # type: ignore[call-overload]
                            borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
         total += sample.reshape(total.shape)
     out = light.copy()
