@@ -1,5 +1,5 @@
 """``softarm harvest``'s dry run of the hardware path: ``--record-frames DIR`` with
-``--sim --world bush`` records, ``--config DIR/hw.toml --frames DIR --dry-run``
+``--sim --world bush`` (or ``row``) records, ``--config DIR/hw.toml --frames DIR --dry-run``
 replays (:mod:`softarm.harvest.rigs.replay.dry_run`, :mod:`softarm.harvest.rigs.replay.devices`)."""
 
 from __future__ import annotations
@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 
 from softarm.commands._args import output_dir
 from softarm.errors import ParameterError
-from softarm.sim.world import WorldName
 
 if TYPE_CHECKING:
     from softarm.harvest.records.log import HarvestLog
@@ -35,7 +34,8 @@ def add_dry_run_options(p: argparse.ArgumentParser) -> None:
     """Add ``--record-frames``, ``--frames`` and ``--dry-run`` to ``p``."""
     p.add_argument(
         "--record-frames", type=output_dir, metavar="DIR",
-        help="--sim --world bush: record every camera frame, ripeness reading and "
+        help="--sim --world bush or row: record every camera frame (as the camera model "
+        "delivers it, in the row), ripeness reading and "
         "pressure command in DIR, with DIR/hw.toml, the rig as a hardware configuration "
         "(the dry run's input). Recorded into a fresh folder beside DIR, moved into place "
         "when the run ends: DIR must be new, empty or an earlier recording (it holds "
@@ -59,8 +59,10 @@ def check_dry_run(args: argparse.Namespace) -> None:
     Raises:
         ParameterError: the option and what it needs, named.
     """
-    if args.record_frames is not None and not (args.sim and args.world is WorldName.BUSH):
-        raise ParameterError("--record-frames: records the rendered bush (--sim --world bush)")
+    if args.record_frames is not None and not (args.sim and args.world.rendered):
+        raise ParameterError(
+            "--record-frames: records the rendered worlds (--sim --world bush or row)"
+        )
     if args.dry_run != (args.frames is not None):
         raise ParameterError("--dry-run and --frames DIR: give both (with --config)")
     if args.dry_run and args.sim:
