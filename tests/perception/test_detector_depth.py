@@ -90,7 +90,7 @@ def test_a_blob_across_a_depth_edge_is_dropped() -> None:
 
 def test_unknown_depth_keeps_the_detection_without_a_position() -> None:
     depth = np.full((H, W), np.nan)
-    depth[0, 0] = 0.0
+    depth[0, :3] = (0.0, np.inf, -np.inf)  # ROS REP 118: unknown, too far, too near
     [det] = detect_berries(_one_ripe(12), CAMERA, depth)
     assert det.position is None
 

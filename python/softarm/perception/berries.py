@@ -225,8 +225,10 @@ def _check(image: object, depth: object, camera: CameraModel | None = None) -> N
     metres = depth_metres(depth, checked.shape)
     # NaN, 0 and +-inf are unknown (ROS REP 118's float depth); a negative depth is no
     # depth at all: a wrong unit or sign, refused rather than read as "unknown".
-    if metres is not None and bool(np.any(metres < 0)):
-        raise VisionError("depth holds negative values: give metres in front of the camera")
+    if metres is not None:
+        negative = metres < 0
+        if negative.any() and np.isfinite(metres[negative]).any():
+            raise VisionError("depth holds negative values: give metres in front of the camera")
     if camera is not None:
         bgr_image(checked, "image", camera.image_size)
 
