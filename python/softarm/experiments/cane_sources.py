@@ -1,12 +1,17 @@
 """The cane pixels' sources side by side (:mod:`softarm.perception.cane_source`): on each
 seed's bush, in each condition (the daylight row's looks, ``sun``, ``overcast``,
 ``dusk`` and ``backlight``, and the rendered bush, ``bush``), C1's stereo pair is
-rendered once; every candidate's mask (``colour``, ``net``, their intersection
-``net+colour`` and their union ``net|colour``) goes through the same stereo and curve fit
-(:func:`softarm.perception.canes.mask_points`, :func:`~softarm.perception.canes.
-fit_cane_points`), and :func:`~softarm.perception.cane_metrics.cane_map_error` scores
-the fits against every cane drawn (the bush's and, in the row, the row's) within the
-arm's reach. C1 is where it truly is, the arm out of view; no depth from the renderer.
+rendered once; every candidate's mask (``colour``, ``net`` and their intersection
+``net+colour``; their union ``net|colour`` with ``--union``) goes through the same
+stereo and curve fit (:func:`softarm.perception.canes.mask_points`,
+:func:`~softarm.perception.canes.fit_cane_points`) twice, once per point budget
+(``budget``: ``view``, the fit's points an even subsample of the whole view's, as
+before the reach; ``reach``, the points beyond ``CaneSettings.reach`` dropped first),
+and :func:`~softarm.perception.cane_metrics.cane_map_error` scores the fits against
+every cane drawn (the bush's and, in the row, the row's) within the arm's reach. C1 is
+where it truly is, the arm out of view; no depth from the renderer. ``fit_ms``: the
+time of the stereo, the points and the fit of one C1 frame for one mask (the mask
+itself not included), both budgets in the same process.
 
 Rows are written one JSON line per scene and source, so that seeds can be run in parts
 (each part a process of a few minutes) and summed up after::
@@ -14,10 +19,10 @@ Rows are written one JSON line per scene and source, so that seeds can be run in
     MUJOCO_GL=egl python -m softarm.experiments.cane_sources run sun 310000 310024 --out rows/
     python -m softarm.experiments.cane_sources table rows/ --out docs/data/cane_sources.json
 
-The summary per condition and source: ``coverage`` pooled over the scenes by true cane
+The summary per condition, source and budget: ``coverage`` pooled over the scenes by true cane
 length; ``precision`` pooled by fitted length in the workspace (a scene without fits
 adds nothing, where a mean of per-scene shares would count it as 1); ``median_mm`` the
-median of the per-scene medians.
+median of the per-scene medians; ``fit_ms`` the median over the scenes.
 
 It lives above :mod:`softarm.perception` (which may not import the simulation).
 """
@@ -25,6 +30,7 @@ It lives above :mod:`softarm.perception` (which may not import the simulation).
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import time
 from collections.abc import Sequence
@@ -37,12 +43,22 @@ from softarm.perception.cane_curves import curve_points
 from softarm.perception.cane_metrics import DEFAULT_REACH, cane_map_error
 from softarm.perception.canes import CaneFit, CaneSettings, fit_cane_points, mask_points
 
-__all__ = ["CONDITIONS", "SOURCES", "fitted_length", "scene_rows", "summarise"]
+__all__ = [
+    "BUDGETS",
+    "CONDITIONS",
+    "SOURCES",
+    "fitted_length",
+    "scene_rows",
+    "side_by_side",
+    "summarise",
+]
 
 #: The row's looks and the rendered bush.
 CONDITIONS = ("sun", "overcast", "dusk", "backlight", "bush")
 #: The candidates, in the order of the table.
 SOURCES = ("colour", "net", "net+colour", "net|colour")
+#: The point budgets: the whole view's (None: as before the reach) and the reach's.
+BUDGETS = {"view": None, "reach": CaneSettings().reach}
 
 
 def fitted_length(fits: Sequence[CaneFit], reach: float = DEFAULT_REACH) -> float:
@@ -57,8 +73,11 @@ def fitted_length(fits: Sequence[CaneFit], reach: float = DEFAULT_REACH) -> floa
     return total
 
 
-def scene_rows(condition: str, seed: int, n_berries: int = 8) -> list[dict[str, Any]]:
-    """One row per source for ``seed``'s bush in ``condition``."""
+def scene_rows(
+    condition: str, seed: int, n_berries: int = 8, union: bool = False
+) -> list[dict[str, Any]]:
+    """One row per source and budget for ``seed``'s bush in ``condition`` (``union``:
+    ``net|colour`` too)."""
     import softarm
     from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.perception.cane_source import candidate_masks
@@ -82,43 +101,60 @@ def scene_rows(condition: str, seed: int, n_berries: int = 8) -> list[dict[str, 
         truth = world.canes()
     finally:
         world.close()
-    stereo, settings = world.stereo, CaneSettings()
+    stereo = world.stereo
     rect_left, rect_right = stereo.rectification.rectify(left.colour, right.colour)
     rows = []
-    for source, mask in candidate_masks(rect_left, settings.look).items():
-        start = time.perf_counter()
-        fits = fit_cane_points(mask_points(rect_left, rect_right, stereo, mask, settings))
-        seconds = time.perf_counter() - start
-        rows.append({
-            "condition": condition, "seed": seed, "source": source,
-            **cane_map_error(fits, truth), "fitted_m": fitted_length(fits),
-            "fits": len(fits), "mask_px": int(mask.sum()), "fit_ms": 1e3 * seconds,
-        })  # fmt: skip
+    for source, mask in candidate_masks(rect_left, CaneSettings().look).items():
+        if source == "net|colour" and not union:
+            continue
+        for budget, reach in BUDGETS.items():
+            settings = CaneSettings(reach=reach)
+            start = time.perf_counter()
+            points = mask_points(rect_left, rect_right, stereo, mask, settings)
+            fits = fit_cane_points(points, settings)
+            seconds = time.perf_counter() - start
+            rows.append({
+                "condition": condition, "seed": seed, "source": source, "budget": budget,
+                **cane_map_error(fits, truth), "fitted_m": fitted_length(fits),
+                "fits": len(fits), "mask_px": int(mask.sum()), "points": len(points),
+                "fit_ms": 1e3 * seconds,
+            })  # fmt: skip
     return rows
 
 
 def summarise(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """One row per condition and source (see the module docstring for the pooling)."""
+    """One row per condition, source and budget (see the module docstring for the
+    pooling); rows without a ``budget`` (written before the reach) count as ``view``."""
     out = []
-    for condition in CONDITIONS:
-        for source in SOURCES:
-            mine = [r for r in rows if r["condition"] == condition and r["source"] == source]
-            if not mine:
-                continue
-            length = np.array([r["length_m"] for r in mine])
-            fitted = np.array([r["fitted_m"] for r in mine])
-            coverage = np.array([r["coverage"] for r in mine])
-            precision = np.array([r["precision"] for r in mine])
-            medians = [r["median_mm"] for r in mine if np.isfinite(r["median_mm"])]
-            out.append({
-                "condition": condition, "source": source, "scenes": len(mine),
-                "coverage": round(float(np.sum(length * coverage) / np.sum(length)), 3),
-                "precision": round(float(np.sum(fitted * precision) / max(fitted.sum(), 1e-9)), 3),
-                "median_mm": round(float(np.median(medians)), 2) if medians else None,
-                "fits_per_scene": round(float(np.mean([r["fits"] for r in mine])), 1),
-                "seeds": [min(r["seed"] for r in mine), max(r["seed"] for r in mine)],
-            })  # fmt: skip
+    for condition, source, budget in itertools.product(CONDITIONS, SOURCES, BUDGETS):
+        mine = [
+            r for r in rows
+            if (r["condition"], r["source"], r.get("budget", "view")) == (condition, source, budget)
+        ]  # fmt: skip
+        if mine:
+            out.append(_summary(condition, source, budget, mine))
     return out
+
+
+def _summary(
+    condition: str, source: str, budget: str, mine: Sequence[dict[str, Any]]
+) -> dict[str, Any]:
+    """One row of :func:`summarise`."""
+    length = np.array([r["length_m"] for r in mine])
+    fitted = np.array([r["fitted_m"] for r in mine])
+    coverage = np.array([r["coverage"] for r in mine])
+    precision = np.array([r["precision"] for r in mine])
+    medians = [r["median_mm"] for r in mine if np.isfinite(r["median_mm"])]
+    times = [r["fit_ms"] for r in mine if "fit_ms" in r]
+    return {
+        "condition": condition, "source": source, "budget": budget, "scenes": len(mine),
+        "coverage": round(float(np.sum(length * coverage) / np.sum(length)), 3),
+        "precision": round(float(np.sum(fitted * precision) / max(fitted.sum(), 1e-9)), 3),
+        "median_mm": round(float(np.median(medians)), 2) if medians else None,
+        "fits_per_scene": round(float(np.mean([r["fits"] for r in mine])), 1),
+        "fit_ms": round(float(np.median(times)), 1) if times else None,
+        "seeds": [min(r["seed"] for r in mine), max(r["seed"] for r in mine)],
+    }  # fmt: skip
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -127,10 +163,30 @@ def _run(args: argparse.Namespace) -> None:
     path = folder / f"{args.condition}_{args.first}_{args.last}.jsonl"
     with path.open("w") as f:
         for seed in range(args.first, args.last + 1):
-            for row in scene_rows(args.condition, seed):
+            for row in scene_rows(args.condition, seed, union=args.union):
                 f.write(json.dumps(row) + "\n")
             f.flush()
             print(args.condition, seed, flush=True)
+
+
+def side_by_side(table: Sequence[dict[str, Any]]) -> list[str]:
+    """The summary as a markdown table, one row per condition and source: each figure
+    with the whole view's budget, then within the reach (``view → reach``)."""
+    keys = ("coverage", "precision", "median_mm", "fit_ms")
+    lines = [
+        "| condition | source | scenes | " + " | ".join(keys) + " |",
+        "| --- | --- | --- |" + " --- |" * len(keys),
+    ]
+    for condition, source in itertools.product(CONDITIONS, SOURCES):
+        pair = {
+            r["budget"]: r for r in table if (r["condition"], r["source"]) == (condition, source)
+        }
+        if not pair:
+            continue
+        cells = [" → ".join(str(pair[b][k]) for b in BUDGETS if b in pair) for k in keys]
+        scenes = "/".join(str(pair[b]["scenes"]) for b in BUDGETS if b in pair)
+        lines.append(f"| {condition} | `{source}` | {scenes} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def _table(args: argparse.Namespace) -> None:
@@ -141,11 +197,8 @@ def _table(args: argparse.Namespace) -> None:
         for line in path.read_text().splitlines()
     ]
     table = summarise(rows)
-    keys = ("condition", "source", "scenes", "coverage", "precision", "median_mm")
-    print("| " + " | ".join(keys) + " |")
-    print("|" + " --- |" * len(keys))
-    for row in table:
-        print("| " + " | ".join(str(row[k]) for k in keys) + " |")
+    for line in side_by_side(table):
+        print(line)
     if args.out:
         Path(args.out).write_text(json.dumps(table, indent=1) + "\n")
 
@@ -159,6 +212,7 @@ def main(argv: list[str] | None = None) -> None:
     run.add_argument("first", type=int)
     run.add_argument("last", type=int)
     run.add_argument("--out", required=True, help="folder for the rows (JSON lines)")
+    run.add_argument("--union", action="store_true", help="score net|colour too")
     table = sub.add_parser("table", help="the summary of the rows in FOLDERS")
     table.add_argument("folders", nargs="+")
     table.add_argument("--out", help="the summary as JSON")
