@@ -114,3 +114,22 @@ def test_experiments_orientation_error_is_the_cores_and_equals_the_old_formula()
         old = float(np.linalg.norm([1.0, 0.0, 1.0] * _old_log(target[:3, :3] @ pose[:3, :3].T)))
         got = orientation_error(judge, rng.uniform(0, 0.03, 9), target, pose)
         assert got == pytest.approx(old, abs=1e-12)
+
+
+@given(VEC)
+def test_quaternion_is_scipys_with_w_not_negative(w: np.ndarray) -> None:
+    from scipy.spatial.transform import Rotation
+
+    r = so3.exp(_scaled(w, 3.1))
+    want = Rotation.from_matrix(r).as_quat()
+    want = want if want[3] >= 0 else -want
+    got = np.array(so3.quaternion_xyzw(r))
+    np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+@pytest.mark.parametrize("axis", [(1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0), (1.0, 1.0, 0)])
+def test_quaternion_of_half_turns_takes_each_branch(axis: tuple[float, ...]) -> None:
+    unit = np.asarray(axis) / np.linalg.norm(axis)
+    x, y, z, w = so3.quaternion_xyzw(so3.exp(np.pi * unit))
+    np.testing.assert_allclose(np.abs([x, y, z]), np.abs(unit), atol=1e-12)
+    assert abs(w) < 1e-12

@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
-__all__ = ["exp", "log", "rotation_between"]
+__all__ = ["exp", "log", "quaternion_xyzw", "rotation_between"]
 
 F64 = npt.NDArray[np.float64]
 
@@ -45,3 +45,31 @@ def rotation_between(a: npt.ArrayLike, b: npt.ArrayLike) -> F64 | None:
     if s < 1e-12:
         return np.eye(3) if c > 0 else None
     return exp(v / s * math.atan2(s, c))
+
+
+def quaternion_xyzw(r: npt.ArrayLike) -> tuple[float, float, float, float]:
+    """The unit quaternion (x, y, z, w), w ≥ 0, of the rotation matrix ``r`` (3, 3).
+
+    Shepperd's method: the largest of w², x², y², z² (from the trace and the diagonal)
+    is taken by its square root and the others from the off-diagonal sums, so no
+    division is by a small number. In plain floats, because the live view converts every
+    control step's poses and scipy's ``Rotation.from_matrix`` (which also checks and
+    orthogonalises) costs about ten times the rest of a step's messages."""
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.asarray(r, dtype=np.float64).tolist()
+    trace = m00 + m11 + m22
+    if trace >= max(m00, m11, m22):
+        s = 2.0 * math.sqrt(max(1.0 + trace, 0.0))
+        q = ((m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s)
+    elif m00 >= m11 and m00 >= m22:
+        s = 2.0 * math.sqrt(max(1.0 + m00 - m11 - m22, 0.0))
+        q = (0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s)
+    elif m11 >= m22:
+        s = 2.0 * math.sqrt(max(1.0 + m11 - m00 - m22, 0.0))
+        q = ((m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s)
+    else:
+        s = 2.0 * math.sqrt(max(1.0 + m22 - m00 - m11, 0.0))
+        q = ((m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s)
+    norm = math.sqrt(sum(c * c for c in q))
+    sign = -1.0 if q[3] < 0.0 else 1.0
+    x, y, z, w = (sign * c / norm for c in q)
+    return x, y, z, w

@@ -35,9 +35,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation  # here, not on the first step: it is slow
 
 from softarm.errors import MissingDependencyError, ParameterError
+from softarm.so3 import quaternion_xyzw
 
 __all__ = ["LiveView", "parse_address", "require_foxglove", "serve_log"]
 
@@ -241,7 +241,7 @@ class LiveView:
 
 
 def _transform(m: Any, stamp: Any, child: str, pose: np.ndarray) -> Any:
-    x, y, z, w = Rotation.from_matrix(pose[:3, :3]).as_quat()
+    x, y, z, w = quaternion_xyzw(pose[:3, :3])
     return m.FrameTransform(
         timestamp=stamp, parent_frame_id="base", child_frame_id=child,
         translation=m.Vector3(x=pose[0, 3], y=pose[1, 3], z=pose[2, 3]),
