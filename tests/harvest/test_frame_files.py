@@ -58,3 +58,13 @@ def test_frames_out_of_order_are_refused(tmp_path: Path) -> None:
     (tmp_path / INDEX).write_text(json.dumps(index))
     with pytest.raises(ConfigError, match=r"frames\[0\]: c1 frame 2 .* out of order"):
         FrameFolder(tmp_path)
+
+
+def test_a_run_that_read_no_ripeness_replays_none(tmp_path: Path) -> None:
+    # A run that grasped nothing (its one berry unripe, never picked) read the sensor
+    # never and ended no berry: its recording still holds both streams, empty, for the
+    # replay to read.
+    rec = FrameRecorder(tmp_path)
+    rec.save()
+    folder = FrameFolder(tmp_path)
+    assert folder.stream("ripeness") == [] and folder.stream("berry_states") == []

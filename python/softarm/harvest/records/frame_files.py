@@ -19,7 +19,12 @@ from softarm.files import write_text
 from softarm.files.fresh import FreshFolder
 from softarm.files.images import read_image, write_image
 from softarm.files.read import load_json
-from softarm.harvest.records.frame_index import check_entry, check_streams
+from softarm.harvest.records.frame_index import (
+    BERRY_STATES,
+    RIPENESS,
+    check_entry,
+    check_streams,
+)
 from softarm.vision.crop import ImageCrop
 
 __all__ = ["INDEX", "TIME_TOLERANCE_S", "FrameFolder", "FrameRecorder"]
@@ -55,7 +60,10 @@ class FrameRecorder:
         self._fresh = FreshFolder(folder, "recording", INDEX)
         self.folder = self._fresh.path
         self.entries: list[dict[str, Any]] = []
-        self.streams: dict[str, list[Any]] = {}
+        # The sensor's readings and the berries' outcomes are kept even when there are
+        # none (a run whose one berry was unripe, never picked): its replay then reads
+        # none, instead of finding the stream missing.
+        self.streams: dict[str, list[Any]] = {RIPENESS: [], BERRY_STATES: []}
 
     def record(self, stream: str, value: Any) -> None:
         """Append ``value`` (JSON: numbers, lists, strings) to the named stream."""
