@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
-from softarm.perception.berries import detect_berries
+from softarm.perception.berries import MAX_REFINED_RADIUS, detect_berries
 from softarm.perception.berry_centre import silhouette_centre
 from softarm.vision.camera_model import CameraModel
 
@@ -66,3 +66,10 @@ def test_a_window_too_small_for_a_background_keeps_the_centroid() -> None:
     mask = np.ones((6, 6), bool)  # the fruit fills the window: no ring around it
     colour = np.zeros((6, 6, 3), np.uint8)
     assert silhouette_centre(mask, colour, (0, 0), (2.5, 2.5)) == (2.5, 2.5)
+
+
+def test_a_close_up_fruit_keeps_its_masks_centroid() -> None:
+    # 20 px: C2's close-up, where highlights on the lit edge would read as background.
+    [det] = detect_berries(fruit_image((80.37, 60.62), 20.0, 80.0), CAMERA)
+    assert det.radius > MAX_REFINED_RADIUS
+    assert det.center == pytest.approx(mask_centroid(det), abs=1e-9)

@@ -52,6 +52,11 @@ MAX_BLOBS = 500
 #: tens of fruit): :func:`~softarm.perception.berry_centre.silhouette_centre` costs about
 #: a millisecond a blob.
 MAX_REFINED = 64
+#: ...and only up to this radius (px): a drupelet's specular highlight, about a ninth of
+#: the fruit's radius, is then within the detector's 3x3 blur. On a larger fruit (C2's
+#: close-up, 20-30 px) highlights on the lit edge read as background and the refined
+#: centre leans away from the light (0.6 px against the mask's 0.3 on C2 at the grasp).
+MAX_REFINED_RADIUS = 14.0
 # What OpenCV returns for a uint8 image (its stubs say any number array).
 _U8 = npt.NDArray[np.uint8]
 _Contour = npt.NDArray[np.int32]
@@ -174,8 +179,12 @@ def detect_berries(
     found = detections_in_masks(ripe, unripe, camera, depth, s)
     # The harvest steers by ripe fruit's centres (an unripe one's only places it in the
     # map); the largest first, at most MAX_REFINED: a frame of specks costs a bound. A
-    # fruit placed by depth keeps the centre its position was found on.
-    ripe_ones = [k for k, d in enumerate(found) if d.ripeness == "ripe" and d.position is None]
+    # fruit placed by depth keeps the centre its position was found on, and a large one
+    # its mask's (MAX_REFINED_RADIUS).
+    ripe_ones = [
+        k for k, d in enumerate(found)
+        if d.ripeness == "ripe" and d.position is None and d.radius <= MAX_REFINED_RADIUS
+    ]  # fmt: skip
     for k in sorted(ripe_ones, key=lambda k: -found[k].radius)[:MAX_REFINED]:
         found[k] = _centred(found[k], blurred)
     return found
