@@ -224,3 +224,30 @@ def test_a_plans_end_hands_over_once_the_lag_model_has_the_arm_within_the_tolera
     early, early_flight = _hand_over(0.01)
     assert late_flight <= 0.001 < early_flight <= 0.01
     assert early < late - 0.3
+
+
+# -- the correction against the plan's point where the arm is -------------------------------
+
+
+def _commands_following_on_the_lagging_plant() -> tuple[np.ndarray, list[np.ndarray]]:
+    """Follow a plan on the lagging plant with an exact model (nothing for the correction
+    to take out); the plan's end and every q commanded."""
+    clock, plant, _, actuator = _lagging_rig(lead_gain(TAU, PERIOD, 1.5))
+    log, config = HarvestLog(), HarvestConfig()
+    servo = Servo(clock, FakeController(), actuator, config, log)
+    vision = FakeVision(FakeTracker(plant), FakeLocator(dict(BERRIES)))
+    vision.select(BerryTarget(1))
+    watch = BerryWatch(vision, clock, BerryTarget(1), log, config.marker_timeout)
+    q_way = np.array([0.02, 0.015, 0.025])
+    servo.transport.follow(watch, HarvestState.INITIAL_PLACEMENT, np.zeros(3), q_way, 30.0)
+    return q_way, [np.array(r["q"]) for r in log.records if r["kind"] == "step"]
+
+
+def test_the_lag_is_not_corrected_as_an_error_while_following_a_plan() -> None:
+    """The arm trails the plan by the regulators' lag; measured against the plan's point
+    the lag read as an error and the correction piled up along the motion, past the plan's
+    end (18 mm of elongation here). Against the plan's point where the arm is, an exact
+    model leaves the correction nothing to do: the commands keep within the plan."""
+    q_way, commanded = _commands_following_on_the_lagging_plant()
+    past_the_end = max(float(np.max(q - q_way)) for q in commanded)
+    assert past_the_end <= 1e-4

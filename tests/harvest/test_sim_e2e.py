@@ -92,13 +92,16 @@ def test_a_lagging_arm_does_not_cut_across_a_cane_on_its_way_to_the_first_berry(
     # Seed 504 on a 1 s / 5 psi plant, not calibrated: the plan's first move used to
     # touch a cane (6 steps, 3.9 mm deep). Each command was clear on the model, but the
     # correction piled up while the arm trailed a whole lag behind, and the arm cut
-    # across from where it was to where the command had gone. The transport now holds a
-    # command whose way from the lag model's arm is not clear (`transport_held`).
+    # across from where it was to where the command had gone. The transport holds a
+    # command whose way from the lag model's arm is not clear (`transport_held`: it
+    # held two and kept 7.0 mm clear here), and its correction compares the measured
+    # pose with the plan's point where the arm is, not the plan's point ahead of it, so
+    # that the lag no longer piles up as a correction: no command held, 14 mm clear.
     # A reproduction on the diagnosis seed it was traced on: the mechanism, not the
     # accuracy (that is judged on a fresh bush below).
-    rig, _, kinds = _on_a_slow_plant(tmp_path, n_berries=8, seed=504)
-    assert rig.watch.contacts == 0 and rig.watch.min_gap > 0.0
-    assert "transport_held" in kinds
+    rig, _, _ = _on_a_slow_plant(tmp_path, n_berries=8, seed=504)
+    assert rig.watch.contacts == 0
+    assert rig.watch.min_gap >= 0.01  # the transport's margin, on the true arm
 
 
 def test_a_lagging_arm_harvests_a_fresh_bush_without_touching_a_cane(tmp_path) -> None:

@@ -26,6 +26,7 @@ from softarm.vision.cube import MarkerCube
 from softarm.vision.detector import Detection, MarkerDetector, square_marker_poses
 from softarm.vision.fusion import CameraFusion
 from softarm.vision.observation import BerryFix, BerryTarget, Observation
+from softarm.vision.pose_gate import PoseGate
 from softarm.vision.poses import invert
 
 __all__ = ["CameraVision", "register_c1"]
@@ -69,9 +70,12 @@ class CameraVision:
         grasp_offset: the grasp point (m) ahead of the end effector; the 6 cm hand-over
             is measured from it.
         max_age: how long (s) the most recent berry fix is held while it is hidden.
-        max_jump: a cube pose this far (m) from the previous one is an outlier (a wrong
-            solution of an ambiguous view: the arm cannot move that fast in one frame)
-            and is dropped, unless ``max_rejects`` in a row agree it is real.
+        max_jump: a cube pose this far (m) from where the arm's tracked motion puts it
+            (:class:`~softarm.vision.pose_gate.PoseGate`: the last accepted pose moved on
+            at its velocity) is an outlier, a wrong solution of an ambiguous view, and is
+            dropped, unless ``max_rejects`` in a row agree it is real.
+        max_speed: the fastest (m/s) the end effector is believed to move (the gate's
+            velocity is bounded by it).
     """
 
     def __init__(
@@ -89,6 +93,7 @@ class CameraVision:
         max_age: float = 1.0,
         max_jump: float = 0.03,
         max_rejects: int = 3,
+        max_speed: float = 2.0,
     ) -> None:
         self.frame1, self.frame2 = frame1, frame2
         self.model1, self.model2 = model1, model2
@@ -100,9 +105,7 @@ class CameraVision:
         )
         self.selected = BerryTarget(-1)
         self._cube_prev: FloatArray | None = None
-        self.max_jump, self.max_rejects = max_jump, max_rejects
-        self._last_ee: FloatArray | None = None
-        self._rejects = 0
+        self.gate = PoseGate(max_jump, max_rejects, max_speed)
 
     def select(self, berry: BerryTarget) -> None:
         """Track ``berry`` from now on (the fusion forgets any held target)."""
@@ -159,20 +162,10 @@ class CameraVision:
         if est is None:
             return None, berry_c1
         T_c1_ee = est.T_camera_cube @ invert(self.T_ee_cube)
-        if self._outlier(T_c1_ee):
+        if not self.gate.accept(time, T_c1_ee[:3, 3]):
             return None, berry_c1
         self._cube_prev = est.T_camera_cube
         return T_c1_ee, berry_c1
-
-    def _outlier(self, T_c1_ee: FloatArray) -> bool:
-        last = self._last_ee
-        if last is not None and np.linalg.norm(T_c1_ee[:3, 3] - last[:3, 3]) > self.max_jump:
-            self._rejects += 1
-            if self._rejects < self.max_rejects:
-                return True
-        self._rejects = 0
-        self._last_ee = T_c1_ee
-        return False
 
     def _want_c2(self, T_c1_ee: FloatArray | None) -> bool:
         """Whether to read C2 this period (always, for tags: they are cheap to find)."""

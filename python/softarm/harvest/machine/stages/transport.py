@@ -60,7 +60,8 @@ class Transport:
 
         Each period the plan's elongations advance by ``home_speed`` (the feedforward of the
         planned q) and the resolver's step, closed on the measured pose towards the model's
-        pose at the plan's current point, adds the correction: the model's error is taken
+        pose at the plan's point where the arm is (:meth:`_plan_at_arm`: the plan's current
+        point less the lag), adds the correction: the model's error is taken
         out as the arm goes and the known canes repel it inside the step (planning paper
         eq. 9), where an open-loop ramp would carry the true arm, a few cm off the model,
         into a cane. The resolver alone is local: closed on a waypoint 20-30 cm away it
@@ -104,7 +105,7 @@ class Transport:
                     f"{stage.value}: waypoint not reached, error {err:.4f} m",
                     retreat_from=q,
                 )
-            goal = model_pose(nominal)
+            goal = model_pose(self._plan_at_arm(nominal))
             q_fb, saturated = self.link.controller.follow_step(q, goal, seen.pose)
             advance = straight_step(nominal, q_way, step)
             q_next = self._led(q, q_fb, advance)
@@ -138,6 +139,22 @@ class Transport:
             nominal = nominal + advance
         watch.log_step(stage, seen, q_next, None, None, False)
         return self.link.hold(q_next), nominal
+
+    def _plan_at_arm(self, nominal: FloatArray) -> FloatArray:
+        """The plan's point where the arm is now, the one the loop's correction compares
+        the measured pose with: the plan's point ``nominal`` less the motion still in
+        flight to the last command (the lag model's; ``nominal`` itself without one).
+
+        The arm trails the command by the regulators' lag: at ``home_speed`` the gripper
+        is a few cm behind the plan's point on the nominal plant (0.08 s), most of a move
+        on the slow one (0.8 s). Measured against the
+        plan's point, that lag read as an error, and the correction piled up along the
+        motion; the arm carried it past the plan's end and came back (tuning seeds
+        1280-1282, slow plant: 0.3-1 s a berry, more in the way home). Against the
+        plan's point where the arm is, the error is the model's alone, which is what the
+        correction is for. The canes' check of each command is as before."""
+        flight = self.link.actuator.in_flight()
+        return nominal if flight is None else np.asarray(nominal - flight, dtype=np.float64)
 
     def _led(self, q: FloatArray, q_fb: FloatArray, advance: FloatArray) -> FloatArray:
         """The command of a period with the pose: the plan's motion (feedforward) on top
