@@ -1,7 +1,8 @@
 """The markerless harvest's goals from its reports (``softarm harvest --sim --world bush
---report``): harvested share of the ripe berries in reach, the ripe ones never mapped,
-unripe picked, true fine-positioning error, contacts, the cane map; and the wall time
-per berry beside the tag world's on the same seeds when its reports and times are given.
+--report``, or ``--world row``): harvested share of the ripe berries in reach, the ripe
+ones never mapped, unripe (and turning) picked, true fine-positioning error (mean and
+p95), contacts and the smallest cane gap, the cane map; and the wall time per berry
+beside the tag world's on the same seeds when its reports and times are given.
 
     python -m softarm.experiments.bush_harvest runs/bush_harvest_700-709
 
@@ -10,10 +11,13 @@ bush world's harvest and then the tag world's on the same seed (so the two share
 machine's load), each timed as a whole process, their reports and ``wall_times.txt``
 written (``--berries``, 8 by default; ``--no-survey``: the bush world without C2's
 cane survey, C1's canes only; ``--jobs N``: N seeds at once, on a machine with the
-cores for it)::
+cores for it; ``--world row --look L``: the daylight row in look L instead of the bush;
+TAG_DIR ``-``: no tag world)::
 
     MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 770 779 \
         runs/bush_harvest_770-779 runs/tag_harvest_770-779
+    MUJOCO_GL=egl python -m softarm.experiments.bush_harvest --run 90120 90125 \
+        runs/row_sun_90120-90125 - --world row --look sun --berries 4
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from softarm.errors import InputError
 from softarm.perception.cane_metrics import cane_map_error
 from softarm.sim.world import WorldName
 
@@ -44,6 +49,7 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
     """Pooled figures over ``reports`` (one per bush)."""
     ripe = sum(r["ripe_in_reach"] for r in reports)
     errors = [b["true_position_error_mm"] for r in reports for b in r["berries"] if b["harvested"]]
+    gaps = [r["min_branch_gap_m"] for r in reports if r.get("min_branch_gap_m") is not None]
     # A bush whose canes in reach were all missed has no distances (None): its coverage
     # still counts.
     maps = [r["cane_map"] for r in reports]
@@ -58,7 +64,10 @@ def summarise(reports: list[dict[str, Any]]) -> dict[str, float]:
         "never_mapped_hidden_from_c1": _hidden_from_c1(reports),
         "unripe_picked": sum(r["unripe_picked"] for r in reports),
         "mean_true_fine_error_mm": statistics.fmean(errors) if errors else float("nan"),
+        "p95_true_fine_error_mm": float(np.percentile(errors, 95)) if errors else float("nan"),
         "contact_steps": sum(r["branch_contact_steps"] for r in reports),
+        "runs_with_contact": sum(r["branch_contact_steps"] > 0 for r in reports),
+        "min_cane_gap_mm": 1e3 * min(gaps) if gaps else float("nan"),
         "cane_median_mm": statistics.median(medians) if medians else float("nan"),
         "cane_p95_mm": statistics.median(p95s) if p95s else float("nan"),
         "cane_coverage": _length_weighted_coverage(reports),
@@ -127,22 +136,26 @@ def _reports(folder: Path) -> list[dict[str, Any]]:
 def run_pair(
     seeds: range,
     bush_dir: Path,
-    tag_dir: Path,
+    tag_dir: Path | None,
     berries: int = 8,
     survey: bool = True,
     jobs: int = 1,
+    look: str | None = None,
 ) -> None:
-    """Harvest each seed in the bush world (without C2's cane survey unless ``survey``),
-    then in the tag world, timing each whole process (``python -m softarm
-    harvest --sim ...``); reports and wall times into the two folders. ``jobs`` seeds
-    run at once (each seed's two worlds one after the other, so they share the load)."""
-    for folder in (bush_dir, tag_dir):
+    """Harvest each seed in the bush world (without C2's cane survey unless ``survey``;
+    in the daylight row in ``look`` where one is given), then in the tag world unless
+    ``tag_dir`` is None, timing each whole process (``python -m softarm harvest --sim
+    ...``); reports and wall times into the folders. ``jobs`` seeds run at once (each
+    seed's worlds one after the other, so they share the load)."""
+    worlds: list[tuple[Path, list[str]]] = [(bush_dir, _rendered_args(survey, look))]
+    if tag_dir is not None:
+        worlds.append((tag_dir, []))
+    for folder, _ in worlds:
         folder.mkdir(parents=True, exist_ok=True)
     lock = threading.Lock()
-    bush = ["--world", "bush"] + ([] if survey else ["--no-survey"])
 
     def one_seed(seed: int) -> None:
-        for folder, world in ((bush_dir, bush), (tag_dir, [])):
+        for folder, world in worlds:
             report = folder / f"r{seed}.json"
             command = [sys.executable, "-m", "softarm", "harvest", "--sim", *world,
                        "--berries", str(berries), "--seed", str(seed),
@@ -157,20 +170,36 @@ def run_pair(
         list(pool.map(one_seed, seeds))
 
 
+def _rendered_args(survey: bool, look: str | None) -> list[str]:
+    """The harvest's world options: the bush, or the daylight row in ``look``."""
+    world = ["--world", "bush"] if look is None else ["--world", "row", "--look", look]
+    return world + ([] if survey else ["--no-survey"])
+
+
+def _option(argv: list[str], name: str, default: str | None) -> str | None:
+    """The value after ``name`` in ``argv``, else ``default``."""
+    return argv[argv.index(name) + 1] if name in argv else default
+
+
 def main(argv: list[str]) -> None:
     """Print the pooled figures of each folder of reports on the command line (after
     making them, with ``--run``)."""
     if argv[:1] == ["--run"]:
-        berries = int(argv[argv.index("--berries") + 1]) if "--berries" in argv else 8
-        jobs = int(argv[argv.index("--jobs") + 1]) if "--jobs" in argv else 1
+        berries = int(_option(argv, "--berries", "8") or 8)
+        jobs = int(_option(argv, "--jobs", "1") or 1)
+        look = _option(argv, "--look", None)
+        if (_option(argv, "--world", "bush") == "row") != (look is not None):
+            raise InputError("--world row and --look: both or neither")
         first, last, bush_dir, tag_dir = argv[1:5]
         seeds = range(int(first), int(last) + 1)
-        run_pair(seeds, Path(bush_dir), Path(tag_dir), berries, "--no-survey" not in argv, jobs)
-        argv = [bush_dir, tag_dir]
+        tags = None if tag_dir == "-" else Path(tag_dir)
+        survey = "--no-survey" not in argv
+        run_pair(seeds, Path(bush_dir), tags, berries, survey, jobs, look)
+        argv = [bush_dir] + ([] if tags is None else [tag_dir])
     for name in argv:
         folder = Path(name)
         reports = _reports(folder)
-        bush = all(r.get("world") == WorldName.BUSH for r in reports)
+        bush = all(r.get("world") in (WorldName.BUSH, WorldName.ROW) for r in reports)
         figures: dict[str, float] = summarise(reports) if bush else {"bushes": len(reports)}
         if (folder / "wall_times.txt").exists():
             figures["wall_s_per_berry"] = wall_per_berry(folder)
