@@ -15,9 +15,9 @@ from softarm.harvest.records.frame_files import INDEX, FrameFolder, FrameRecorde
 from softarm.vision.crop import ImageCrop
 
 
-def _record(folder: Path) -> list[object]:
+def _record(folder: Path) -> list[np.ndarray | None]:
     rng = np.random.default_rng(1)
-    shown = [
+    shown: list[np.ndarray | None] = [
         ImageCrop(rng.integers(0, 256, (8, 10, 3), np.uint8), (5, 7), (64, 48)),
         None,
         rng.integers(0, 256, (6, 4, 3), np.uint8),
@@ -36,9 +36,9 @@ def test_frames_come_back_bit_for_bit_in_order(tmp_path: Path) -> None:
     c1 = FrameFolder(tmp_path).frame("c1")
     first = c1(0.0)
     assert isinstance(first, ImageCrop) and first.origin == (5, 7) and first.full_size == (64, 48)
-    assert np.array_equal(first, shown[0])
+    assert shown[0] is not None and np.array_equal(first, shown[0])
     assert c1(1.0) is None
-    assert np.array_equal(c1(2.0), shown[2])
+    assert shown[2] is not None and np.array_equal(c1(2.0), shown[2])
     with pytest.raises(ConfigError, match="no c1 frame left"):
         c1(3.0)
 
