@@ -5,6 +5,8 @@ arm sweeps; what moves with the camera stays sharp; seeded and repeatable."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -166,7 +168,10 @@ def test_the_arm_still_gives_no_motion_and_moving_gives_its_step() -> None:
 
 
 def _frames(motion: RigMotion | None, clock: list[float]) -> list[np.ndarray]:
-    cams = RowCameras(RowLook.named("sun", 90104), motion)
+    look = RowLook.named("sun", 90104)
+    if motion is None:  # the reference: the look's random blur made nothing
+        look = replace(look, blur_px_s=0.0)
+    cams = RowCameras(look, motion)
     image = np.random.default_rng(3).integers(0, 255, (SIZE[1], SIZE[0], 3)).astype(np.uint8)
     out = []
     for x in (0.0, 0.0, 0.1):  # still, still, 2 m/s: a 4 px smear
@@ -188,6 +193,16 @@ def test_a_still_c2_frame_is_bit_identical_and_a_moving_one_blurs_repeatably() -
     assert all(
         np.array_equal(a, b) for a, b in zip(moved, _frames(_rig(clock), clock), strict=True)
     )
+
+
+def test_without_a_clock_c2_keeps_the_looks_random_blur() -> None:
+    look = RowLook.named("dusk", 90104)  # blur_px_s 60-300: a smear of 0.6-3 px
+    image = np.random.default_rng(3).integers(0, 255, (SIZE[1], SIZE[0], 3)).astype(np.uint8)
+    rig = _rig([0.0])
+    rig.clock = None
+    timeless = RowCameras(look, rig).apply("c2", image)
+    assert np.array_equal(timeless, RowCameras(look).apply("c2", image))
+    assert not np.array_equal(timeless, RowCameras(replace(look, blur_px_s=0.0)).apply("c2", image))
 
 
 def test_a_zero_flow_changes_nothing_and_a_bad_flow_is_refused() -> None:

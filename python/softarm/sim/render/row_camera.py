@@ -11,10 +11,12 @@ given by the world with the rig's geometry and the simulation's clock): C2's fra
 smear as a whole along the scene's image velocity from C2's own twist; in C1's only the
 arm smears, by its image velocity over what it sweeps. C1 also takes the look's
 ``blur_px_s`` in a random direction each frame: its mount's own shake (wind, the
-platform), which the arm's motion does not give. A still arm, or no motion given, adds
-no blur to C2: its frame is then the same, bit for bit, as a frame blurred by
-nothing (the random draw that once blurred C2 is still drawn, and unused, so that the
-noise that follows is the same).
+platform), which the arm's motion does not give. A still arm adds no blur to C2: its
+frame is then the same, bit for bit, as a frame blurred by nothing (the random draw
+below is still made, and unused, so that the noise that follows is the same). Where
+the motion is not known (no clock: a dataset's or a picture's single renders) C2
+takes the look's random blur, as C1 does: such frames are as they were before the
+motion was known.
 """
 
 from __future__ import annotations
@@ -69,8 +71,10 @@ class RowCameras:
         shake = self._velocity(rng)
         stereo = self.look.stereo
         if camera == "c2":
-            flow = None if self.motion is None else self.motion.c2_flow()
-            still = None if flow is None or self.motion is None else self.motion.c2_still()
+            if self.motion is None or self.motion.clock is None:  # the motion unknown
+                return self.look.c2.apply(image, rng, shake)
+            flow = self.motion.c2_flow()
+            still = None if flow is None else self.motion.c2_still()
             return self.look.c2.apply(image, rng, flow_px_s=flow, still=still)
         exposure_s = stereo.left.exposure_s
         if camera == "c1_left":
