@@ -29,6 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import MissingDependencyError
+from softarm.files.images import read_image
 from softarm.perception.detector.choice import DETECTORS, detector
 from softarm.perception.detector.draw import draw_detections, write_image
 from softarm.vision.camera_model import CameraModel
@@ -49,6 +50,7 @@ class Photo:
 
         Raises:
             MissingDependencyError: the package is not installed.
+            InputError: the package lacks the photo.
         """
         try:
             root = importlib.resources.files(self.package)
@@ -57,9 +59,8 @@ class Photo:
                 f"the real photos come from {self.package}: pip install scikit-image scikit-learn",
                 self.package,
             ) from exc
-        image = cv2.imread(str(root.joinpath(self.folder, self.name)), cv2.IMREAD_COLOR)
-        if image is None:
-            raise MissingDependencyError(f"{self.package} has no {self.name}", self.package)
+        path = root.joinpath(self.folder, self.name)
+        image = read_image(str(path), "photo", cv2.IMREAD_COLOR)
         return np.asarray(image, dtype=np.uint8)
 
 
