@@ -395,8 +395,12 @@ def main() -> None:
     args = parser.parse_args()
     if args.summary:
         rows = [json.loads(line) for path in args.summary for line in path.open()]
-        print(table(rows))
-        figures = by_group(rows)
+        # Rows of the first trace (before the report's figures were kept) carry only
+        # the decomposition.
+        full = [r for r in rows if "label" in r]
+        trace = [r for r in rows if "label" not in r]
+        print(table(full))
+        figures = {"groups": by_group(full), "trace_only": summarise(trace) if trace else None}
         print(json.dumps(figures, indent=1))
         if args.json is not None:
             args.json.write_text(json.dumps(figures, indent=1) + "\n")
