@@ -12,6 +12,7 @@ from softarm.experiments.row_contacts import (
     MAPPED_MM,
     Step,
     cause_of,
+    covered,
     episodes,
     main,
     nearest_mm,
@@ -64,6 +65,16 @@ def test_nearest_mm_of_a_straight_cane_and_of_none() -> None:
     line = softarm.PolynomialCurve(np.array([[0.0, 0.0], [0.0, 1.0], [0.3, 0.0]]), (0.0, 0.2))
     assert nearest_mm(np.array([0.01, 0.1, 0.3]), [line]) == pytest.approx(10.0, abs=0.1)
     assert nearest_mm(np.zeros(3), []) == float("inf")
+
+
+def test_covered_is_the_share_of_the_cane_near_the_map() -> None:
+    cane = softarm.PolynomialCurve(np.array([[0.0, 0.0], [0.0, 1.0], [0.3, 0.0]]), (0.0, 0.2))
+    half = softarm.PolynomialCurve(np.array([[0.005, 0.0], [0.0, 1.0], [0.3, 0.0]]), (0.0, 0.1))
+    far = softarm.PolynomialCurve(np.array([[0.05, 0.0], [0.0, 1.0], [0.3, 0.0]]), (0.0, 0.2))
+    assert covered(cane, [cane]) == 1.0
+    assert covered(cane, [half]) == pytest.approx(0.54, abs=0.02)  # 10 mm past its end
+    assert covered(cane, [far]) == 0.0
+    assert covered(cane, []) == 0.0
 
 
 def test_main_refuses_bad_arguments() -> None:

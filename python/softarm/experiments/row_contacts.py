@@ -14,6 +14,11 @@ map and to the true canes, and a cause:
 - ``mapped``: a fitted curve lies there; the model arm kept clear of it (or not), the true
   arm did not (tracking, the model's shape, or the planner's margin).
 
+Beside the cause: the nearest of C1's own curves (the planner's fallback after C2's
+survey), the model's gap to the map at the true shape, how far the true grasp point is
+from the model's at the command (the plant's lag), and the share of the touched cane the
+map and C1's own curves hold within ``MAPPED_MM``.
+
     python -m softarm.experiments.row_contacts SEED LOOK [--berries N] [--world row|bush]
         [--out trace.json] [--report report.json]
 """
@@ -64,6 +69,11 @@ class Step:
     model_map_gap_mm: float  # the model arm at the command, to the map
     model_true_gap_mm: float  # the model arm at the command, to the true canes
     fell_back: bool
+    c1_mm: float = float("inf")  # nearest of C1's own curves (the fallback) to the point
+    model_map_gap_true_q_mm: float = float("inf")  # the model at the TRUE shape, to the map
+    lag_mm: float = 0.0  # the true grasp point from the model's at the command
+    cane_covered: float = 0.0  # share of the touched cane within MAPPED_MM of the map
+    cane_covered_c1: float = 0.0  # the same of C1's own curves
 
 
 @dataclass
@@ -85,6 +95,11 @@ class Episode:
     model_true_gap_mm: float
     fell_back: bool
     cause: str = ""
+    c1_mm: float = float("inf")
+    model_map_gap_true_q_mm: float = float("inf")
+    lag_mm: float = 0.0
+    cane_covered: float = 0.0
+    cane_covered_c1: float = 0.0
     transitions: list[str] = field(default_factory=list)
 
 
@@ -123,7 +138,8 @@ def _episode(group: list[Step]) -> Episode:
         deep.cane, deep.state, deep.berry, len(group), group[0].t, group[-1].t, deep.gap_mm,
         sorted({s.piece for s in group}), deep.from_base_m, deep.in_c1_view, deep.map_mm,
         deep.model_map_gap_mm, deep.model_true_gap_mm, deep.fell_back,
-        cause_of(deep.from_base_m, deep.map_mm),
+        cause_of(deep.from_base_m, deep.map_mm), deep.c1_mm, deep.model_map_gap_true_q_mm,
+        deep.lag_mm, deep.cane_covered, deep.cane_covered_c1,
     )  # fmt: skip
 
 
@@ -139,6 +155,15 @@ def touched_point(
     if i >= len(backbone):
         return cane_points[j], "gripper"
     return cane_points[j], f"section {min(int(i * sections / len(backbone)), sections - 1)}"
+
+
+def covered(cane: Any, curves: Sequence[Any]) -> float:
+    """The share of ``cane``'s samples within ``MAPPED_MM`` of one of ``curves``."""
+    if not curves:
+        return 0.0
+    pts = np.vstack([np.asarray(c.sample(CANE_SAMPLES)) for c in curves])
+    near = [np.min(np.linalg.norm(pts - p, axis=1)) for p in np.asarray(cane.sample(100))]
+    return float(np.mean(np.array(near) <= MAPPED_MM / 1e3))
 
 
 def nearest_mm(point: FloatArray, curves: Sequence[Any]) -> float:
@@ -178,14 +203,18 @@ class _Tracer:
                                      true.arm.n_sections)  # fmt: skip
         planner = machine.planner
         mapped = planner.clearance.canes if planner is not None and planner.clearance else []
+        own = planner.fallback.canes if planner is not None and planner.fallback else mapped
         model, cmd = rig.model, machine.q
-        model_map = Clearance(model, mapped, true.offset).gap(cmd)
+        on_map = Clearance(model, mapped, true.offset)
         model_true = Clearance(model, true.canes, true.offset).gap(cmd)
+        lag = np.linalg.norm(_grasp(model, cmd, true.offset) - _grasp(true.arm, q, true.offset))
         return Step(
             rig.clock.now(), str(machine.state), self.berry, 1e3 * gap, cane, piece,
             [float(x) for x in point], float(np.linalg.norm(point)), self._in_c1(point),
-            nearest_mm(point, mapped), 1e3 * model_map, 1e3 * model_true,
-            bool(planner is not None and planner.fell_back),
+            nearest_mm(point, mapped), 1e3 * on_map.gap(cmd), 1e3 * model_true,
+            bool(planner is not None and planner.fell_back), nearest_mm(point, own),
+            1e3 * on_map.gap(q), 1e3 * float(lag), covered(true.canes[cane], mapped),
+            covered(true.canes[cane], own),
         )  # fmt: skip
 
     def _in_c1(self, point: FloatArray) -> bool:
@@ -200,6 +229,12 @@ class _Tracer:
         u, v = np.asarray(c1.left.project(p[None, :3])).reshape(-1)[:2]
         w, h = c1.left.image_size or (0, 0)
         return bool(0 <= u < w and 0 <= v < h)
+
+
+def _grasp(arm: Any, q: FloatArray, offset: float) -> FloatArray:
+    """The grasp point of ``arm`` at ``q``: ``offset`` ahead of the end effector."""
+    pose = np.asarray(arm.forward(q))
+    return np.asarray(pose[:3, 3] + offset * pose[:3, 2])
 
 
 @contextmanager
