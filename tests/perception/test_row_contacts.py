@@ -77,6 +77,13 @@ def test_covered_is_the_share_of_the_cane_near_the_map() -> None:
     assert covered(cane, []) == 0.0
 
 
+def test_the_trace_draws_the_berries_as_the_harvest_does() -> None:
+    from softarm.commands.harvest import BUSH_UNRIPE_FRACTION
+    from softarm.experiments.row_contacts import UNRIPE_FRACTION
+
+    assert UNRIPE_FRACTION == BUSH_UNRIPE_FRACTION
+
+
 def test_main_refuses_bad_arguments() -> None:
     with pytest.raises(InputError, match="usage"):
         main(["90120"])

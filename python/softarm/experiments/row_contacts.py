@@ -16,7 +16,8 @@ map and to the true canes, and a cause:
 
 Beside the cause: the nearest of C1's own curves (the planner's fallback after C2's
 survey), the model's gap to the map at the true shape, how far the true grasp point is
-from the model's at the command (the plant's lag), and the share of the touched cane the
+from the model's at the command (the plant's lag and the model's error; the latter alone:
+the model's grasp point at the true shape), and the share of the touched cane the
 map and C1's own curves hold within ``MAPPED_MM``.
 
     python -m softarm.experiments.row_contacts SEED LOOK [--berries N] [--world row|bush]
@@ -47,6 +48,10 @@ __all__ = ["Episode", "Step", "cause_of", "episodes", "main", "trace"]
 #: A fitted curve within this distance (mm) of the point touched counts as mapping it.
 MAPPED_MM = 10.0
 
+#: The unripe share of the rendered worlds' berries, as ``softarm harvest --sim`` draws
+#: them (``commands.harvest.BUSH_UNRIPE_FRACTION``; the experiments sit below commands).
+UNRIPE_FRACTION = 0.3
+
 #: Samples along a cane and along the arm when looking for the point touched.
 CANE_SAMPLES = 400
 ARM_SAMPLES = 60
@@ -74,6 +79,7 @@ class Step:
     lag_mm: float = 0.0  # the true grasp point from the model's at the command
     cane_covered: float = 0.0  # share of the touched cane within MAPPED_MM of the map
     cane_covered_c1: float = 0.0  # the same of C1's own curves
+    shape_mm: float = 0.0  # the model's grasp point at the TRUE shape from the true one
 
 
 @dataclass
@@ -100,6 +106,7 @@ class Episode:
     lag_mm: float = 0.0
     cane_covered: float = 0.0
     cane_covered_c1: float = 0.0
+    shape_mm: float = 0.0
     transitions: list[str] = field(default_factory=list)
 
 
@@ -139,7 +146,7 @@ def _episode(group: list[Step]) -> Episode:
         sorted({s.piece for s in group}), deep.from_base_m, deep.in_c1_view, deep.map_mm,
         deep.model_map_gap_mm, deep.model_true_gap_mm, deep.fell_back,
         cause_of(deep.from_base_m, deep.map_mm), deep.c1_mm, deep.model_map_gap_true_q_mm,
-        deep.lag_mm, deep.cane_covered, deep.cane_covered_c1,
+        deep.lag_mm, deep.cane_covered, deep.cane_covered_c1, deep.shape_mm,
     )  # fmt: skip
 
 
@@ -207,14 +214,16 @@ class _Tracer:
         model, cmd = rig.model, machine.q
         on_map = Clearance(model, mapped, true.offset)
         model_true = Clearance(model, true.canes, true.offset).gap(cmd)
-        lag = np.linalg.norm(_grasp(model, cmd, true.offset) - _grasp(true.arm, q, true.offset))
+        at = _grasp(true.arm, q, true.offset)
+        lag = np.linalg.norm(_grasp(model, cmd, true.offset) - at)
+        shape = np.linalg.norm(_grasp(model, q, true.offset) - at)
         return Step(
             rig.clock.now(), str(machine.state), self.berry, 1e3 * gap, cane, piece,
             [float(x) for x in point], float(np.linalg.norm(point)), self._in_c1(point),
             nearest_mm(point, mapped), 1e3 * on_map.gap(cmd), 1e3 * model_true,
             bool(planner is not None and planner.fell_back), nearest_mm(point, own),
             1e3 * on_map.gap(q), 1e3 * float(lag), covered(true.canes[cane], mapped),
-            covered(true.canes[cane], own),
+            covered(true.canes[cane], own), 1e3 * float(shape),
         )  # fmt: skip
 
     def _in_c1(self, point: FloatArray) -> bool:
@@ -260,12 +269,11 @@ def trace(
     """Harvest ``seed`` as ``softarm harvest --sim --world WORLD --look LOOK --berries N``
     does, the contact steps traced; the report saved to ``report`` where given. Returns
     the episodes, the map's canes count and the report's headline figures."""
-    from softarm.commands.harvest import BUSH_UNRIPE_FRACTION
     from softarm.harvest.rigs.sim.options import SimRigOptions
     from softarm.harvest.rigs.sim.rig import build_sim_rig
 
     options = SimRigOptions(
-        n_berries=berries, seed=seed, world=world, unripe_fraction=BUSH_UNRIPE_FRACTION,
+        n_berries=berries, seed=seed, world=world, unripe_fraction=UNRIPE_FRACTION,
         look=look if world is WorldName.ROW else None,
     )  # fmt: skip
     tracer = _Tracer()
