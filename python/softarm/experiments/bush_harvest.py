@@ -188,7 +188,11 @@ def main(argv: list[str]) -> None:
         berries = int(_option(argv, "--berries", "8") or 8)
         jobs = int(_option(argv, "--jobs", "1") or 1)
         look = _option(argv, "--look", None)
-        if (_option(argv, "--world", "bush") == "row") != (look is not None):
+        world_name = _option(argv, "--world", "bush")
+        if world_name not in ("bush", "row"):
+            raise InputError(f"--world must be bush or row, got {world_name!r}")
+        world = WorldName(world_name)
+        if (world is WorldName.ROW) != (look is not None):
             raise InputError("--world row and --look: both or neither")
         first, last, bush_dir, tag_dir = argv[1:5]
         seeds = range(int(first), int(last) + 1)
