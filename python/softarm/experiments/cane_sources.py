@@ -13,7 +13,7 @@ where it truly is, the arm out of view; no depth from the renderer. ``fit_ms``: 
 time of the stereo, the points and the fit of one C1 frame for one mask (the mask
 itself not included), both budgets in the same process.
 
-Rows are written one JSON line per scene and source, so that seeds can be run in parts
+Rows are written one JSON line per scene, source and budget, so that seeds can be run in parts
 (each part a process of a few minutes) and summed up after::
 
     MUJOCO_GL=egl python -m softarm.experiments.cane_sources run sun 310000 310024 --out rows/
