@@ -50,11 +50,14 @@ WINDOW = 10
 FINE_BUDGET_S = 12.0
 
 
-def cross_rays(c1_dir: FloatArray, c2_ray: FloatArray, T_c1_c2: FloatArray) -> FloatArray | None:
+def cross_rays(
+    c1_dir: FloatArray, c2_ray: FloatArray, T_c1_c2: FloatArray, c1_origin: FloatArray | None = None
+) -> FloatArray | None:
     """The point on C2's ray (unit ``c2_ray`` in C2's frame) nearest C1's ray (unit
-    ``c1_dir`` from C1's origin, C1's frame), in C2's frame; None when the two are
-    parallel. :meth:`RayCrossing.fix` in C1's frame."""
-    origin, ray = T_c1_c2[:3, 3], T_c1_c2[:3, :3] @ c2_ray
+    ``c1_dir`` from ``c1_origin``, C1's origin when None, C1's frame), in C2's frame;
+    None when the two are parallel. :meth:`RayCrossing.fix` in C1's frame."""
+    ray = T_c1_c2[:3, :3] @ c2_ray
+    origin = T_c1_c2[:3, 3] - (np.zeros(3) if c1_origin is None else c1_origin)
     b = float(c1_dir @ ray)
     if 1.0 - b * b < 1e-9:
         return None
@@ -85,6 +88,7 @@ class Fix:
     truth: FloatArray
     by: dict[str, FloatArray]
     c2_centre_px: float  # the detection's centre from the true centre's projection
+    c1_ray_px: float = 0.0  # C1's ray from the true one, in C1's pixels
 
 
 def _cube_parts(poses: dict[str, FloatArray], T_ee_c2: FloatArray) -> dict[str, FloatArray]:
@@ -156,25 +160,32 @@ class BiasTrace:
         x, y = vision.model2.normalize(np.array([det.center]))[0]
         true_c2 = _apply(np.linalg.inv(poses["true"]), berry_c1)
         rays = {"measured": _unit(np.array([x, y, 1.0])), "true": _unit(true_c2)}
-        c1 = {"measured": _unit(_apply(T_c1_base, track.position)), "true": _unit(berry_c1)}
+        # C1's ray starts where the harvest's does (the baseline's middle), fixed in C1.
+        o1 = _apply(T_c1_base, track.c1_centre)
+        c1 = {
+            "measured": _unit(_apply(T_c1_base, track.position) - o1),
+            "true": _unit(berry_c1 - o1),
+        }
         projected = vision.model2.project(true_c2[None, :])[0]
         by: dict[str, FloatArray] = {}
         for k in range(len(SOURCES) + 1):
             for subset in itertools.combinations(SOURCES, k):
                 pick = {s: "true" if s in subset else "measured" for s in SOURCES}
-                p = cross_rays(c1[pick["c1_ray"]], rays[pick["c2_centre"]], poses[pick["cube"]])
+                p = cross_rays(c1[pick["c1_ray"]], rays[pick["c2_centre"]], poses[pick["cube"]], o1)
                 if p is None:
                     return
                 by["+".join(subset)] = _apply(T_ee_c2, p)
         for part, mixed in _cube_parts(poses, T_ee_c2).items():  # the cube's two errors
-            p = cross_rays(c1["measured"], rays["measured"], mixed)
+            p = cross_rays(c1["measured"], rays["measured"], mixed, o1)
             if p is None:
                 return
             by[part] = _apply(T_ee_c2, p)
         truth = _apply(np.linalg.inv(T_base_ee_true), berry)
         offset = float(np.hypot(*(np.asarray(det.center) - projected)))
+        angle = float(np.arccos(np.clip(c1["measured"] @ c1["true"], -1.0, 1.0)))
+        c1_px = angle * float(self.rig.scene.world.stereo.rectification.focal)
         self.fixes.append(
-            Fix(self.rig.clock.now(), vision.selected.tag_id, by[""], truth, by, offset)
+            Fix(self.rig.clock.now(), vision.selected.tag_id, by[""], truth, by, offset, c1_px)
         )
 
     def _grasp(self) -> None:
@@ -225,6 +236,7 @@ def decompose(grasp: dict[str, Any]) -> dict[str, Any] | None:
         "left_when_true": left,
         "carried_alone": alone,
         "c2_centre_px": float(np.median([f.c2_centre_px for f in recent])),
+        "c1_ray_px": float(np.median([f.c1_ray_px for f in recent])),
         "fixes": len(recent),
     }
 
@@ -344,6 +356,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "true_within_0.5mm": within(true),
         "without_bias": within(residual),
         "bias_norm_median_mm": _median(np.linalg.norm(bias, axis=1)),
+        "c1_ray_px_median": _median([g.get("c1_ray_px", np.nan) for g in grasps]),
         "bias_axial_rms_mm": round(float(np.sqrt(np.mean(bias[:, 2] ** 2))), 3),
         "bias_lateral_rms_mm": round(float(np.sqrt(np.mean(np.sum(bias[:, :2] ** 2, 1)))), 3),
     }

@@ -51,7 +51,10 @@ class RayCrossing:
     """The berry where C2's ray to it crosses C1's (see the module docstring).
 
     Args:
-        c1_centre: C1's (left eye's) optical centre in the base frame.
+        c1_centre: where C1's ray starts, in the base frame: the middle of its stereo
+            baseline for a berry :func:`~softarm.perception.stereo.locate_berries`
+            placed (:func:`~softarm.perception.two_eyes.ray_origin`: the berry's
+            direction from there is the mean of the two eyes'), else its optical centre.
         position: the berry's position from C1's stereo (base frame), which gives C1's
             ray and, with ``radius`` (m), where and how large C2 should see it.
 

@@ -58,6 +58,10 @@ class BushMap:
     cane_points: FloatArray | None = None
     #: The ripe fruit C1 found without a position, each with C2's crossings so far.
     unplaced: list[Placing] = field(default_factory=list)
+    #: Where C1's rays to the mapped berries start (base frame): the middle of its
+    #: stereo baseline (:func:`~softarm.perception.two_eyes.ray_origin`); None before
+    #: a stereo view, or for a map not built from one (C1's optical centre then).
+    ray_origin: FloatArray | None = None
 
     def update(self, detections: Iterable[BerryDetection]) -> int:
         """Merge one view's detections (positions in the base frame, as

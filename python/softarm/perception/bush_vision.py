@@ -57,9 +57,10 @@ class BushVision(CameraVision):
         """Track the map's berry ``berry.tag_id``; its C2 sightings start afresh."""
         super().select(berry)
         entry = self.bush_map.get(berry.tag_id)
+        origin = self.bush_map.ray_origin
+        origin = self.T_base_c1[:3, 3] if origin is None else origin
         self._track = (
-            None if entry is None
-            else RayCrossing(self.T_base_c1[:3, 3], entry.position, entry.radius)
+            None if entry is None else RayCrossing(origin, entry.position, entry.radius)
         )  # fmt: skip
 
     def _mapped(self) -> FloatArray | None:

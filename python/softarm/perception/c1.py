@@ -19,6 +19,7 @@ from softarm.perception.canes import CaneFit, cane_points, fit_cane_points
 from softarm.perception.self_filter import a_cane
 from softarm.perception.sight_lines import sight_lines
 from softarm.perception.stereo import locate_berries
+from softarm.perception.two_eyes import ray_origin
 from softarm.vision.stereo_camera import StereoCamera
 
 __all__ = ["Pair", "StereoC1"]
@@ -53,6 +54,7 @@ class StereoC1:
         left, right = self.pair()
         detections = locate_berries(left, right, self.stereo)
         new = self.bush_map.update(detections)
+        self.bush_map.ray_origin = ray_origin(self.stereo)  # where its positions' rays start
         self.bush_map.note_unplaced(sight_lines(detections, self.stereo))
         return new
 

@@ -37,6 +37,7 @@ from softarm.perception.berries import (
     DetectorSettings,
 )
 from softarm.perception.detector.choice import detect_berries, fruit_mask  # the chosen detector
+from softarm.perception.two_eyes import mean_centre
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.stereo_camera import StereoCamera
 
@@ -91,7 +92,9 @@ def locate_berries(
         return []
     rows = _band(detections, L.shape[0])
     R = _rectified_rows(right, rect.maps[1], rows, L.shape)
-    sil_l, sil_r = (_silhouettes(img, rows, settings) for img in (L, R))
+    fruit_l, fruit_r = (_fruit(img, rows, settings) for img in (L, R))
+    sil_l, sil_r = (_blurred(m, rows) for m in (fruit_l, fruit_r))
+    right_colour = cast(npt.NDArray[np.uint8], cv2.GaussianBlur(R, (3, 3), 0))  # as the detector's
     grey_l, grey_r = (_grey(img, rows) for img in (L, R))
     d_lo = rect.focal * rect.baseline / DEPTH_RANGE[1]
     d_hi = rect.focal * rect.baseline / DEPTH_RANGE[0]
@@ -101,7 +104,9 @@ def locate_berries(
         d = cues.disparity()
         position = radius_m = None
         if d is not None and _plausible(d, det.radius, rect.baseline):
-            centre = rect.triangulate(np.array([det.center]), np.array([d]))[0]
+            # The mean of the two eyes' centres: C1's ray from the baseline's middle.
+            px = mean_centre(det, d, right_colour, (fruit_r * 255).astype(np.uint8))
+            centre = rect.triangulate(np.array([px]), np.array([d]))[0]
             position = (stereo.T_base_left @ np.append(centre, 1.0))[:3]
             radius_m = det.radius * float(np.linalg.norm(centre)) / rect.focal
         out.append(replace(det, position=position, radius_m=radius_m, frame="base"))
@@ -254,15 +259,22 @@ def _grey(image: npt.NDArray[np.uint8], rows: slice) -> npt.NDArray[np.float32]:
     return out
 
 
-def _silhouettes(
+def _blurred(fruit: npt.NDArray[np.float32], rows: slice) -> npt.NDArray[np.float32]:
+    """The silhouettes the eyes match: the fruit pixels of ``rows`` blurred by
+    SILHOUETTE_BLUR."""
+    out = np.zeros_like(fruit)
+    out[rows] = cv2.GaussianBlur(fruit[rows], (0, 0), SILHOUETTE_BLUR)
+    return out
+
+
+def _fruit(
     image: npt.NDArray[np.uint8], rows: slice, settings: DetectorSettings | None
 ) -> npt.NDArray[np.float32]:
-    """The fruit silhouettes of a rectified image's ``rows`` as a smooth [0, 1] image:
-    what the two eyes match, so that neither the background behind a fruit nor the
-    highlights on it (which move with the eye) pull the match."""
+    """The fruit pixels of a rectified image's ``rows`` as a [0, 1] image; blurred, they
+    are the silhouettes the two eyes match, so that neither the background behind a
+    fruit nor the highlights on it (which move with the eye) pull the match."""
     out = np.zeros(image.shape[:2], np.float32)
-    mask = fruit_mask(image[rows], settings).astype(np.float32) / 255.0
-    out[rows] = cv2.GaussianBlur(mask, (0, 0), SILHOUETTE_BLUR)
+    out[rows] = fruit_mask(image[rows], settings).astype(np.float32) / 255.0
     return out
 
 
