@@ -12,6 +12,7 @@ from test_berry_centre import fruit_image
 
 from softarm.perception import StereoCamera
 from softarm.perception.berries import BerryDetection, detect_berries, fruit_mask
+from softarm.perception.c1 import StereoC1
 from softarm.perception.two_eyes import mean_centre, ray_origin
 from softarm.vision.camera_model import CameraModel
 
@@ -71,3 +72,16 @@ def test_the_ray_from_the_baseline_middle_has_the_mean_direction() -> None:
         direction / np.linalg.norm(direction), expected / np.linalg.norm(expected), atol=1e-9
     )
     assert point[2] == pytest.approx(rect.focal * stereo.baseline / d)
+
+
+def test_c1s_map_keeps_where_its_rays_start() -> None:
+    camera = CameraModel.ideal(300.0, 160, 120)
+    T_left_right = np.eye(4)
+    T_left_right[0, 3] = 0.12
+    stereo = StereoCamera(camera, camera, np.eye(4), T_left_right)
+    blank = np.full((120, 160, 3), (60, 110, 70), np.uint8)
+    c1 = StereoC1(stereo, lambda: (blank, blank))
+    assert c1.bush_map.ray_origin is None
+    c1.look()
+    assert c1.bush_map.ray_origin is not None
+    np.testing.assert_allclose(c1.bush_map.ray_origin, (0.06, 0.0, 0.0), atol=1e-12)
