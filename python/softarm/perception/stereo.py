@@ -18,7 +18,10 @@ otherwise never mapped, look after look). With f ≈
 900 px and B = 0.12 m a pixel of disparity is about 13 mm of depth at 1.2 m. The
 silhouette of a round fruit is its equator, so the triangulated point is taken as the
 centre. The drupelets that form the outline differ between the two eyes, which leaves
-about half a pixel of disparity noise per berry (±5 mm at 1 m).
+about half a pixel of disparity noise per berry (±5 mm at 1 m). A ripe berry is
+triangulated at the mean of its two eyes' centres (:mod:`softarm.perception.two_eyes`),
+so that its direction from the baseline's middle, which C1's ray to it keeps, averages
+the eyes' centre errors while the disparity's moves it along that ray only.
 """
 
 from __future__ import annotations
