@@ -37,3 +37,21 @@ def test_rows_written_before_the_reach_count_as_the_whole_views_budget() -> None
 def test_the_side_by_side_table_gives_each_figure_before_and_after() -> None:
     lines = side_by_side(summarise([_row(1, "view", 0.2, 1.0), _row(1, "reach", 0.8, 1.0)]))
     assert lines[2].startswith("| sun | `net` | 1/1 | 0.2 → 0.8 | 0.9 → 0.9 |")
+
+
+def test_the_reach_budget_keeps_the_count_support_the_length_budget_the_defaults() -> None:
+    from softarm.experiments.cane_sources import BUDGETS
+    from softarm.perception.canes import CaneSettings
+
+    assert BUDGETS["reach"].max_points == 4000 and BUDGETS["reach"].search.min_support == 70
+    assert BUDGETS["reach"].search.support_length == 0.0
+    assert BUDGETS["view"].reach is None and BUDGETS["length"] == CaneSettings()
+
+
+def test_the_kept_fits_are_pooled_as_every_fit_and_missing_figures_are_dashes() -> None:
+    row = _row(1, "reach", 0.8, 1.0)
+    row.update(kept_coverage=0.5, kept_precision=1.0, kept_median_mm=1.5, kept_fitted_m=0.5)
+    (summary,) = summarise([row])
+    assert summary["kept_coverage"] == 0.5 and summary["kept_precision"] == 1.0
+    lines = side_by_side(summarise([_row(1, "view", 0.2, 1.0), row]))
+    assert "| - → 1.0 |" in lines[2]

@@ -34,14 +34,22 @@ import itertools
 import json
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from softarm.perception.cane_curves import curve_points
+from softarm.perception.cane_curves import CurveSearch, curve_points
 from softarm.perception.cane_metrics import DEFAULT_REACH, cane_map_error
-from softarm.perception.canes import CaneFit, CaneSettings, fit_cane_points, mask_points
+from softarm.perception.canes import (
+    CaneFit,
+    CaneSettings,
+    even_subsample,
+    fit_cane_points,
+    mask_points,
+)
+from softarm.perception.self_filter import CANE_REACH, a_cane, rig_parts
 
 __all__ = [
     "BUDGETS",
@@ -57,8 +65,17 @@ __all__ = [
 CONDITIONS = ("sun", "overcast", "dusk", "backlight", "bush")
 #: The candidates, in the order of the table.
 SOURCES = ("colour", "net", "net+colour", "net|colour")
-#: The point budgets: the whole view's (None: as before the reach) and the reach's.
-BUDGETS = {"view": None, "reach": CaneSettings().reach}
+#: Support counted in points, as before the support length.
+_COUNTED = CurveSearch(min_support=70, support_length=0.0)
+#: The point budgets and supports: ``view``, 4,000 points over the whole view, a cane 70
+#: of them (as before the reach); ``reach``, 4,000 points within the reach, a cane 70 of
+#: them (as before the support length); ``length``, the defaults (the budget and the
+#: support length of :class:`~softarm.perception.canes.CaneSettings`).
+BUDGETS: dict[str, CaneSettings] = {
+    "view": CaneSettings(reach=None, max_points=4000, search=_COUNTED),
+    "reach": CaneSettings(max_points=4000, search=_COUNTED),
+    "length": CaneSettings(),
+}
 
 
 def fitted_length(fits: Sequence[CaneFit], reach: float = DEFAULT_REACH) -> float:
@@ -74,13 +91,57 @@ def fitted_length(fits: Sequence[CaneFit], reach: float = DEFAULT_REACH) -> floa
 
 
 def scene_rows(
-    condition: str, seed: int, n_berries: int = 8, union: bool = False
+    condition: str,
+    seed: int,
+    n_berries: int = 8,
+    union: bool = False,
+    only: Sequence[str] | None = None,
+    budgets: Sequence[str] = tuple(BUDGETS),
 ) -> list[dict[str, Any]]:
     """One row per source and budget for ``seed``'s bush in ``condition`` (``union``:
-    ``net|colour`` too)."""
+    ``net|colour`` too; ``only``: just these sources; ``budgets``: just these). The
+    ``kept_`` figures score only the fits the bush map keeps (none within
+    ``SELF_MARGIN`` of the rig's own parts: :func:`~softarm.perception.self_filter.
+    a_cane`), the others every fit."""
+    from softarm.perception.cane_pixels import cane_mask
+    from softarm.perception.cane_source import candidate_masks
+
+    rect_left, rect_right, stereo, truth = _render(condition, seed, n_berries)
+    look = CaneSettings().look
+    if only is not None and set(only) <= {"colour"}:
+        masks = {"colour": cane_mask(rect_left, look)}  # the network is not run for nothing
+    else:
+        masks = candidate_masks(rect_left, look)
+    parts = _rig_parts()
+    rows = []
+    for source, mask in masks.items():
+        if (source == "net|colour" and not union) or (only and source not in only):
+            continue
+        placed = _Placed(rect_left, rect_right, stereo, mask)
+        for budget in budgets:
+            settings = BUDGETS[budget]
+            points, wall, cpu = placed.points(settings)
+            start, start_cpu = time.perf_counter(), time.process_time()
+            fits = fit_cane_points(points, settings)
+            wall, cpu = wall + time.perf_counter() - start, cpu + time.process_time() - start_cpu
+            kept = [f for f in fits if a_cane(f.points, parts, CANE_REACH)]
+            scores = cane_map_error(kept, truth)
+            rows.append({
+                "condition": condition, "seed": seed, "source": source, "budget": budget,
+                **cane_map_error(fits, truth), "fitted_m": fitted_length(fits),
+                **{f"kept_{k}": v for k, v in scores.items()},
+                "kept_fitted_m": fitted_length(kept), "fits": len(fits),
+                "mask_px": int(mask.sum()), "points": len(points),
+                "fit_ms": 1e3 * wall, "cpu_ms": 1e3 * cpu,
+            })  # fmt: skip
+    return rows
+
+
+def _render(condition: str, seed: int, n_berries: int) -> tuple[Any, Any, Any, Any]:
+    """C1's rectified pair of ``seed``'s bush in ``condition``, its stereo and every
+    cane drawn."""
     import softarm
     from softarm.harvest.rigs.sim.options import default_cameras
-    from softarm.perception.cane_source import candidate_masks
     from softarm.sim.bush import Bush
     from softarm.sim.render import RenderedBush
     from softarm.sim.render.row_look import RowLook
@@ -103,23 +164,42 @@ def scene_rows(
         world.close()
     stereo = world.stereo
     rect_left, rect_right = stereo.rectification.rectify(left.colour, right.colour)
-    rows = []
-    for source, mask in candidate_masks(rect_left, CaneSettings().look).items():
-        if source == "net|colour" and not union:
-            continue
-        for budget, reach in BUDGETS.items():
-            settings = CaneSettings(reach=reach)
-            start = time.perf_counter()
-            points = mask_points(rect_left, rect_right, stereo, mask, settings)
-            fits = fit_cane_points(points, settings)
-            seconds = time.perf_counter() - start
-            rows.append({
-                "condition": condition, "seed": seed, "source": source, "budget": budget,
-                **cane_map_error(fits, truth), "fitted_m": fitted_length(fits),
-                "fits": len(fits), "mask_px": int(mask.sum()), "points": len(points),
-                "fit_ms": 1e3 * seconds,
-            })  # fmt: skip
-    return rows
+    return rect_left, rect_right, stereo, truth
+
+
+def _rig_parts() -> Any:
+    """What C1 sees of the simulated rig itself, as the simulated harvest gives it to
+    the self-filter (the cube's box without its plates)."""
+    import softarm
+    from softarm.harvest.rigs.sim.options import default_cameras
+    from softarm.harvest_config import HarvestConfig
+
+    cams = default_cameras()
+    model = softarm.SoftArm.blackberry()
+    return rig_parts(model, HarvestConfig(), cams.T_ee_cube, cams.T_base_tag)
+
+
+class _Placed:
+    """One mask's points, placed once per reach (the stereo is the costly part) and each
+    budget's even subsample of them taken after, as ``mask_points`` takes it; the time
+    of the placing counted in every budget that uses it."""
+
+    def __init__(self, rect_left: Any, rect_right: Any, stereo: Any, mask: Any) -> None:
+        self.args = (rect_left, rect_right, stereo, mask)
+        self.placed: dict[float, tuple[Any, float, float]] = {}
+
+    def points(self, settings: CaneSettings) -> tuple[Any, float, float]:
+        """(points, wall seconds, CPU seconds) for ``settings``."""
+        # without a reach the budget is spent on pixels before they are placed
+        key = settings.reach if settings.reach is not None else -float(settings.max_points)
+        if key not in self.placed:
+            whole = settings if settings.reach is None else CaneSettings(max_points=10**9)
+            start, start_cpu = time.perf_counter(), time.process_time()
+            points = mask_points(*self.args, replace(whole, reach=settings.reach))
+            wall, cpu = time.perf_counter() - start, time.process_time() - start_cpu
+            self.placed[key] = (points, wall, cpu)
+        points, wall, cpu = self.placed[key]
+        return even_subsample(points, settings.max_points), wall, cpu
 
 
 def summarise(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -139,22 +219,34 @@ def summarise(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
 def _summary(
     condition: str, source: str, budget: str, mine: Sequence[dict[str, Any]]
 ) -> dict[str, Any]:
-    """One row of :func:`summarise`."""
-    length = np.array([r["length_m"] for r in mine])
-    fitted = np.array([r["fitted_m"] for r in mine])
-    coverage = np.array([r["coverage"] for r in mine])
-    precision = np.array([r["precision"] for r in mine])
-    medians = [r["median_mm"] for r in mine if np.isfinite(r["median_mm"])]
+    """One row of :func:`summarise`: the figures of every fit and, where the rows have
+    them, of the fits the map keeps (``kept_``)."""
     times = [r["fit_ms"] for r in mine if "fit_ms" in r]
+    cpu = [r["cpu_ms"] for r in mine if "cpu_ms" in r]
+    kept = _scores(mine, "kept_") if all("kept_coverage" in r for r in mine) else {}
     return {
         "condition": condition, "source": source, "budget": budget, "scenes": len(mine),
+        **_scores(mine, ""), **{f"kept_{k}": v for k, v in kept.items()},
+        "fits_per_scene": round(float(np.mean([r["fits"] for r in mine])), 1),
+        "fit_ms": round(float(np.median(times)), 1) if times else None,
+        "cpu_ms": round(float(np.median(cpu)), 1) if cpu else None,
+        "seeds": [min(r["seed"] for r in mine), max(r["seed"] for r in mine)],
+    }  # fmt: skip
+
+
+def _scores(mine: Sequence[dict[str, Any]], prefix: str) -> dict[str, Any]:
+    """Coverage, precision and median of the rows' figures named with ``prefix``,
+    pooled as the module docstring says."""
+    length = np.array([r["length_m"] for r in mine])
+    fitted = np.array([r[prefix + "fitted_m"] for r in mine])
+    coverage = np.array([r[prefix + "coverage"] for r in mine])
+    precision = np.array([r[prefix + "precision"] for r in mine])
+    medians = [r[prefix + "median_mm"] for r in mine if np.isfinite(r[prefix + "median_mm"])]
+    return {
         "coverage": round(float(np.sum(length * coverage) / np.sum(length)), 3),
         "precision": round(float(np.sum(fitted * precision) / max(fitted.sum(), 1e-9)), 3),
         "median_mm": round(float(np.median(medians)), 2) if medians else None,
-        "fits_per_scene": round(float(np.mean([r["fits"] for r in mine])), 1),
-        "fit_ms": round(float(np.median(times)), 1) if times else None,
-        "seeds": [min(r["seed"] for r in mine), max(r["seed"] for r in mine)],
-    }  # fmt: skip
+    }
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -163,7 +255,10 @@ def _run(args: argparse.Namespace) -> None:
     path = folder / f"{args.condition}_{args.first}_{args.last}.jsonl"
     with path.open("w") as f:
         for seed in range(args.first, args.last + 1):
-            for row in scene_rows(args.condition, seed, union=args.union):
+            rows = scene_rows(
+                args.condition, seed, union=args.union, only=args.sources, budgets=args.budgets
+            )
+            for row in rows:
                 f.write(json.dumps(row) + "\n")
             f.flush()
             print(args.condition, seed, flush=True)
@@ -171,8 +266,9 @@ def _run(args: argparse.Namespace) -> None:
 
 def side_by_side(table: Sequence[dict[str, Any]]) -> list[str]:
     """The summary as a markdown table, one row per condition and source: each figure
-    with the whole view's budget, then within the reach (``view → reach``)."""
-    keys = ("coverage", "precision", "median_mm", "fit_ms")
+    for each budget in the order of BUDGETS (``view → reach → length``), "-" where the
+    rows lack it."""
+    keys = ("coverage", "precision", "kept_precision", "median_mm", "cpu_ms")
     lines = [
         "| condition | source | scenes | " + " | ".join(keys) + " |",
         "| --- | --- | --- |" + " --- |" * len(keys),
@@ -183,10 +279,14 @@ def side_by_side(table: Sequence[dict[str, Any]]) -> list[str]:
         }
         if not pair:
             continue
-        cells = [" → ".join(str(pair[b][k]) for b in BUDGETS if b in pair) for k in keys]
+        cells = [" → ".join(_cell(pair[b].get(k)) for b in BUDGETS if b in pair) for k in keys]
         scenes = "/".join(str(pair[b]["scenes"]) for b in BUDGETS if b in pair)
         lines.append(f"| {condition} | `{source}` | {scenes} | " + " | ".join(cells) + " |")
     return lines
+
+
+def _cell(value: Any) -> str:
+    return "-" if value is None else str(value)
 
 
 def _table(args: argparse.Namespace) -> None:
@@ -213,6 +313,11 @@ def main(argv: list[str] | None = None) -> None:
     run.add_argument("last", type=int)
     run.add_argument("--out", required=True, help="folder for the rows (JSON lines)")
     run.add_argument("--union", action="store_true", help="score net|colour too")
+    run.add_argument("--sources", nargs="+", choices=SOURCES, help="only these sources")
+    run.add_argument(
+        "--budgets", nargs="+", choices=tuple(BUDGETS), default=list(BUDGETS),
+        help="only these budgets",
+    )  # fmt: skip
     table = sub.add_parser("table", help="the summary of the rows in FOLDERS")
     table.add_argument("folders", nargs="+")
     table.add_argument("--out", help="the summary as JSON")

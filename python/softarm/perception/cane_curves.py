@@ -26,6 +26,7 @@ DEGREE = 3
 DENSE = 200  # samples of a curve when points are matched to it
 SCORED = 600  # points a proposed line is scored on
 MAX_MISSES = 8  # proposed lines in a row that grow into no cane before the search ends
+SUPPORT_BIN = 0.005  # m: the steps along a cane in which its support length is counted
 
 
 @dataclass(frozen=True)
@@ -50,6 +51,10 @@ class CurveSearch:
         ``join_gap`` (m), each end's outward direction within ``join_angle`` (degrees)
         of the line to the other end, are one cane hidden in between when a single
         cubic passes 90 % of their points within ``curve_tolerance``.
+    support_length: the length of cane (m) a cane's points must cover, counted in
+        ``SUPPORT_BIN`` steps along it (a bin with any point counts): a support that
+        means the same whatever the point budget, where ``min_support`` counts points
+        and so depends on how many the budget keeps.
     """
 
     line_tolerance: float = 0.008
@@ -63,6 +68,7 @@ class CurveSearch:
     seed: int = 0
     join_gap: float = 0.15
     join_angle: float = 35.0
+    support_length: float = 0.0
 
 
 def curve_points(coeffs: FloatArray, n: int = DENSE, u: FloatArray | None = None) -> FloatArray:
@@ -194,6 +200,8 @@ def _grow(points: FloatArray, line: IndexArray, search: CurveSearch) -> IndexArr
         members = _longest_run(points, members, search.max_gap)
     if len(members) < search.min_support or _extent(points[members]) < search.min_length:
         return None
+    if _covered_length(points[members]) < search.support_length:
+        return None
     return members
 
 
@@ -259,6 +267,16 @@ def _longest_run(points: FloatArray, members: IndexArray, max_gap: float) -> Ind
     cuts = np.flatnonzero(np.diff(t) > max_gap) + 1
     runs = np.split(order, cuts)
     return members[max(runs, key=len)]
+
+
+def _covered_length(points: FloatArray) -> float:
+    """The length (m) along the points' principal axis that they cover, in steps of
+    ``SUPPORT_BIN``: a hole between them does not count, however many points crowd
+    either side of it."""
+    centred = points - points.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    bins = np.floor((centred @ axis) / SUPPORT_BIN).astype(np.int64)
+    return float(np.unique(bins).size * SUPPORT_BIN)
 
 
 def _extent(points: FloatArray) -> float:

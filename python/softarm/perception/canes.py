@@ -45,6 +45,7 @@ __all__ = [
     "CaneSettings",
     "cane_points",
     "centre_line_points",
+    "even_subsample",
     "fit_cane_points",
     "fit_canes",
     "mask_points",
@@ -256,6 +257,11 @@ def _within_budget(points: FloatArray, reach: float | None, max_points: int) -> 
     the points out of reach are dropped first, so that they take none of the budget."""
     if reach is not None:
         points = points[np.linalg.norm(points[:, :3], axis=1) <= reach]
+    return even_subsample(points, max_points)
+
+
+def even_subsample(points: FloatArray, max_points: int) -> FloatArray:
+    """Every k-th row of ``points``, k the smallest that leaves at most ``max_points``."""
     return points[:: max(1, int(np.ceil(len(points) / max_points)))]
 
 
