@@ -21,7 +21,7 @@ def test_a_short_dense_run_is_refused_however_many_points_it_has() -> None:
     run = _straight(0.05, 2000, seed=1)  # 5 cm: a phantom's length, 2000 points
     assert split_into_curves(run, CurveSearch(min_support=20, support_length=0.08)) == []
     # counted in points it passes: the count depends on the budget, not on the cane
-    assert len(split_into_curves(run, CurveSearch(min_support=70))) == 1
+    assert len(split_into_curves(run, CurveSearch(min_support=70, support_length=0.0))) == 1
 
 
 def test_a_cane_is_found_at_any_density_when_support_is_a_length() -> None:
@@ -30,7 +30,10 @@ def test_a_cane_is_found_at_any_density_when_support_is_a_length() -> None:
     for budget in (4000, 400, 60):
         assert len(split_into_curves(even_subsample(cane, budget), search)) == 1
     # a count of 70 loses the same cane once the budget thins it below 70 points
-    assert split_into_curves(even_subsample(cane, 60), CurveSearch(min_support=70)) == []
+    assert (
+        split_into_curves(even_subsample(cane, 60), CurveSearch(min_support=70, support_length=0.0))
+        == []
+    )
 
 
 def test_a_hole_does_not_count_towards_the_length() -> None:
