@@ -45,7 +45,8 @@ def test_the_reach_budget_keeps_the_count_support_the_length_budget_the_defaults
 
     assert BUDGETS["reach"].max_points == 4000 and BUDGETS["reach"].search.min_support == 70
     assert BUDGETS["reach"].search.support_length == 0.0
-    assert BUDGETS["view"].reach is None and BUDGETS["length"] == CaneSettings()
+    assert BUDGETS["view"].reach is None and BUDGETS["reach"] == CaneSettings()
+    assert BUDGETS["length"].search.support_length == 0.08
 
 
 def test_the_kept_fits_are_pooled_as_every_fit_and_missing_figures_are_dashes() -> None:

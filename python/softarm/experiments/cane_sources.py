@@ -65,16 +65,18 @@ __all__ = [
 CONDITIONS = ("sun", "overcast", "dusk", "backlight", "bush")
 #: The candidates, in the order of the table.
 SOURCES = ("colour", "net", "net+colour", "net|colour")
-#: Support counted in points, as before the support length.
+#: Support counted in points, the default.
 _COUNTED = CurveSearch(min_support=70, support_length=0.0)
 #: The point budgets and supports: ``view``, 4,000 points over the whole view, a cane 70
 #: of them (as before the reach); ``reach``, 4,000 points within the reach, a cane 70 of
-#: them (as before the support length); ``length``, the defaults (the budget and the
-#: support length of :class:`~softarm.perception.canes.CaneSettings`).
+#: them (the default); ``length``, 8,000 points within the reach, a cane 8 cm of cane
+#: covered and at least 20 points (``CurveSearch.support_length``; measured, not adopted).
 BUDGETS: dict[str, CaneSettings] = {
     "view": CaneSettings(reach=None, max_points=4000, search=_COUNTED),
     "reach": CaneSettings(max_points=4000, search=_COUNTED),
-    "length": CaneSettings(),
+    "length": CaneSettings(
+        max_points=8000, search=CurveSearch(min_support=20, support_length=0.08)
+    ),
 }
 
 

@@ -35,11 +35,10 @@ class CurveSearch:
 
     line_tolerance: a point within this of a proposed line is its inlier.
     curve_tolerance: a point within this of a grown cubic belongs to that cane.
-    min_support: fewest points a cane keeps, a floor for the fit (20); what a cane
-        must show is ``support_length``. (Before it, 70 points did that job: the phantoms
-        that wrong stereo depths make are short runs, but a count of points depends on
-        the budget, and with the budget spent within the reach 70 points were a few
-        centimetres of any run, phantoms included.)
+    min_support: fewest points a cane keeps (70: the phantoms that wrong stereo depths
+        make are short runs of few points; on the tuning bushes 0–4, 40 → 70 took
+        precision from 0.88 to 0.97 for coverage 0.85 → 0.83, and on diagnosis bush 708
+        it removed the two phantoms that made the planner refuse two berries);
         min_length: its shortest extent.
     max_gap: the longest hole (a leaf in front) a cane is followed across.
     speck_radius, speck_points: a point with fewer than ``speck_points`` points of its
@@ -55,14 +54,15 @@ class CurveSearch:
     support_length: the length of cane (m) a cane's points must cover, counted in
         ``SUPPORT_BIN`` steps along it (a bin with any point counts): a support that
         means the same whatever the point budget, where ``min_support`` counts points
-        and so depends on how many the budget keeps. 8 cm: the phantoms of the row
-        (leaf edges, stray matches, the rig's own thin parts) cover 5–7 cm; tuned on
-        seeds 311000–311008 (sun, overcast, dusk, bush) against 6, 9, 10 and 12 cm.
+        and so depends on how many the budget keeps. 0: off, the count alone. 8 cm
+        with 20 points and a budget of 8,000 (tuned on seeds 311000–311008 against 6,
+        9, 10 and 12 cm) lost precision on fresh seeds (docs/perception.md): not the
+        default.
     """
 
     line_tolerance: float = 0.008
     curve_tolerance: float = 0.006
-    min_support: int = 20
+    min_support: int = 70
     min_length: float = 0.04
     max_gap: float = 0.10
     speck_radius: float = 0.010
@@ -71,7 +71,7 @@ class CurveSearch:
     seed: int = 0
     join_gap: float = 0.15
     join_angle: float = 35.0
-    support_length: float = 0.08
+    support_length: float = 0.0
 
 
 def curve_points(coeffs: FloatArray, n: int = DENSE, u: FloatArray | None = None) -> FloatArray:

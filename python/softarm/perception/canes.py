@@ -73,9 +73,10 @@ class CaneSettings:
     budget is spent (the map's own reach, :data:`softarm.perception.self_filter.
     CANE_REACH`: canes beyond it cannot touch the arm; None: every point shares the
     budget, as before the reach was used); ``max_points``: points kept for the fit, an
-    even subsample of those within ``reach`` beyond that (8,000: within the reach the
-    row's masks give 4,000–23,000 points; 16,000 or all of them covered about as much
-    on the tuning seeds for up to twice the fit's time);
+    even subsample of those within ``reach`` beyond that (4,000; 8,000 with a support
+    length of 8 cm instead of 70 points covered 0.10–0.19 more of the row's canes on
+    fresh seeds 310140–310159 but lost 0.05–0.17 of precision: not adopted, the figures
+    in docs/perception.md);
     ``smoothness``: StereoSGBM's penalties P1, P2 (see
     :func:`softarm.perception.cane_pixels.stereo_disparity`); ``source``: where the cane
     pixels come from (:data:`softarm.perception.cane_source.CANE_SOURCES`; None: this
@@ -89,7 +90,7 @@ class CaneSettings:
     look: CaneLook = field(default_factory=CaneLook)
     search: CurveSearch = field(default_factory=CurveSearch)
     depth_range: tuple[float, float] = (0.6, 1.5)
-    max_points: int = 8000
+    max_points: int = 4000
     smoothness: tuple[int, int] = (4, 16)
     source: str | None = None
     reach: float | None = CANE_REACH
