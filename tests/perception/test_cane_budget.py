@@ -12,22 +12,12 @@ from softarm.errors import ParameterError
 from softarm.perception import canes
 from softarm.perception.canes import CaneSettings, cane_points, centre_line_points, mask_points
 from softarm.perception.self_filter import CANE_REACH
-from softarm.vision.camera_model import CameraModel
 from softarm.vision.stereo_camera import StereoCamera
 
 #: Depths (m) of the near cane and of the far wall of cane pixels, the camera at the base.
 NEAR, FAR = 0.7, 1.4
 #: The near cane's rows and columns in the left image: 300 x 5 = 1,500 pixels.
 ROWS, COL = slice(100, 400), 400
-
-
-@pytest.fixture(scope="module")
-def stereo() -> StereoCamera:
-    K = np.array([[900.0, 0, 320], [0, 900.0, 240], [0, 0, 1]])
-    camera = CameraModel(K, np.zeros(5), image_size=(640, 480))
-    T_left_right = np.eye(4)
-    T_left_right[0, 3] = 0.12
-    return StereoCamera(camera, camera, np.eye(4), T_left_right)
 
 
 def _scene(stereo: StereoCamera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

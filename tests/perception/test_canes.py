@@ -185,15 +185,6 @@ def test_the_map_error_of_no_fit_is_no_coverage() -> None:
     assert scores["coverage"] == 0.0 and np.isnan(scores["median_mm"])
 
 
-@pytest.fixture(scope="module")
-def stereo() -> StereoCamera:
-    K = np.array([[900.0, 0, 320], [0, 900.0, 240], [0, 0, 1]])
-    camera = CameraModel(K, np.zeros(5), image_size=(640, 480))
-    T_left_right = np.eye(4)
-    T_left_right[0, 3] = 0.12
-    return StereoCamera(camera, camera, np.eye(4), T_left_right)
-
-
 @pytest.mark.parametrize(
     ("left", "right", "depth", "names"),
     [
