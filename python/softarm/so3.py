@@ -1,5 +1,6 @@
 """The SO(3) toolkit of the Python side: rotation vector ↔ rotation matrix, on scipy's
-:class:`~scipy.spatial.transform.Rotation`.
+:class:`~scipy.spatial.transform.Rotation`, and a matrix's quaternion in plain floats
+(:func:`quaternion_xyzw`, for the live view's every step).
 
 One place for the exponential and logarithm maps (the rotation vector of
 ``R_target R_currentᵀ`` is the resolver's orientation error e_ζ, redundancy paper
