@@ -10,6 +10,7 @@ import pytest
 from softarm.errors import ParameterError
 from softarm.sim.render.camera_effects import (
     AUTO_HIGHLIGHT_DN,
+    AUTO_RANGE,
     AUTO_TARGET_DN,
     CameraEffects,
     StereoEffects,
@@ -164,3 +165,35 @@ def test_bad_parameters_are_one_clear_error(bad: dict[str, object]) -> None:
 def test_a_bad_image_shape_is_refused() -> None:
     with pytest.raises(ParameterError, match="image"):
         CameraEffects().apply(np.zeros((4, 4), np.uint8), np.random.default_rng(0))
+
+
+def test_roi_metering_puts_the_roi_s_highlights_at_their_level_whatever_the_mean() -> None:
+    roi = _flat(10)
+    roi[:10, :] = 200  # a marker's white paper, a twentieth of its window, on a dark hedge
+    frame = CameraEffects(exposure_bias=0.9)
+    # The frame's rule gives up half the mean's exposure and clips the white ...
+    assert 200 * frame.exposure_of(roi) > 255
+    # ... the ROI's rule gives up nothing for the mean.
+    assert frame.roi_exposure_of(roi) == pytest.approx(0.9 * AUTO_HIGHLIGHT_DN / 200)
+    out = frame.apply(roi, np.random.default_rng(0), exposure=frame.roi_exposure_of(roi))
+    assert out.max() < 255
+
+
+def test_roi_metering_of_a_render_at_part_of_the_light_is_for_the_scene() -> None:
+    effects = CameraEffects()
+    roi = _flat(10)
+    roi[:40, :] = 200
+    half = roi // 2
+    # Twice the exposure for a render at half the light: the same DN delivered.
+    assert effects.roi_exposure_of(half, 0.5) == pytest.approx(2 * effects.roi_exposure_of(roi))
+    # The exposure's range is the scene's: a dark ROI at half the light gets twice the
+    # largest exposure, which brings it to where the scene at full light would be.
+    dark = _flat(2)
+    assert effects.roi_exposure_of(dark, 0.5) == pytest.approx(2 * AUTO_RANGE[1])
+    assert CameraEffects(exposure=1.5).roi_exposure_of(roi, 0.5) == pytest.approx(3.0)
+
+
+@pytest.mark.parametrize("scale", [0.0, -1.0, 1.5, float("nan")])
+def test_roi_metering_refuses_a_scale_outside_0_1(scale: float) -> None:
+    with pytest.raises(ParameterError, match="scale"):
+        CameraEffects().roi_exposure_of(_flat(10), scale)

@@ -131,13 +131,27 @@ class CameraEffects:
             return self.exposure * self.exposure_bias
         grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         mean = float(cv2.mean(grey)[0])
-        counts = cv2.calcHist([grey], [0], None, [256], [0, 256]).ravel()
-        above = np.cumsum(counts[::-1])  # pixels at or above each level, from 255 down
-        highlight = 255 - int(np.searchsorted(above, AUTO_HIGHLIGHT_SHARE * grey.size))
+        highlight = _highlight(image)
         by_mean = AUTO_TARGET_DN / max(mean, 1e-3)
         by_highlight = AUTO_HIGHLIGHT_DN / max(highlight, 1)
         auto = max(min(by_mean, by_highlight), (1 - AUTO_HIGHLIGHT_GIVE) * by_mean)
         return float(np.clip(auto, *AUTO_RANGE)) * self.exposure_bias
+
+    def roi_exposure_of(self, roi: npt.NDArray[np.uint8], scale: float = 1.0) -> float:
+        """The exposure a camera metering on a region of interest gives ``roi``'s
+        pixels: the ROI's brightest AUTO_HIGHLIGHT_SHARE brought to AUTO_HIGHLIGHT_DN,
+        nothing given up for a mean (the ROI is the subject: a marker's white paper
+        must not clip, whatever the rest of the frame), within AUTO_RANGE, times the
+        bias; the fixed exposure when there is one. ``scale``: the share of the scene's
+        light ``roi`` was rendered with (0.5: at half the light, so that what is
+        brighter than 255 DN at an exposure of 1 is not clipped by the render); the
+        exposure returned is for ``roi``'s pixels, AUTO_RANGE for the scene's."""
+        if not 0 < scale <= 1:
+            raise ParameterError(f"scale must be in (0, 1], got {scale}")
+        if self.exposure is not None:
+            return self.exposure * self.exposure_bias / scale
+        by_highlight = scale * AUTO_HIGHLIGHT_DN / max(_highlight(roi), 1)
+        return float(np.clip(by_highlight, *AUTO_RANGE)) * self.exposure_bias / scale
 
     def apply(
         self,
@@ -221,6 +235,15 @@ class StereoEffects:
     def right(self) -> CameraEffects:
         """The right eye's effects (its exposure bias folded in)."""
         return replace(self.left, exposure_bias=self.left.exposure_bias * self.right_exposure)
+
+
+def _highlight(image: npt.NDArray[np.uint8]) -> int:
+    """The grey level (DN) at or above which the brightest AUTO_HIGHLIGHT_SHARE of
+    ``image``'s (BGR) pixels lie."""
+    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+    counts = cv2.calcHist([grey], [0], None, [256], [0, 256]).ravel()
+    above = np.cumsum(counts[::-1])  # pixels at or above each level, from 255 down
+    return 255 - int(np.searchsorted(above, AUTO_HIGHLIGHT_SHARE * grey.size))
 
 
 @functools.lru_cache(maxsize=8)

@@ -20,11 +20,12 @@ T = TypeVar("T")
 def scene_state(model: Any, data: Any) -> bytes:
     """What a render of ``model`` and ``data`` is drawn from and the harvest changes:
     the arm's bodies (mocap poses) and sizes, the leaves pushed aside, the geoms
-    taken away (their groups). The cameras, lights and materials stay as built."""
+    taken away (their groups), the lights' strength (C1's marker window is drawn with
+    them dimmed: softarm.sim.render.headroom). The cameras and materials stay as built."""
     return b"".join(
         np.ascontiguousarray(a).tobytes()
         for a in (data.mocap_pos, data.mocap_quat, model.geom_pos, model.geom_size,
-                  model.geom_group)
+                  model.geom_group, model.light_diffuse)
     )  # fmt: skip
 
 

@@ -4,7 +4,13 @@ look's), seeded by the look, the camera and the frame's count, so that a run is
 repeatable. C1's left eye meters (auto-exposure) and the right eye exposes with the
 left's exposure times its own bias, shifted by the pair's rectification error (the
 ground truth is not shifted: it is where the scene is). A window of C1's left eye (the
-cube tracking's) keeps that eye's last exposure and has no vignetting of its own.
+cube tracking's) is metered on itself: the tracker sets the camera's auto-exposure
+region of interest to the marker's window (the ZED SDK's ``AEC_AGC_ROI``), so the
+marker's white paper does not clip however dark the hedge around it is
+(:meth:`~softarm.sim.render.camera_effects.CameraEffects.roi_exposure_of`); it has no
+vignetting of its own. A real camera's metering converges over a few frames and
+exposes the whole frame so; here each window is metered at once and C1's full frames
+keep their own metering (the harvest takes them with the arm at home).
 
 Motion blur comes from the motion (:class:`~softarm.sim.render.rig_motion.RigMotion`,
 given by the world with the rig's geometry and the simulation's clock): C2's frames
@@ -26,6 +32,7 @@ from dataclasses import replace
 import numpy as np
 import numpy.typing as npt
 
+from softarm.errors import ParameterError
 from softarm.sim.render.camera_effects import CameraEffects
 from softarm.sim.render.rig_motion import RigMotion
 from softarm.sim.render.row_look import RowLook
@@ -63,10 +70,22 @@ class RowCameras:
         return self.motion.c1_flow(eye, size, origin, exposure_s)
 
     def apply(
-        self, camera: str, image: npt.NDArray[np.uint8], origin: tuple[int, int] = (0, 0)
+        self,
+        camera: str,
+        image: npt.NDArray[np.uint8],
+        origin: tuple[int, int] = (0, 0),
+        scale: float = 1.0,
     ) -> npt.NDArray[np.uint8]:
         """``image`` of ``camera`` (c1_left, c1_right, c2 or c1_window) as delivered;
-        ``origin``: a window's top-left pixel in the whole image."""
+        ``origin``: a window's top-left pixel in the whole image; ``scale``: the share
+        of the scene's light a c1_window was rendered with
+        (:mod:`softarm.sim.render.headroom`), 1 for every other camera.
+
+        Raises:
+            ParameterError: ``scale`` not 1 for a camera other than c1_window.
+        """
+        if scale != 1.0 and camera != "c1_window":
+            raise ParameterError(f"scale must be 1 for {camera!r}, got {scale}")
         rng = self._rng(camera)
         shake = self._velocity(rng)
         stereo = self.look.stereo
@@ -89,4 +108,5 @@ class RowCameras:
             return right.apply(image, rng, shake, exposure, stereo.right_offset_px, flow)
         window: CameraEffects = replace(stereo.left, vignetting=0.0)
         flow = self._c1_flow("left", image, origin, exposure_s)
-        return window.apply(image, rng, shake, exposure=self._exposure, flow_px_s=flow)
+        exposure = window.roi_exposure_of(image, scale)
+        return window.apply(image, rng, shake, exposure=exposure, flow_px_s=flow)

@@ -21,6 +21,7 @@ from softarm._core import SoftArm
 from softarm.checks import FloatArray
 from softarm.sim.bush import PLUS_Y, Branch, Bush
 from softarm.sim.render.distortion import Distorter
+from softarm.sim.render.headroom import WINDOW_HEADROOM, dimmed
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.look import BushLook
 from softarm.sim.render.mjcf import (
@@ -232,12 +233,17 @@ class RenderedBush:
             return ImageCrop(
                 self.c1_left().colour[y0 : y0 + side, x0 : x0 + side], (x0, y0), (w, h)
             )
-        pin = self.renderer.render_window("c1_left", (px0, py0), span)
+        # In the row the window is drawn with headroom (softarm.sim.render.headroom): the
+        # sun would clip the marker's white at the render, before the camera meters it.
+        share = 1.0 if self.effects is None else WINDOW_HEADROOM
+        with dimmed(self.renderer.model, share):
+            pin = self.renderer.render_window("c1_left", (px0, py0), span)
         colour = cv2.remap(
             pin, mx - px0, my - py0, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
         )
         if self.effects is not None:
-            colour = self.effects.apply("c1_window", np.asarray(colour, np.uint8), (x0, y0))
+            window = np.asarray(colour, np.uint8)
+            colour = self.effects.apply("c1_window", window, (x0, y0), share)
         return ImageCrop(colour, (x0, y0), (w, h))
 
     def c2_frame(self, truth: bool = False) -> RenderedFrame:
