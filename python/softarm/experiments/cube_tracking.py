@@ -20,7 +20,9 @@ comparison on the same poses. ``--look L`` measures it in the daylight row
 marker body B instead of the paper's cube (:mod:`softarm.vision.marker_body`);
 ``--by-angle`` prints the figures by approach angle as well (:data:`ANGLE_BINS`: the
 angle between C1's line of sight and the paper cube's best-facing tag, whichever body
-is drawn), ``--json FILE`` writes them all.
+is drawn), ``--json FILE`` writes them all, ``--into FILE`` puts them into FILE with
+the other worlds' and bodies' (:mod:`softarm.experiments.cube_tracking_table` draws
+the docs' table from it).
 
 It lives above :mod:`softarm.perception` (which may not import the simulation).
 """
@@ -34,10 +36,12 @@ import sys
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from softarm.experiments.cube_tracking_table import merge_into
 from softarm.sim.render.row_look import LOOKS
 from softarm.vision.marker_body import MARKER_BODIES
 
@@ -205,8 +209,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--marker-body", choices=MARKER_BODIES, default="cube", help="the body tracked")
     p.add_argument("--by-angle", action="store_true", help="also by approach angle")
     p.add_argument("--json", metavar="FILE", help="write the figures as JSON to FILE")
+    p.add_argument("--into", metavar="FILE", help="put the figures into the JSON file FILE")
     args = p.parse_args(argv)
     result = track_cubes(args.seeds, args.poses, args.side, args.look, args.marker_body)
+    if args.into:
+        merge_into(Path(args.into), {"seeds": args.seeds, "look": args.look, **result})
     print(_line({k: v for k, v in result.items() if k != "by_angle"}))
     if args.by_angle:
         for row in result["by_angle"]:
