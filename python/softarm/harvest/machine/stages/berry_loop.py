@@ -54,8 +54,9 @@ class BerryLoop:
             if goal.record_errors:  # the errors at the grasp
                 watch.record_grasp_errors(self._grasp_error(seen), aim.pointing)
             ended = settled_or_out_of_time(
-                self.link, watch, stage, seen, q, axis, aim, goal, progress
-            )
+                self.link, watch, stage, seen, q, axis, self._ahead(seen, axis, goal, aim),
+                goal, progress,
+            )  # fmt: skip
             if ended is not None:
                 return ended
             q_next, saturated = self._loop_step(q, aim.goal, seen.pose)
@@ -75,6 +76,24 @@ class BerryLoop:
         goal = tool_pose(seen.pose, point, axis, offset)
         error = float(np.linalg.norm(grasp_point(seen.pose, offset) - point))
         return Aim(goal, error, pointing_error(seen.pose, axis))
+
+    def _ahead(self, seen: Observation, axis: FloatArray, goal: ServoGoal, aim: Aim) -> Aim:
+        """The aim a stage with ``goal.ahead`` ends on: the measured pose carried by the
+        model's motion from where the lag model has the arm now (the q sent less the
+        motion still in flight) to the q sent, i.e. where the commands already sent put
+        the arm. On a slow plant the arm trails the loop's last command by seconds,
+        most of it the regulators' lag with a channel near 0 or 70 psi: the loop's
+        commands have stopped changing long before the measured pose is within the
+        tolerances. Without ``goal.ahead`` or a lag model, ``aim`` itself."""
+        flight = self.link.actuator.in_flight()
+        if not goal.ahead or flight is None or seen.pose is None:
+            return aim
+        sent = self.link.actuator.sent
+        model_pose = self.link.controller.model_pose
+        # The model's motion still to come, in the end effector's frame: the true arm's
+        # is a few per cent off it, so the measured pose carries the model's error.
+        shift = np.linalg.solve(model_pose(sent - flight), model_pose(sent))
+        return self._aim(replace(seen, pose=seen.pose @ shift), axis, goal.distance)
 
     def _grasp_error(self, seen: Observation) -> float:
         """The grasp point's distance (m) from the berry."""

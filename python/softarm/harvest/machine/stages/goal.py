@@ -23,7 +23,11 @@ class ServoGoal:
     ``budget`` (fine positioning): past it, grasp within ``grasp_within`` (m) or be
     UNREACHABLE; ``record_errors``: keep every step's errors at the grasp;
     ``placed_on_limit`` (placement): a saturated arm within ``tol`` hands over;
-    ``frozen`` (the way back): the berry is this fixed point, held in the fingers."""
+    ``frozen`` (the way back): the berry is this fixed point, held in the fingers;
+    ``ahead`` (placement, the back-out): the stage ends on where the commands already
+    sent put the arm once it has caught up (the lag model's motion in flight carried
+    through the model), not on where it is measured now: the next stage goes on from
+    there while the arm is still on its way (docs/harvest.md, 'The moves')."""
 
     distance: float
     tol: float
@@ -33,6 +37,7 @@ class ServoGoal:
     record_errors: bool = True
     placed_on_limit: bool = False
     frozen: FloatArray | None = None
+    ahead: bool = False
 
 
 @dataclass(frozen=True)

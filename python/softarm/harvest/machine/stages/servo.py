@@ -16,7 +16,7 @@ from softarm.harvest.machine.interfaces import (
     require_controller,
 )
 from softarm.harvest.machine.observe import BerryWatch
-from softarm.harvest.machine.outcome import Fault, StageOutcome
+from softarm.harvest.machine.outcome import Ending, Fault, StageOutcome
 from softarm.harvest.machine.stages.arm_link import ArmLink
 from softarm.harvest.machine.stages.berry_loop import BerryLoop
 from softarm.harvest.machine.stages.goal import ServoGoal
@@ -115,7 +115,7 @@ class Servo:
             q = self.transport.follow(watch, stage, q, q_way, start + c.placement_timeout)
         placement = ServoGoal(
             c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout,
-            placed_on_limit=True,
+            placed_on_limit=True, ahead=True,
         )  # fmt: skip
         out = self.berry_loop.run(watch, stage, q, axis, placement)
         return replace(out, waypoints=waypoints)
@@ -157,9 +157,16 @@ class Servo:
         try:
             back_out = ServoGoal(
                 c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2,
-                record_errors=False, frozen=berry,
+                record_errors=False, frozen=berry, ahead=True,
             )  # fmt: skip
-            q = self.berry_loop.run(watch, stage, q, axis, back_out).q
+            backed = self.berry_loop.run(watch, stage, q, axis, back_out)
+            q = backed.q
+            if backed.ending is Ending.SETTLED and waypoints:
+                # The back-out has the arm at the pre-grasp pose, the plan's last
+                # waypoint, measured on the berry: the way home starts at the leg after
+                # it. Sent back to the plan's q there first, the arm moved by the
+                # model's error (1-4 cm on a slow plant) and waited to arrive.
+                waypoints = waypoints[:-1]
         except Fault as fault:
             # Backing out is best effort: the berry is already in the fingers (or the
             # machine is backing out of a fault), and the ramp home is open loop anyway.
