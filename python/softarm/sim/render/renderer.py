@@ -117,6 +117,7 @@ class BushRenderer:
         self.data = mujoco.MjData(self.model)
         self.cameras = {c.name: c for c in [*spec.world_cameras, *spec.hand_cameras]}
         self.labels = GeomLabels.from_model(self.model, mujoco)
+        #: One context per offscreen buffer size and shadow map (:meth:`_renderer`).
         self._renderers: dict[tuple[int, int, bool], Any] = {}
         self._last = LastRender()
         self._mocap = {
@@ -350,24 +351,31 @@ class BushRenderer:
                 self._renderers.popitem()[1].close()
 
     def _renderer(self, spec: CameraSpec, local: bool = False) -> Any:
-        """The renderer (an OpenGL context) of ``spec``'s size; ``local``: with the
-        small shadow map (MuJoCo reads the map's settings when it makes the context)."""
+        """The renderer (an OpenGL context) set to ``spec``'s size; ``local``: with the
+        small shadow map (MuJoCo reads the map's settings when it makes the context).
+
+        One context serves every size its offscreen buffer holds: MuJoCo draws into
+        that buffer's lower-left ``size`` pixels whatever size the context was made
+        for, so only the viewport differs. Making a context costs half a second of
+        CPU (every mesh and texture uploaded again), and the C1 windows come in many
+        sizes."""
         w, h = spec.size
         m = self.model
-        if (w, h, local) not in self._renderers:
-            m.vis.global_.offwidth = max(m.vis.global_.offwidth, w)
-            m.vis.global_.offheight = max(m.vis.global_.offheight, h)
+        m.vis.global_.offwidth = max(m.vis.global_.offwidth, w)
+        m.vis.global_.offheight = max(m.vis.global_.offheight, h)
+        key = (int(m.vis.global_.offwidth), int(m.vis.global_.offheight), local)
+        if key not in self._renderers:
             full = (int(m.vis.quality.shadowsize), float(m.vis.map.shadowclip))
             if local and self._sun is not None:
                 m.vis.quality.shadowsize = LOCAL_SIZE
                 m.vis.map.shadowclip = self._sun.local_shadowclip
             try:
-                self._renderers[(w, h, local)] = self._mj.Renderer(m, h, w)
+                self._renderers[key] = self._mj.Renderer(m, h, w)
             except (OSError, AttributeError, RuntimeError, self._mj.FatalError) as exc:  # no GL
                 raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
             finally:
                 m.vis.quality.shadowsize, m.vis.map.shadowclip = full
-        return self._renderers[(w, h, local)]
+        return _sized(self._renderers[key], self._mj, w, h)
 
     def _place(self, body: str, pos: FloatArray, R: FloatArray) -> None:
         x, y, z, w = Rotation.from_matrix(R).as_quat()
@@ -377,6 +385,16 @@ class BushRenderer:
         i = self._mocap[body]
         self.data.mocap_pos[i] = pos
         self.data.mocap_quat[i] = quat
+
+
+def _sized(r: Any, mj: Any, w: int, h: int) -> Any:
+    """``mujoco.Renderer`` ``r`` set to draw and read ``w`` x ``h`` pixels: its image
+    size is its viewport (``_rect``) and its read-back's shape, which the class fixes
+    when it is made; the offscreen buffer must hold the size (:meth:`_renderer`)."""
+    if (r._width, r._height) != (w, h):
+        r._width, r._height = w, h
+        r._rect = mj.MjrRect(0, 0, w, h)
+    return r
 
 
 def _quat_z_to(direction: FloatArray) -> FloatArray:
