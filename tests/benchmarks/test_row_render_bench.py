@@ -1,7 +1,9 @@
 """What a small render of the daylight row costs (issue 37 item 6): C2's frame (at the
 harvest's half scale) and a 184-pixel window of C1's left eye around the marker cube,
 the arm reaching for a berry, drawn with the small shadow map (the harvest's way) and
-with the full one, on the same world."""
+with the full one, on the same world; and with the small map on the same row whose
+ground is drawn on MuJoCo's finest grid (200 x 200 quads, as it was before
+row_mjcf.GROUND_GRID)."""
 
 from __future__ import annotations
 
@@ -18,11 +20,12 @@ SEED = 4
 WINDOW = 184
 
 
-@pytest.fixture(scope="module")
-def row() -> Iterator[Any]:
+def _row(ground_grid: float | None = None) -> Any:
+    """The row of SEED with the arm reaching for its first berry; ``ground_grid``: the
+    ground plane's grid pitch (m) instead of row_mjcf.GROUND_GRID."""
     pytest.importorskip("mujoco")
-    from softarm.harvest.rigs.sim.rig import default_cameras
-    from softarm.sim.render import RenderUnavailableError
+    from softarm.harvest.rigs.sim.options import default_cameras
+    from softarm.sim.render import RenderUnavailableError, row_mjcf
     from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import arm_sections, world_for
     from softarm.sim.rig_cameras import BASE_TAG_ID
@@ -30,14 +33,40 @@ def row() -> Iterator[Any]:
     cams = default_cameras()
     arm = softarm.SoftArm.blackberry()
     bush = Bush.generate(arm, 6, SEED, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.3)
+    kept = row_mjcf.GROUND_GRID
+    row_mjcf.GROUND_GRID = kept if ground_grid is None else ground_grid
     try:
         world = world_for(bush, cams, BASE_TAG_ID, RowLook.named("overcast", SEED), 0.5)
     except RenderUnavailableError as exc:
         pytest.skip(str(exc))
+    finally:
+        row_mjcf.GROUND_GRID = kept
     q = np.asarray(bush.berries[0].q) * 0.9
     world.set_arm(arm_sections(arm, q), arm.forward(q))
+    return world
+
+
+@pytest.fixture(scope="module")
+def row() -> Iterator[Any]:
+    world = _row()
     yield world
     world.close()
+
+
+@pytest.fixture(scope="module")
+def fine_ground_row() -> Iterator[Any]:
+    world = _row(ground_grid=0.1)
+    yield world
+    world.close()
+
+
+def _anew(renderer: Any) -> Any:
+    """``renderer`` with no render kept: the same scene is drawn again, not handed back
+    (softarm.sim.render.last_render)."""
+    from softarm.sim.render.last_render import LastRender
+
+    renderer._last = LastRender()
+    return renderer
 
 
 def _window_origin(world: Any) -> tuple[int, int]:
@@ -59,10 +88,21 @@ def test_row_small_render(benchmark, row: Any, view: str, shadow_map: str) -> No
         renderer._sun.place = lambda *a: False
     try:
         if view == "c2":
-            image = benchmark(lambda: renderer.render("c2").colour)
+            image = benchmark(lambda: _anew(renderer).render("c2").colour)
         else:
             origin = _window_origin(row)
-            image = benchmark(lambda: renderer.render_window("c1_left", origin, WINDOW))
+            image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
     finally:
         renderer._sun.place = place
+    assert image.ndim == 3
+
+
+@pytest.mark.parametrize("view", ["c2", "c1_window"])
+def test_row_small_render_fine_ground(benchmark, fine_ground_row: Any, view: str) -> None:  # type: ignore[no-untyped-def]
+    renderer = fine_ground_row.renderer
+    if view == "c2":
+        image = benchmark(lambda: _anew(renderer).render("c2").colour)
+    else:
+        origin = _window_origin(fine_ground_row)
+        image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
     assert image.ndim == 3
