@@ -1,6 +1,6 @@
 """The stereo match of one berry along the rows (``softarm.perception.stereo``): the
 disparity of a textured fruit, no unique match on a flat one, and the shading's veto
-when it has no match of its own but contradicts the outline's."""
+when it contradicts the outline's and another fruit lies beside the berry."""
 
 from __future__ import annotations
 
@@ -65,11 +65,16 @@ def test_the_cues_together() -> None:
         (flat, _shifted(flat, 31)), (textured, _shifted(textured, 31)), berry, RANGE
     )
     assert shading_only.by_outline is None and shading_only.disparity() is not None
-    # Both unique, 1.5 px apart: the shading's; 3 px apart: neither.
+    # Both unique, 1.5 px apart: the shading's; 3 px apart: neither where another fruit
+    # lies beside the berry (the outline may be on it), the outline's where none does.
+    beside = [berry, _berry(x=140)]
     near = _Cues(
-        (textured, _shifted(textured, 33)), (textured, _shifted(textured, 31)), berry, RANGE
-    )
+        (textured, _shifted(textured, 33)), (textured, _shifted(textured, 31)), berry, RANGE,
+        beside,
+    )  # fmt: skip
     near.by_outline = 32.5
     assert near.disparity() == near.by_shading
     near.by_outline = 34.5
     assert near.disparity() is None
+    near.neighbours = []
+    assert near.disparity() == 34.5

@@ -14,9 +14,13 @@ the outline alone, 6.9 with the shading alone, 6.0 with both, 93 % localised). W
 one cue has no unique match, the other's stands if the first one's cost does not
 contradict it; where both match within two pixels but not one, the shading's stands
 (diagnosed on harvest bushes 736, 739 and 750–757, where whole berries in view were
-otherwise never mapped, look after look). With f ≈
-900 px and B = 0.12 m a pixel of disparity is about 13 mm of depth at 1.2 m. The
-silhouette of a round fruit is its equator, so the triangulated point is taken as the
+otherwise never mapped, look after look). Where they disagree otherwise, the outline's
+stands if the fruit's outline is alone: no other detected fruit beside it on its rows,
+and the two eyes' silhouettes alike at the match (the shading's template holds the
+row's leaves, canes and sky around the fruit's edge, at other depths; on the diagnosis
+rows 90120–90125 this places 37 of the 48 ripe berries of C1's first look, against 16).
+With f ≈ 900 px and B = 0.12 m a pixel of disparity is about 13 mm of depth at 1.2 m.
+The silhouette of a round fruit is its equator, so the triangulated point is taken as the
 centre. The drupelets that form the outline differ between the two eyes, which leaves
 about half a pixel of disparity noise per berry (±5 mm at 1 m). A ripe berry is
 triangulated at the mean of its two eyes' centres (:mod:`softarm.perception.two_eyes`),
@@ -26,6 +30,7 @@ the eyes' centre errors while the disparity's moves it along that ray only.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import cast
 
@@ -57,6 +62,9 @@ AGREEMENT = 1.0
 SHADING_LEAD = 2.0
 #: The fruit's width (m): 1.5–2.5 cm across, with a margin either side.
 FRUIT_ACROSS = (0.013, 0.032)
+#: How much of the template's support the two eyes' silhouettes must share (their
+#: intersection over union there) for the outline's match to stand against the shading's.
+OUTLINE_OVERLAP = 0.6
 #: How much better (as a share of the cost) the best match must be than any other.
 UNIQUENESS = 0.15
 #: Depths (m) searched along the rows: the disparity range f B / z.
@@ -103,7 +111,7 @@ def locate_berries(
     d_hi = rect.focal * rect.baseline / DEPTH_RANGE[0]
     out = []
     for det in detections:
-        cues = _Cues((sil_l, sil_r), (grey_l, grey_r), det, (d_lo, d_hi))
+        cues = _Cues((sil_l, sil_r), (grey_l, grey_r), det, (d_lo, d_hi), detections)
         d = cues.disparity()
         position = radius_m = None
         if d is not None and _plausible(d, det.radius, rect.baseline):
@@ -149,15 +157,12 @@ def _cost_curve(
     """The masked template's squared-difference cost along the rows of the right
     image, with the template's left column ``x0`` and the strip's ``s0`` (a cost index
     k is the disparity ``x0 - s0 - k``); None when the window leaves the image."""
-    x, y, w, h = det.box
-    pad = 2
-    x0, y0, x1, y1 = x - pad, y - pad, x + w + pad, y + h + pad
+    x0, y0, x1, y1 = _window(det)
     height, width = left.shape
     if x0 < 0 or y0 < 0 or x1 > width or y1 > height:
         return None
     template = left[y0:y1, x0:x1]
-    mask = det.mask_window(x0, y0, x1, y1).astype(np.uint8)
-    mask = cv2.dilate(mask, np.ones((3, 3), np.uint8)).astype(np.float32)
+    mask = _support(det, (x0, y0, x1, y1)).astype(np.float32)
     lo = max(int(np.floor(disparity_range[0])), 0)
     hi = int(np.ceil(disparity_range[1]))
     s0 = max(x0 - hi, 0)
@@ -167,6 +172,20 @@ def _cost_curve(
     strip = right[y0:y1, s0:s1]
     cost = cv2.matchTemplate(strip, template, cv2.TM_SQDIFF, mask=mask)[0]
     return cost, x0, s0
+
+
+def _window(det: BerryDetection) -> tuple[int, int, int, int]:
+    """The template's window (x0, y0, x1, y1): the berry's box with 2 px either side."""
+    x, y, w, h = det.box
+    pad = 2
+    return x - pad, y - pad, x + w + pad, y + h + pad
+
+
+def _support(det: BerryDetection, window: tuple[int, int, int, int]) -> npt.NDArray[np.uint8]:
+    """The template's support over ``window``: the berry's mask dilated by a pixel, so
+    that the silhouette's edge is in it (0/1)."""
+    mask = det.mask_window(*window).astype(np.uint8)
+    return cast(npt.NDArray[np.uint8], cv2.dilate(mask, np.ones((3, 3), np.uint8)))
 
 
 def _cost_allows(
@@ -200,30 +219,67 @@ class _Cues:
         shading: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]],
         det: BerryDetection,
         disparity_range: tuple[float, float],
+        detections: Sequence[BerryDetection] = (),
     ) -> None:
         self.outline, self.shading, self.det, self.range = outline, shading, det, disparity_range
+        self.neighbours = [d for d in detections if d is not det and _beside(det, d)]
         self.by_outline = match_disparity(*outline, det, disparity_range)
         self.by_shading = match_disparity(*shading, det, disparity_range)
 
     def disparity(self) -> float | None:
-        """Their mean where they agree within AGREEMENT px. Where one cue has no unique
-        match of its own, the other's stands if that cue's cost does not contradict
-        it (:func:`_cost_allows`): a dark fruit on a dark ground leaves the shading
-        flat, a fruit whose drupelets differ in the two eyes the outline. Where both
-        match but differ by up to SHADING_LEAD px, the shading's stands: alone it is
-        the better cue (p95 6.9 against 8.6 mm on the diagnosis bushes 200–219), and a
-        match on a neighbour lies farther off. Else None: a later look may place it."""
+        """Their mean where they agree within AGREEMENT px. Where both match but differ
+        by up to SHADING_LEAD px, the shading's stands: alone it is the better cue (p95
+        6.9 against 8.6 mm on the diagnosis bushes 200–219), and a match on a neighbour
+        lies farther off. Where one cue has no unique match of its own, the other's
+        stands if that cue's cost does not contradict it (:func:`_cost_allows`): a dark
+        fruit on a dark ground leaves the shading flat, a fruit whose drupelets differ
+        in the two eyes the outline. The outline's match stands against the shading's
+        too where the fruit's outline is alone (:meth:`_outline_alone`). Else None: a
+        later look may place it."""
         a, g = self.by_outline, self.by_shading
         agreed = _agreed(a, g)
         if agreed is not None:
             return agreed
-        if a is not None and g is None:
-            return a if _cost_allows(*self.shading, self.det, self.range, a) else None
-        if g is not None and a is None:
-            return g if _cost_allows(*self.outline, self.det, self.range, g) else None
         if a is not None and g is not None and abs(a - g) <= SHADING_LEAD:
             return g
+        if a is not None:
+            allowed = g is None and _cost_allows(*self.shading, self.det, self.range, a)
+            return a if allowed or self._outline_alone(a) else None
+        if g is not None:
+            return g if _cost_allows(*self.outline, self.det, self.range, g) else None
         return None
+
+    def _outline_alone(self, disparity: float) -> bool:
+        """Whether the outline's match at ``disparity`` needs no word from the shading:
+        no other detected fruit beside the berry (:func:`_beside`), whose image in the
+        right eye could take the match, and the two eyes' silhouettes sharing
+        OUTLINE_OVERLAP of the template's support there (a fruit that a leaf hides
+        differently in the two eyes has two outlines, and the match slides between
+        them: on test bush 300 a berry 2.9 px off, 0.41 shared). Against the row's
+        leaves, canes and sky, which the shading's template holds around the fruit's
+        edge at other depths, the shading vetoed 21 outline matches within 1.5 px of the
+        truth on the diagnosis rows 90120–90125 (C1's first look); 20 stand by this."""
+        if self.neighbours:
+            return False
+        x0, y0, x1, y1 = _window(self.det)
+        shift = round(disparity)
+        sil_l, sil_r = self.outline
+        if x0 - shift < 0 or x1 > sil_l.shape[1] or y0 < 0 or y1 > sil_l.shape[0]:
+            return False
+        support = _support(self.det, (x0, y0, x1, y1)) > 0
+        left = (sil_l[y0:y1, x0:x1] > 0.5) & support
+        right = (sil_r[y0:y1, x0 - shift : x1 - shift] > 0.5) & support
+        union = int((left | right).sum())
+        return union > 0 and (left & right).sum() >= OUTLINE_OVERLAP * union
+
+
+def _beside(det: BerryDetection, other: BerryDetection) -> bool:
+    """Whether ``other`` lies on ``det``'s rows within one of ``det``'s widths of its box
+    either side: there its image in the right eye could take ``det``'s outline match."""
+    x, y, w, h = det.box
+    ox, oy, ow, oh = other.box
+    rows = min(y + h, oy + oh) > max(y, oy)
+    return rows and ox < x + 2 * w and ox + ow > x - w
 
 
 def _agreed(by_outline: float | None, by_shading: float | None) -> float | None:
