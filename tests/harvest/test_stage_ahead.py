@@ -174,3 +174,26 @@ def test_a_back_out_that_did_not_settle_goes_home_by_the_plans_way() -> None:
     way = _way_home(servo, watch, q, q_pre)
     assert len(way) == 2
     np.testing.assert_array_equal(way[0], q_pre)
+
+
+def test_the_way_homes_last_leg_leaves_the_rest_of_the_way_to_the_ramp_home() -> None:
+    """The last leg of the way home ends once the plan's point is home: the ramp home
+    after it waits for the arm there. Before, the leg went on closing the loop until the
+    arm was measured at the leg's end or the lag model had it there, then the ramp
+    waited again."""
+    clock, plant, _, servo, watch, log = _slow_rig(off=True)
+    config = servo.link.cfg
+    axis = np.array([0.0, 1.0, 0.0])
+    q = (BERRIES[1] - (config.standoff + config.grasp_offset) * axis - P0) / K
+    q = servo.transport.ramp(watch, HarvestState.INITIAL_PLACEMENT, np.zeros(3), q, 30.0)
+    start = len(log.records)
+    home = np.full(3, 0.0167)
+    plan_steps = int(np.ceil(np.max(np.abs(home - q)) / (config.home_speed * config.period)))
+    q = servo.transport.way_back(watch, HarvestState.RETURN_HOME, q, (home,), clock.now())
+    steps = [r for r in log.records[start:] if r["kind"] == "step"]
+    followed = [r for r in steps if r["goal"] is not None]  # the ramp has no goal
+    assert len(followed) <= plan_steps + 1
+    np.testing.assert_array_equal(q, home)
+    np.testing.assert_allclose(
+        plant.pressures(), home / METRES_PER_PSI, atol=config.arrival_tolerance / METRES_PER_PSI
+    )

@@ -157,7 +157,7 @@ class Servo:
         try:
             back_out = ServoGoal(
                 c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2,
-                record_errors=False, frozen=berry, ahead=True,
+                record_errors=False, frozen=berry,
             )  # fmt: skip
             backed = self.berry_loop.run(watch, stage, q, axis, back_out)
             q = backed.q

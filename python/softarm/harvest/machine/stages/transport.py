@@ -52,11 +52,16 @@ class Transport:
         q_way: FloatArray,
         deadline: float,
         near_ends: bool = False,
+        hand_over: bool = True,
     ) -> FloatArray:
         """Follow the planned segment ``q`` → ``q_way`` in closed loop on the eye-to-hand
         camera until the end effector is within ``placement_tolerance`` of the model's pose
         at ``q_way``: once the plan's feedforward has reached ``q_way`` or, with
-        ``near_ends`` (a waypoint of the way home), as soon as the arm is there.
+        ``near_ends`` (a waypoint of the way home), as soon as the arm is there. Without
+        ``hand_over`` (the way home's last leg) it ends once the plan's feedforward has
+        reached ``q_way``: the ramp home that follows takes the arm the rest of the way
+        along the same line, and waiting here for the lag model to have the arm at the
+        plan's end, then again at home, waited twice for the regulators.
 
         Each period the plan's elongations advance by ``home_speed`` (the feedforward of the
         planned q) and the resolver's step, closed on the measured pose towards the model's
@@ -77,6 +82,8 @@ class Transport:
         while True:
             seen = self.link.look(watch, q, need_fix=False)
             on_plan_end = bool(np.all(nominal == q_way))
+            if on_plan_end and not hand_over:
+                return q
             if seen.pose is None:
                 blind = on_plan_end or seen.t - posed > c.follow_blind_time
                 q, nominal = self._blind(watch, stage, seen, q, nominal, q_way, blind)
@@ -287,7 +294,8 @@ class Transport:
                 # the next leg's way from there is checked as every command's is. The
                 # last leg runs to home's q: the open-loop ramp after it is short.
                 deadline = start + c.home_timeout
-                q = self.follow(watch, stage, q, legs[0], deadline, near_ends=len(legs) > 1)
+                last = len(legs) == 1
+                q = self.follow(watch, stage, q, legs[0], deadline, not last, hand_over=not last)
                 legs.pop(0)
         except Fault as fault:
             if fault.reason not in (FaultReason.TIMEOUT, FaultReason.MARKER_LOST):
