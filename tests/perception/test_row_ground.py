@@ -1,7 +1,8 @@
-"""The row's ground plane is drawn as a few large quads (softarm.sim.render.row_mjcf.
-GROUND_GRID): MuJoCo draws a plane as a grid of quads in each of a shadowed render's
-three passes, and the row's lights are directional, so the grid's pitch changes no lit
-colour: the small renders the harvest draws are the same, pixel for pixel."""
+"""The row's small renders (C2, C1's windows) draw the ground plane as a few large quads
+(softarm.sim.render.renderer.SMALL_RENDER_GROUND_GRID), a whole C1 frame as MuJoCo's
+finest grid (row_mjcf.GROUND_GRID): MuJoCo makes a plane's quads when it makes the
+context, and draws them in each of a shadowed render's three passes. The row's lights
+are directional, so the small renders are the same, pixel for pixel."""
 
 from __future__ import annotations
 
@@ -25,9 +26,9 @@ def _quads_a_side(half_size: float, pitch: float) -> int:
     return n - n % 2 + 2
 
 
-def _row_world(grid: float | None = None) -> Any:
+def _row_world() -> Any:
     from softarm.harvest.rigs.sim.options import default_cameras
-    from softarm.sim.render import RenderUnavailableError, row_mjcf
+    from softarm.sim.render import RenderUnavailableError
     from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import arm_sections, world_for
     from softarm.sim.rig_cameras import BASE_TAG_ID
@@ -36,42 +37,70 @@ def _row_world(grid: float | None = None) -> Any:
     cams = default_cameras()  # the harvest's: C2 at half scale, 320 x 240
     arm = softarm.SoftArm.blackberry()
     bush = Bush.generate(arm, 6, 4, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
-    kept = row_mjcf.GROUND_GRID
-    row_mjcf.GROUND_GRID = kept if grid is None else grid
     try:
         world = world_for(bush, cams, BASE_TAG_ID, RowLook.named("sun", 4), 0.5)
     except RenderUnavailableError as exc:
         pytest.skip(str(exc))
-    finally:
-        row_mjcf.GROUND_GRID = kept
     q = np.asarray(bush.berries[0].q) * 0.9
     world.set_arm(arm_sections(arm, q), arm.forward(q))
     return world
 
 
-def test_the_ground_is_a_few_quads_not_mujocos_finest_grid() -> None:
+def test_small_renders_draw_a_few_quads_of_ground_and_whole_frames_the_finest() -> None:
+    import mujoco
+
+    from softarm.sim.render.shadow_map import LOCAL_SIZE
+
     world = _row_world()
+    renderer = world.renderer
+    m = renderer.model
+    ground = m.geom("bg_ground").id
+    half = float(m.geom_size[ground, 0])
+    made = []  # (small shadow map, ground quads a side) of each context made
+
+    def spy(model: Any, h: int, w: int) -> Any:
+        small = int(model.vis.quality.shadowsize) == LOCAL_SIZE
+        made.append((small, _quads_a_side(half, float(model.geom_size[ground, 2]))))
+        return mujoco.Renderer(model, h, w)
+
+    renderer._mj = _WithRenderer(mujoco, spy)
     try:
-        m = world.renderer.model
-        ground = m.geom("bg_ground").id
-        half = float(m.geom_size[ground, 0])
-        assert _quads_a_side(half, float(m.geom_size[ground, 2])) <= 16
-        assert _quads_a_side(half, 0.1) == MAX_PLANE_GRID  # the pitch it was drawn at
+        renderer.render("c2")
+        renderer.render("c1_left")
     finally:
+        renderer._mj = mujoco
         world.close()
+    assert sorted(made) == [(False, MAX_PLANE_GRID), (True, 12)], made
+    assert _quads_a_side(half, float(m.geom_size[ground, 2])) == MAX_PLANE_GRID  # kept
 
 
-def test_small_renders_are_those_of_the_fine_grid() -> None:
-    coarse, fine = _row_world(), _row_world(grid=0.1)
+class _WithRenderer:
+    """The ``mujoco`` module with its ``Renderer`` replaced."""
+
+    def __init__(self, module: Any, renderer: Any) -> None:
+        self._module, self.Renderer = module, renderer
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._module, name)
+
+
+def test_small_renders_are_those_of_the_finest_grid(monkeypatch: pytest.MonkeyPatch) -> None:
+    from softarm.sim.render import renderer as module
+
+    windows = ((560, 260), (900, 120))
+    coarse = _row_world()
     try:
-        np.testing.assert_array_equal(
-            coarse.renderer.render("c2").colour, fine.renderer.render("c2").colour
-        )
-        for origin in ((560, 260), (900, 120)):
-            np.testing.assert_array_equal(
-                coarse.renderer.render_window("c1_left", origin, 96),
-                fine.renderer.render_window("c1_left", origin, 96),
-            )
+        c2 = coarse.renderer.render("c2").colour
+        small = [coarse.renderer.render_window("c1_left", o, 96) for o in windows]
     finally:
         coarse.close()
+    monkeypatch.setattr(module, "SMALL_RENDER_GROUND_GRID", 0.1)  # read as a context is made
+    fine = _row_world()
+    try:
+        np.testing.assert_array_equal(c2, fine.renderer.render("c2").colour)
+        for origin, window in zip(windows, small, strict=True):
+            np.testing.assert_array_equal(
+                window, fine.renderer.render_window("c1_left", origin, 96)
+            )
+    finally:
         fine.close()

@@ -57,6 +57,16 @@ CULLED_GROUP = 5
 SHADOW_REACH = 3.0
 SHADOW_STEP = 0.125
 SHADOW_STEPS = np.arange(SHADOW_STEP, SHADOW_REACH, 2 * SHADOW_STEP)
+#: The ground planes' grid pitch (m) in the small renders' context (C2, C1's windows,
+#: with the small shadow map). MuJoCo draws a plane as a grid of quads, made when the
+#: context is made, for the per-vertex light of spot and point lights; the row's lights
+#: are directional, so the grid changes no lit colour, while its finest grid (200 x 200
+#: quads, drawn in each of a shadowed render's three passes) was a fifth of a small
+#: render's cost. At 4 m the row's 80 m ground is 12 x 12 quads. A whole C1 frame keeps
+#: the fine grid: there the longer triangles' texture coordinates round a few hundred
+#: pixels of open soil onto the next texel of its speckle (up to 4 levels), and the
+#: cane fit read them (7 canes instead of 8 on row 90140).
+SMALL_RENDER_GROUND_GRID = 4.0
 
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
@@ -140,6 +150,7 @@ class BushRenderer:
         self._cullable = np.flatnonzero(self.labels.kind != KINDS.index("arm"))
         self._arm = np.flatnonzero(self.labels.kind == KINDS.index("arm"))
         self._backdrop = self.model.geom_rbound > BACKDROP_RADIUS
+        self._planes = np.flatnonzero(self.model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
         self._backdrop[self._arm] = False
         self._shadow_travel: FloatArray | None = None
         self._sun: SunShadows | None = None
@@ -352,7 +363,8 @@ class BushRenderer:
 
     def _renderer(self, spec: CameraSpec, local: bool = False) -> Any:
         """The renderer (an OpenGL context) set to ``spec``'s size; ``local``: with the
-        small shadow map (MuJoCo reads the map's settings when it makes the context).
+        small shadow map and the coarse ground (MuJoCo reads the map's settings and
+        makes a plane's quads when it makes the context).
 
         One context serves every size its offscreen buffer holds: MuJoCo draws into
         that buffer's lower-left ``size`` pixels whatever size the context was made
@@ -366,15 +378,18 @@ class BushRenderer:
         key = (int(m.vis.global_.offwidth), int(m.vis.global_.offheight), local)
         if key not in self._renderers:
             full = (int(m.vis.quality.shadowsize), float(m.vis.map.shadowclip))
+            grids = m.geom_size[self._planes, 2].copy()
             if local and self._sun is not None:
                 m.vis.quality.shadowsize = LOCAL_SIZE
                 m.vis.map.shadowclip = self._sun.local_shadowclip
+                m.geom_size[self._planes, 2] = SMALL_RENDER_GROUND_GRID
             try:
                 self._renderers[key] = self._mj.Renderer(m, h, w)
             except (OSError, AttributeError, RuntimeError, self._mj.FatalError) as exc:  # no GL
                 raise RenderUnavailableError(f"{HOW_TO_ENABLE} ({exc})") from exc
             finally:
                 m.vis.quality.shadowsize, m.vis.map.shadowclip = full
+                m.geom_size[self._planes, 2] = grids
         return _sized(self._renderers[key], self._mj, w, h)
 
     def _place(self, body: str, pos: FloatArray, R: FloatArray) -> None:

@@ -49,16 +49,11 @@ LEAF_BINS = np.linspace(0.05, 0.09, 5)
 ROW_DRUPELETS = 34
 #: The row's canes are drawn with fewer segments than the bush's (they are not fitted).
 ROW_CANE_SEGMENTS = 10
-#: The ground plane's grid pitch (m) as MuJoCo draws it (the third of a plane's sizes).
-#: MuJoCo subdivides a drawn plane into quads of this pitch, at most 200 a side, for the
-#: per-vertex lighting of spot and point lights; the row's lights are directional, so the
-#: grid changes no lit colour, and the 200 x 200 quads of a 0.1 m pitch were drawn three
-#: times a render (the shadow map, the unshadowed and the sunlit pass): a fifth of a C2
-#: frame's or a C1 window's cost. At 4 m the 80 m ground is 12 x 12 quads; small renders
-#: are the same, pixel for pixel, and a whole C1 frame differs by at most 2 levels in
-#: 0.06 % of its pixels (soil in the open ground, where the longer triangles' texture
-#: coordinates round onto the next texel of the soil's speckle).
-GROUND_GRID = 4.0
+#: The ground plane's grid pitch (m) as MuJoCo draws it (the third of a plane's sizes):
+#: at 0.1 m MuJoCo draws the 80 m ground as its finest grid, 200 x 200 quads, in each of
+#: a shadowed render's three passes. The small renders' context draws it coarser
+#: (softarm.sim.render.renderer.SMALL_RENDER_GROUND_GRID).
+GROUND_GRID = 0.1
 #: Where the scene is, for the sun's position and shadow frustum.
 CENTRE = np.array([0.0, 0.45, 0.2])
 EXTENT = 1.6
