@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.perception.approach import RayCrossing
+from softarm.perception.approach import RayCrossing, along_spread
 from softarm.perception.berries import BerryDetection, DetectorSettings
 from softarm.perception.bush_map import BushMap
 from softarm.perception.detector.choice import detect_berries  # the chosen detector
@@ -58,10 +58,23 @@ class BushVision(CameraVision):
         super().select(berry)
         entry = self.bush_map.get(berry.tag_id)
         origin = self.bush_map.ray_origin
-        origin = self.T_base_c1[:3, 3] if origin is None else origin
-        self._track = (
-            None if entry is None else RayCrossing(origin, entry.position, entry.radius)
+        self._track = None if entry is None else RayCrossing(
+            self.T_base_c1[:3, 3] if origin is None else origin, entry.position, entry.radius,
+            self._along(origin, entry.position),
         )  # fmt: skip
+
+    def _along(self, origin: FloatArray | None, position: FloatArray) -> float:
+        """How far along C1's ray C2 looks for the berry at ``position``: the depth the
+        stereo's disparity spread spans there (:func:`along_spread`); 0 where the map's
+        positions are not the stereo's (no ray origin: the baseline's middle, half
+        the baseline from C1's left eye)."""
+        if origin is None:
+            return 0.0
+        baseline = 2.0 * float(np.linalg.norm(origin - self.T_base_c1[:3, 3]))
+        depth = float(np.linalg.norm(position - origin))
+        if baseline <= 0.0 or depth <= 0.0:
+            return 0.0
+        return along_spread(depth, self.model1.focal, baseline)
 
     def _mapped(self) -> FloatArray | None:
         berry = self.bush_map.get(self.selected.tag_id)
