@@ -13,7 +13,7 @@ import pytest
 import softarm
 from softarm.errors import ParameterError
 from softarm.sim.bush import Bush
-from softarm.sim.render.headroom import WINDOW_HEADROOM, dimmed
+from softarm.sim.render.headroom import MARGIN, dimmed, window_share
 from softarm.sim.render.row_camera import RowCameras
 from softarm.sim.render.row_look import RowLook
 
@@ -41,6 +41,16 @@ def test_dimmed_scales_every_light_and_restores_them_after_an_error() -> None:
         raise RuntimeError("a render failing inside")
     for after, was in zip(_lights(model), before, strict=True):
         np.testing.assert_array_equal(after, was)
+
+
+def test_the_share_keeps_the_brightest_white_under_full_scale() -> None:
+    mujoco = pytest.importorskip("mujoco")
+    model = mujoco.MjModel.from_xml_string(_LIGHT)  # the light shines down (-z)
+    up, down = np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, -1.0]])
+    # Facing the light: diffuse 0.8 plus the ambients 0.2 + 0.3 in the brightest channel.
+    assert window_share(model, up) == pytest.approx(1.0 / (MARGIN * 1.3))
+    assert window_share(model, np.vstack([down, up])) == window_share(model, up)
+    assert window_share(model, down) == 1.0  # ambient alone: no dimming
 
 
 @pytest.mark.parametrize("share", [0.0, -0.5, 1.5, float("nan")])
@@ -128,4 +138,3 @@ def test_the_row_s_marker_window_does_not_clip(sunny_row: Any) -> None:
     # ROI metering puts the brightest 0.5 % at 230 DN x 0.997: only noise reaches 255
     # (metered as C1's frame, 4-6 % of this window was at 255).
     assert (window.max(axis=2) >= 255).mean() < 0.005
-    assert 0.0 < WINDOW_HEADROOM < 1.0

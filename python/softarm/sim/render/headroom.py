@@ -4,15 +4,21 @@ at the render, before any camera model sees it: a camera that meters on the mark
 could then only scale a step already clipped, and the edge refinement's gradient
 centroid is biased by a clipped step (docs/perception.md, "Cube tracking in the row").
 
-C1's window around the marker is therefore drawn with the scene's lights at
-:data:`WINDOW_HEADROOM` of their strength (:func:`dimmed`), and the camera model
-(:meth:`~softarm.sim.render.camera_effects.CameraEffects.roi_exposure_of`) scales its
-exposure back: radiance up to 255 / WINDOW_HEADROOM DN reaches the simulated sensor,
-where the exposure decides what clips, as in a camera. The cost is the render's
-quantisation: one DN of the dimmed render is 1 / WINDOW_HEADROOM DN of the scene's.
+C1's window around the marker is therefore drawn with the scene's lights dimmed
+(:func:`dimmed`) to the share :func:`window_share` gives: just enough that a white tag
+facing any way the body's tags face stays under the render's full scale, by the
+lights' own terms (each directional light's diffuse by the cosine to it, plus every
+ambient; shadows left out, so it errs towards dimming), with :data:`MARGIN` to spare;
+1 (no dimming) where no tag can reach full scale (in shade, against the light, under
+cloud). The camera model (:meth:`~softarm.sim.render.camera_effects.CameraEffects.
+roi_exposure_of`) scales its exposure back: radiance up to 255 / share DN reaches the
+simulated sensor, where the exposure decides what clips, as in a camera. The cost is
+the render's quantisation, one DN of the dimmed render being 1 / share DN of the
+scene's, which is why the share is no smaller than the tags need.
 
-MuJoCo draws the skybox unlit, so it is not dimmed: sky in a window comes out
-1 / WINDOW_HEADROOM times as bright, relative to the lit scene, as in a full frame.
+MuJoCo draws the skybox unlit, so it is not dimmed: sky in a dimmed window comes out
+1 / share times as bright, relative to the lit scene, as in a full frame (no window of
+the diagnosis poses held sky).
 """
 
 from __future__ import annotations
@@ -21,14 +27,29 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+import numpy as np
+
+from softarm.checks import FloatArray
 from softarm.errors import ParameterError
 
-__all__ = ["WINDOW_HEADROOM", "dimmed"]
+__all__ = ["MARGIN", "dimmed", "window_share"]
 
-#: The share of the scene's light C1's marker window is rendered with: the row's
-#: brightest lit white (sun up to 1.25 plus ambient and sky fill, about 1.6 of the
-#: render's full scale) stays under 255 DN.
-WINDOW_HEADROOM = 0.5
+#: The brightest white's radiance is taken this much higher than the lights' terms
+#: give it (what the sum leaves out: MuJoCo's shading and texture filtering).
+MARGIN = 1.1
+
+
+def window_share(model: Any, normals: FloatArray) -> float:
+    """The share of its lights' strength the MuJoCo ``model`` is drawn with for C1's
+    marker window (see the module docstring): 1 / (MARGIN x the radiance, in the
+    render's full scale, of a white surface facing the brightest of ``normals`` (N, 3),
+    unit vectors in the world frame), at most 1. The model's lights are taken as
+    directional, fixed in the world (the row's sun and sky are)."""
+    toward = -np.asarray(model.light_dir, np.float64)
+    toward /= np.linalg.norm(toward, axis=1, keepdims=True)
+    ambient = np.asarray(model.vis.headlight.ambient) + model.light_ambient.sum(axis=0)
+    lit = np.clip(np.asarray(normals) @ toward.T, 0.0, None) @ model.light_diffuse + ambient
+    return float(min(1.0, 1.0 / (MARGIN * float(lit.max()))))
 
 
 @contextmanager

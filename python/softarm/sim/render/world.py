@@ -21,7 +21,7 @@ from softarm._core import SoftArm
 from softarm.checks import FloatArray
 from softarm.sim.bush import PLUS_Y, Branch, Bush
 from softarm.sim.render.distortion import Distorter
-from softarm.sim.render.headroom import WINDOW_HEADROOM, dimmed
+from softarm.sim.render.headroom import dimmed, window_share
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.look import BushLook
 from softarm.sim.render.mjcf import (
@@ -132,8 +132,10 @@ class RenderedBush:
         )
         self.c2 = c2
         self.T_ee_cube = T_ee_cube
-        outline = panel_corners(make_body(marker_body, cube_marker)).reshape(-1, 3)
+        body = make_body(marker_body, cube_marker)
+        outline = panel_corners(body).reshape(-1, 3)
         self._cube_corners = outline
+        self._tag_normals = np.stack([T[:3, 2] for T in body.markers.values()])  # body frame
         # The leaves the body pushes: as far as the cube's, plus what the body reaches past it.
         cube_outline = panel_corners(make_body("cube", cube_marker)).reshape(-1, 3)
         self._cube_reach = CUBE_REACH + float(
@@ -214,13 +216,21 @@ class RenderedBush:
         side = WINDOW_STEP * int(np.ceil(2.0 * reach / WINDOW_STEP))
         w, h = self.stereo.left.image_size or (side, side)
         centre = (float(pixels[0, 0]), float(pixels[0, 1]))
-        return self.c1_left_window(centre, min(side, w, h))
+        share = 1.0  # the bush has no camera model: its render is delivered as drawn
+        if self.effects is not None:
+            normals = self._tag_normals @ T_base_cube[:3, :3].T
+            share = window_share(self.renderer.model, normals)
+        return self.c1_left_window(centre, min(side, w, h), share)
 
-    def c1_left_window(self, centre: tuple[float, float], side: int) -> ImageCrop:
+    def c1_left_window(
+        self, centre: tuple[float, float], side: int, share: float = 1.0
+    ) -> ImageCrop:
         """The ``side``-pixel square of C1's left eye around ``centre`` (px, clamped into
         the frame), with lens distortion, as an :class:`ImageCrop` that detectors read in
         full-frame coordinates. Only the pinhole pixels the window needs are rendered
-        (:meth:`BushRenderer.render_window`); they equal the full frame's."""
+        (:meth:`BushRenderer.render_window`); they equal the full frame's. ``share``:
+        the lights' strength it is drawn with, its camera's exposure scaled back
+        (:mod:`softarm.sim.render.headroom`)."""
         w, h = self.stereo.left.image_size or (0, 0)
         x0 = int(np.clip(round(centre[0] - side / 2), 0, max(w - side, 0)))
         y0 = int(np.clip(round(centre[1] - side / 2), 0, max(h - side, 0)))
@@ -233,9 +243,6 @@ class RenderedBush:
             return ImageCrop(
                 self.c1_left().colour[y0 : y0 + side, x0 : x0 + side], (x0, y0), (w, h)
             )
-        # In the row the window is drawn with headroom (softarm.sim.render.headroom): the
-        # sun would clip the marker's white at the render, before the camera meters it.
-        share = 1.0 if self.effects is None else WINDOW_HEADROOM
         with dimmed(self.renderer.model, share):
             pin = self.renderer.render_window("c1_left", (px0, py0), span)
         colour = cv2.remap(
