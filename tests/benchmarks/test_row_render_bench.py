@@ -2,8 +2,8 @@
 harvest's half scale) and a 184-pixel window of C1's left eye around the marker cube,
 the arm reaching for a berry, drawn with the small shadow map (the harvest's way) and
 with the full one, on the same world; and with the small map on the same row whose
-ground is drawn on MuJoCo's finest grid (200 x 200 quads, as it was before
-row_mjcf.GROUND_GRID)."""
+small renders draw the ground on MuJoCo's finest grid (200 x 200 quads, as before
+renderer.SMALL_RENDER_GROUND_GRID)."""
 
 from __future__ import annotations
 
@@ -20,12 +20,11 @@ SEED = 4
 WINDOW = 184
 
 
-def _row(ground_grid: float | None = None) -> Any:
-    """The row of SEED with the arm reaching for its first berry; ``ground_grid``: the
-    ground plane's grid pitch (m) instead of row_mjcf.GROUND_GRID."""
+def _row() -> Any:
+    """The row of SEED with the arm reaching for its first berry."""
     pytest.importorskip("mujoco")
     from softarm.harvest.rigs.sim.options import default_cameras
-    from softarm.sim.render import RenderUnavailableError, row_mjcf
+    from softarm.sim.render import RenderUnavailableError
     from softarm.sim.render.row_look import RowLook
     from softarm.sim.render.world import arm_sections, world_for
     from softarm.sim.rig_cameras import BASE_TAG_ID
@@ -33,14 +32,10 @@ def _row(ground_grid: float | None = None) -> Any:
     cams = default_cameras()
     arm = softarm.SoftArm.blackberry()
     bush = Bush.generate(arm, 6, SEED, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.3)
-    kept = row_mjcf.GROUND_GRID
-    row_mjcf.GROUND_GRID = kept if ground_grid is None else ground_grid
     try:
         world = world_for(bush, cams, BASE_TAG_ID, RowLook.named("overcast", SEED), 0.5)
     except RenderUnavailableError as exc:
         pytest.skip(str(exc))
-    finally:
-        row_mjcf.GROUND_GRID = kept
     q = np.asarray(bush.berries[0].q) * 0.9
     world.set_arm(arm_sections(arm, q), arm.forward(q))
     return world
@@ -55,7 +50,18 @@ def row() -> Iterator[Any]:
 
 @pytest.fixture(scope="module")
 def fine_ground_row() -> Iterator[Any]:
-    world = _row(ground_grid=0.1)
+    """The row whose small renders' context draws the ground on MuJoCo's finest grid
+    (the grid is made with the context: both are made here, then the setting restored)."""
+    from softarm.sim.render import renderer as module
+
+    world = _row()
+    kept = module.SMALL_RENDER_GROUND_GRID
+    module.SMALL_RENDER_GROUND_GRID = 0.1
+    try:
+        world.renderer.render("c2")
+        world.renderer.render_window("c1_left", _window_origin(world), WINDOW)
+    finally:
+        module.SMALL_RENDER_GROUND_GRID = kept
     yield world
     world.close()
 
