@@ -19,17 +19,13 @@ from softarm.experiments.fine_bias import (
 )
 from softarm.perception.approach import RayCrossing
 from softarm.perception.berries import BerryDetection
+from softarm.sim.rig_cameras import look_at
 from softarm.vision.camera_model import CameraModel
 
 
 def _look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    z = (target - eye) / np.linalg.norm(target - eye)
-    x = np.cross([0.0, 0.0, 1.0], z)
-    x /= np.linalg.norm(x)
-    T = np.eye(4)
-    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    T[:3, 3] = eye
-    return T
+    """A camera pose at ``eye`` looking at ``target``, image y along +z."""
+    return look_at(eye, target, up=(0.0, 0.0, -1.0))
 
 
 def test_two_rays_through_a_point_cross_at_it() -> None:

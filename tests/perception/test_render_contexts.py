@@ -11,8 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-import softarm
-from softarm.sim.bush import Bush
+from row_world import sunlit_row_world
 from softarm.sim.render.last_render import LastRender
 
 SIDES = (64, 128)
@@ -20,22 +19,7 @@ SIDES = (64, 128)
 
 @pytest.fixture(scope="module")
 def row() -> Iterator[Any]:
-    from softarm.harvest.rigs.sim.options import default_cameras
-    from softarm.sim.render import RenderUnavailableError
-    from softarm.sim.render.row_look import RowLook
-    from softarm.sim.render.world import arm_sections, world_for
-    from softarm.sim.rig_cameras import BASE_TAG_ID
-
-    pytest.importorskip("mujoco")
-    cams = default_cameras()
-    arm = softarm.SoftArm.blackberry()
-    bush = Bush.generate(arm, 6, 4, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
-    try:
-        world = world_for(bush, cams, BASE_TAG_ID, RowLook.named("sun", 4), 0.5)
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
-    q = np.asarray(bush.berries[0].q) * 0.9
-    world.set_arm(arm_sections(arm, q), arm.forward(q))
+    world = sunlit_row_world()
     yield world
     world.close()
 

@@ -11,8 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-import softarm
-from softarm.sim.bush import Bush
+from row_world import sunlit_row_world
 
 #: MuJoCo's most grid lines a side of a drawn plane (mjMAXPLANEGRID).
 MAX_PLANE_GRID = 200
@@ -26,32 +25,12 @@ def _quads_a_side(half_size: float, pitch: float) -> int:
     return n - n % 2 + 2
 
 
-def _row_world() -> Any:
-    from softarm.harvest.rigs.sim.options import default_cameras
-    from softarm.sim.render import RenderUnavailableError
-    from softarm.sim.render.row_look import RowLook
-    from softarm.sim.render.world import arm_sections, world_for
-    from softarm.sim.rig_cameras import BASE_TAG_ID
-
-    pytest.importorskip("mujoco")
-    cams = default_cameras()  # the harvest's: C2 at half scale, 320 x 240
-    arm = softarm.SoftArm.blackberry()
-    bush = Bush.generate(arm, 6, 4, view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4)
-    try:
-        world = world_for(bush, cams, BASE_TAG_ID, RowLook.named("sun", 4), 0.5)
-    except RenderUnavailableError as exc:
-        pytest.skip(str(exc))
-    q = np.asarray(bush.berries[0].q) * 0.9
-    world.set_arm(arm_sections(arm, q), arm.forward(q))
-    return world
-
-
 def test_small_renders_draw_a_few_quads_of_ground_and_whole_frames_the_finest() -> None:
     import mujoco
 
     from softarm.sim.render.shadow_map import LOCAL_SIZE
 
-    world = _row_world()
+    world = sunlit_row_world()
     renderer = world.renderer
     m = renderer.model
     ground = m.geom("bg_ground").id
@@ -88,14 +67,14 @@ def test_small_renders_are_those_of_the_finest_grid(monkeypatch: pytest.MonkeyPa
     from softarm.sim.render import renderer as module
 
     windows = ((560, 260), (900, 120))
-    coarse = _row_world()
+    coarse = sunlit_row_world()
     try:
         c2 = coarse.renderer.render("c2").colour
         small = [coarse.renderer.render_window("c1_left", o, 96) for o in windows]
     finally:
         coarse.close()
     monkeypatch.setattr(module, "SMALL_RENDER_GROUND_GRID", 0.1)  # read as a context is made
-    fine = _row_world()
+    fine = sunlit_row_world()
     try:
         np.testing.assert_array_equal(c2, fine.renderer.render("c2").colour)
         for origin, window in zip(windows, small, strict=True):

@@ -15,6 +15,7 @@ from softarm.perception.sight_lines import (
     crossing,
     sight_lines,
 )
+from softarm.sim.rig_cameras import look_at
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.stereo_camera import StereoCamera
 
@@ -25,21 +26,10 @@ C2 = CameraModel(K2, np.zeros(5), (640, 480))
 FRUIT = np.array([0.05, 0.40, 0.30])  # base frame
 
 
-def _look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """An OpenCV camera pose (z forward, y down) at ``eye`` looking at ``target``."""
-    z = (target - eye) / np.linalg.norm(target - eye)
-    x = np.cross([0.0, 0.0, -1.0], z)
-    x /= np.linalg.norm(x)
-    T = np.eye(4)
-    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    T[:3, 3] = eye
-    return T
-
-
 def _stereo() -> StereoCamera:
     T_left_right = np.eye(4)
     T_left_right[0, 3] = 0.12
-    return StereoCamera(C1, C1, _look_at(np.array([0.6, -0.5, 0.5]), FRUIT), T_left_right)
+    return StereoCamera(C1, C1, look_at(np.array([0.6, -0.5, 0.5]), FRUIT), T_left_right)
 
 
 def _det(center: tuple[float, float], radius: float, ripe: bool = True) -> BerryDetection:
@@ -64,7 +54,7 @@ def _line() -> SightLine:
 
 
 def _c2(eye: np.ndarray) -> np.ndarray:
-    return _look_at(eye, FRUIT + np.array([0.0, 0.0, 0.01]))
+    return look_at(eye, FRUIT + np.array([0.0, 0.0, 0.01]))
 
 
 def _distance_to_line(line: SightLine, point: np.ndarray) -> float:
@@ -103,7 +93,7 @@ def test_a_ray_that_misses_the_line_or_runs_along_it_gives_nothing() -> None:
     T = _c2(np.array([0.0, 0.15, 0.32]))
     beside = FRUIT + np.array([0.0, 0.0, 0.03])  # another fruit 3 cm off the line
     assert crossing(line, _det(_seen(T, C2, beside), 12.0), T, C2) is None
-    along = _look_at(line.origin - 0.2 * line.direction, FRUIT)  # C2 behind C1, in line
+    along = look_at(line.origin - 0.2 * line.direction, FRUIT)  # C2 behind C1, in line
     assert crossing(line, _det(_seen(along, C2, FRUIT), 12.0), along, C2) is None
 
 
