@@ -90,17 +90,7 @@ class Transport:
                 continue
             posed = seen.t
             err = float(np.linalg.norm(seen.pose[:3, 3] - goal_final[:3, 3]))
-            if (on_plan_end or near_ends) and err <= c.placement_tolerance:
-                return q
-            if near_ends and on_plan_end and self._passing(q):
-                self.link.log.event("waypoint_passed", t=seen.t, error=err)
-                return q
-            if on_plan_end and self._handover():
-                # The plan is done and the arm has caught up with it (lag model): what is
-                # left is the model's error, which the lag-bounded correction here takes
-                # out at a few per cent a period on a slow plant. The loop on the berry
-                # that follows takes it out at the predictor's full gain.
-                self.link.log.event("waypoint_handover", t=seen.t, error=err)
+            if self._arrived(seen.t, q, err, on_plan_end, near_ends):
                 return q
             if err < best - c.stall_progress:
                 best, best_t = err, seen.t
@@ -130,6 +120,26 @@ class Transport:
                 stage, seen, q_next, goal, (err, pointing_error(seen.pose, goal[:3, 2])), saturated
             )
             q = self.link.hold(q_next)  # goes on from what was sent
+
+    def _arrived(
+        self, t: float, q: FloatArray, err: float, on_plan_end: bool, near_ends: bool
+    ) -> bool:
+        """Whether :meth:`follow` ends at ``t`` with the cube ``err`` (m) from the model's
+        pose at the segment's end: within ``placement_tolerance`` (at the plan's end, or
+        anywhere with ``near_ends``), a waypoint of the way home passed, or handed over."""
+        if (on_plan_end or near_ends) and err <= self.link.cfg.placement_tolerance:
+            return True
+        if near_ends and on_plan_end and self._passing(q):
+            self.link.log.event("waypoint_passed", t=t, error=err)
+            return True
+        if on_plan_end and self._handover():
+            # The plan is done and the arm has caught up with it (lag model): what is
+            # left is the model's error, which the lag-bounded correction here takes
+            # out at a few per cent a period on a slow plant. The loop on the berry
+            # that follows takes it out at the predictor's full gain.
+            self.link.log.event("waypoint_handover", t=t, error=err)
+            return True
+        return False
 
     def _blind(
         self, watch: BerryWatch, stage: HarvestState, seen: Observation, q: FloatArray,
