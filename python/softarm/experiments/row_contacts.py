@@ -26,6 +26,7 @@ map and C1's own curves hold within ``MAPPED_MM``.
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from collections.abc import Iterator, Sequence
@@ -37,7 +38,6 @@ from typing import Any
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.errors import InputError
 from softarm.harvest.control.clearance import CANE_RADIUS, Clearance
 from softarm.harvest.rigs.sim import devices
 from softarm.perception.self_filter import CANE_REACH
@@ -330,25 +330,25 @@ def _plain(x: Any) -> Any:
     return str(x)
 
 
-def main(argv: list[str]) -> None:
+def main(argv: list[str] | None = None) -> int:
     """``SEED LOOK [--berries N] [--world row|bush] [--out FILE] [--report FILE]``: trace
     one harvest; the trace printed, and written to ``--out``."""
-    if len(argv) < 2:
-        raise InputError("usage: row_contacts SEED LOOK [--berries N] [--world row|bush] "
-                         "[--out FILE] [--report FILE]")  # fmt: skip
-    opts = dict(zip(argv[2::2], argv[3::2], strict=False))
-    for key in opts:
-        if key not in ("--berries", "--world", "--out", "--report"):
-            raise InputError(f"{key}: unknown option")
-    world = WorldName(opts.get("--world", "row"))
-    report = Path(opts["--report"]) if "--report" in opts else None
-    look = None if argv[1] == "-" else argv[1]
-    out = trace(int(argv[0]), look, int(opts.get("--berries", "4")), world, report)
+    p = argparse.ArgumentParser(prog="row_contacts", description=main.__doc__)
+    p.add_argument("seed", type=int)
+    p.add_argument("look", help="the row's look, or - for the world's default")
+    p.add_argument("--berries", type=int, default=4)
+    p.add_argument("--world", choices=[w.value for w in WorldName], default="row")
+    p.add_argument("--out", type=Path, help="also write the trace (JSON) to this file")
+    p.add_argument("--report", type=Path, help="write the harvest's report to this file")
+    args = p.parse_args(argv)
+    look = None if args.look == "-" else args.look
+    out = trace(args.seed, look, args.berries, WorldName(args.world), args.report)
     text = json.dumps(out, indent=1, default=_plain)
-    if "--out" in opts:
-        Path(opts["--out"]).write_text(text)
+    if args.out is not None:
+        args.out.write_text(text)
     print(text)
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())
