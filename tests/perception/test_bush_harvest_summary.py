@@ -3,6 +3,7 @@ coverage is pooled by each bush's cane length, the goal's measure."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -57,3 +58,13 @@ def test_the_maps_precision_is_their_mean_and_unknown_when_a_report_lacks_it() -
     both = [_report(1.0, 1.0, precision=0.8), _report(1.0, 1.0, precision=1.0)]
     assert summarise(both)["cane_precision"] == pytest.approx(0.9)
     assert np.isnan(summarise([*both, _report(1.0, 1.0)])["cane_precision"])
+
+
+def test_a_folder_without_reports_is_one_clear_error(tmp_path: Path) -> None:
+    from softarm.errors import InputError
+    from softarm.experiments.bush_harvest import main
+
+    with pytest.raises(InputError, match="no harvest reports"):
+        main([str(tmp_path)])
+    with pytest.raises(InputError, match="no harvest reports"):
+        main([str(tmp_path / "absent")])

@@ -130,7 +130,14 @@ def wall_per_berry(folder: Path) -> float:
 
 
 def _reports(folder: Path) -> list[dict[str, Any]]:
-    return [json.loads(p.read_text()) for p in sorted(folder.glob("r*.json"))]
+    """The harvest reports (``r*.json``) in ``folder``.
+
+    Raises:
+        InputError: ``folder`` holds none (or is not a folder)."""
+    paths = sorted(folder.glob("r*.json")) if folder.is_dir() else []
+    if not paths:
+        raise InputError(f"{folder}: no harvest reports (r*.json) there")
+    return [json.loads(p.read_text()) for p in paths]
 
 
 def run_pair(
@@ -184,6 +191,9 @@ def _option(argv: list[str], name: str, default: str | None) -> str | None:
 def main(argv: list[str]) -> None:
     """Print the pooled figures of each folder of reports on the command line (after
     making them, with ``--run``)."""
+    if not argv or argv[0] in ("-h", "--help"):
+        print(__doc__)
+        return
     if argv[:1] == ["--run"]:
         berries = int(_option(argv, "--berries", "8") or 8)
         jobs = int(_option(argv, "--jobs", "1") or 1)
@@ -211,4 +221,7 @@ def main(argv: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    try:
+        main(sys.argv[1:])
+    except InputError as exc:
+        sys.exit(f"bush_harvest: {exc}")
