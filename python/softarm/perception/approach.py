@@ -21,6 +21,7 @@ from softarm.checks import FloatArray, as_array, as_pose, positive
 from softarm.errors import ParameterError
 from softarm.perception._inputs import instance
 from softarm.perception.berries import BerryDetection
+from softarm.perception.two_lines import closest_params
 from softarm.vision.camera_model import CameraModel
 
 __all__ = ["DISPARITY_SPREAD_PX", "RayCrossing", "along_spread", "distance_from_size"]
@@ -29,8 +30,6 @@ __all__ = ["DISPARITY_SPREAD_PX", "RayCrossing", "along_spread", "distance_from_
 SIZE_RANGE = (0.6, 1.6)
 #: ...and its centre within the expected radius, or this many pixels, of the expected one.
 MIN_GATE_PX = 8.0
-#: Rays crossing at less than this angle (rad) leave the depth undetermined.
-MIN_CROSSING = np.radians(15.0)
 #: How far (px of C1's disparity) the stereo's match may miss: C2 looks for the berry
 #: along C1's ray as far as this many pixels of disparity move it. The placed berries'
 #: disparity error on the diagnosis rows 90120-90125 is 0.49 px median, 1.35 px p95;
@@ -112,13 +111,10 @@ class RayCrossing:
         x, y = camera.normalize(np.array([det.center]))[0]
         local = np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0])
         origin, ray = T_base_camera[:3, 3], T_base_camera[:3, :3] @ local
-        # Closest points of o1 + s u1 and o2 + t u2: the 2x2 normal equations.
-        w = origin - self.c1_centre
-        b = float(self.c1_ray @ ray)
-        if 1.0 - b * b < np.sin(MIN_CROSSING) ** 2:
+        params = closest_params(self.c1_centre, self.c1_ray, origin, ray)
+        if params is None:
             return None
-        t = (b * float(self.c1_ray @ w) - float(ray @ w)) / (1.0 - b * b)
-        result: FloatArray = local * t
+        result: FloatArray = local * params[1]
         return result
 
     def consistent(
@@ -148,12 +144,11 @@ class RayCrossing:
         parallel: then C2 cannot tell where along C1's ray the fruit is)."""
         x, y = camera.normalize(np.array([det.center]))[0]
         ray = T_base_camera[:3, :3] @ (np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0]))
-        w = T_base_camera[:3, 3] - self.position
-        b = float(self.c1_ray @ ray)
-        if self.along == 0.0 or 1.0 - b * b < np.sin(MIN_CROSSING) ** 2:
+        params = closest_params(self.position, self.c1_ray, T_base_camera[:3, 3], ray)
+        if self.along == 0.0 or params is None:
             return self.position
-        s = (float(self.c1_ray @ w) - b * float(ray @ w)) / (1.0 - b * b)
-        out: FloatArray = self.position + float(np.clip(s, -self.along, self.along)) * self.c1_ray
+        s = float(np.clip(params[0], -self.along, self.along))
+        out: FloatArray = self.position + s * self.c1_ray
         return out
 
 

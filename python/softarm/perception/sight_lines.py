@@ -21,6 +21,7 @@ import numpy as np
 from softarm.checks import FloatArray, as_pose
 from softarm.perception._inputs import instance
 from softarm.perception.berries import BerryDetection, ripe_by_votes
+from softarm.perception.two_lines import closest_params
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.stereo_camera import StereoCamera
 
@@ -28,8 +29,6 @@ __all__ = ["Placing", "SightLine", "crossing", "sight_lines"]
 
 #: The two rays must pass within this distance (m) of each other: about a fruit's radius.
 RAY_GAP = 0.008
-#: Rays crossing at less than this angle (rad) leave the depth undetermined.
-MIN_CROSSING = np.radians(15.0)
 #: A fruit's radius (m) along its outline: 1.5-2.5 cm across, with a margin either side.
 FRUIT_RADIUS = (0.0065, 0.016)
 #: Crossings that agree within this distance (m) are the same fruit...
@@ -90,7 +89,7 @@ def crossing(
 ) -> FloatArray | None:
     """Where the ray of ``camera`` (at ``T_base_camera``) through ``det`` crosses
     ``line`` (the midpoint of their closest points, base frame), or None: the rays pass
-    farther apart than RAY_GAP, cross at less than MIN_CROSSING, meet behind either
+    farther apart than RAY_GAP, cross at less than two_lines.MIN_CROSSING, meet behind either
     camera, or the fruit's size in either image does not fit a fruit there.
 
     Raises:
@@ -103,12 +102,10 @@ def crossing(
     local = np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0])
     o2, u2 = T_base_camera[:3, 3], T_base_camera[:3, :3] @ local
     o1, u1 = line.origin, line.direction
-    b = float(u1 @ u2)
-    if 1.0 - b * b < np.sin(MIN_CROSSING) ** 2:
+    params = closest_params(o1, u1, o2, u2)
+    if params is None:
         return None
-    w = o1 - o2
-    s = (b * float(u2 @ w) - float(u1 @ w)) / (1.0 - b * b)
-    t = (float(u2 @ w) - b * float(u1 @ w)) / (1.0 - b * b)
+    s, t = params
     p1, p2 = o1 + s * u1, o2 + t * u2
     if s <= 0.0 or t <= 0.0 or np.linalg.norm(p1 - p2) > RAY_GAP:
         return None
