@@ -222,6 +222,22 @@ def test_harvest_takes_a_look_for_the_row_only(capsys: pytest.CaptureFixture[str
         build_sim_rig(SimRigOptions(world="bush", look="sun"))
 
 
+def test_demo_takes_the_row_and_a_look_for_the_row_only(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``softarm demo --world row --look L`` parses as ``harvest`` does; a look without
+    the row, or one that does not exist, is one line naming ``--look`` and no output."""
+    out = tmp_path / "demo"
+    with pytest.raises(SystemExit) as exit_:
+        main(["demo", "--world", "row", "--look", "noon", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and err.count("\n") == 1 and "--look" in err
+    assert main(["demo", "--world", "bush", "--look", "sun", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--look" in err and "--world row" in err
+    assert not out.exists()
+
+
 def test_culled_renders_keep_the_shadows_of_what_is_out_of_the_picture(row: Any) -> None:
     """A window (and the frame) leaves out the geoms it cannot see, but not those whose
     shadows fall into it: the same pixels as with nothing left out."""

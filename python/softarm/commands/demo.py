@@ -5,9 +5,11 @@ from __future__ import annotations
 import argparse
 
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
+from softarm.commands._looks import LOOKS
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._worlds import world_metavar, world_type
 from softarm.commands.harvest import MAX_BERRIES
+from softarm.errors import ParameterError
 from softarm.sim.world import WorldName
 from softarm.stops import drives_arm
 
@@ -29,10 +31,16 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the bush and arm")
     p.add_argument(
-        "--world", type=world_type(WorldName.TAGS, WorldName.BUSH),
-        metavar=world_metavar(WorldName.TAGS, WorldName.BUSH), default=WorldName.TAGS,
+        "--world", type=world_type(*WorldName), metavar=world_metavar(*WorldName),
+        default=WorldName.TAGS,
         help="'tags' (default): tagged berries, mapped canes; 'bush': the markerless "
-        "harvest in the rendered bush (render extra), with harvest_c1.png, what C1 saw",
+        "harvest in the rendered bush (render extra), with harvest_c1.png, what C1 saw; "
+        "'row': the same bush inside a hedgerow in daylight (--look)",
+    )  # fmt: skip
+    p.add_argument(
+        "--look", choices=LOOKS, default=None,
+        help="--world row: the daylight family (default random: one of the four drawn "
+        "from the seed; docs/perception.md, 'The daylight row')",
     )  # fmt: skip
     add_plant_options(p, sim_only_flag=False)
     add_quiet(p)
@@ -44,12 +52,16 @@ def run(args: argparse.Namespace) -> int:
     """Harvest, print a line per berry and the summary, save the figures."""
     from softarm.commands.harvest import check_render, configure_logging, run_sim
 
+    if args.look is not None and args.world is not WorldName.ROW:
+        raise ParameterError("--look: for the rendered row (--world row)")
     options = plant_options(args)  # a bad --plant/--identified fails before any output
     check_render(args.world.rendered)  # so does a missing renderer
-    if args.world is WorldName.BUSH:
+    if args.world.rendered:
         from softarm.commands.harvest import BUSH_UNRIPE_FRACTION
 
-        options.update(world="bush", unripe_fraction=BUSH_UNRIPE_FRACTION)
+        options.update(world=args.world, unripe_fraction=BUSH_UNRIPE_FRACTION)
+    if args.world is WorldName.ROW:
+        options.update(look=args.look)
     configure_logging(args.quiet)
     args.out.mkdir(parents=True, exist_ok=True)
     log = args.out / "harvest_log.jsonl"
