@@ -1,7 +1,8 @@
 """The moves on a slow plant that is not the controller's model: placement and the
 back-out end on where the commands already sent put the arm (the lag model's motion in
-flight carried through the model), and the way home does not send the arm back to the
-plan's pre-grasp q once the back-out has it at the pre-grasp pose."""
+flight carried through the model; the back-out only once the arm is within 2 cm), and
+the way home does not send the arm back to the plan's pre-grasp q once the back-out has
+it at the pre-grasp pose."""
 
 from __future__ import annotations
 
@@ -159,6 +160,33 @@ def test_the_way_home_leaves_from_the_back_out_not_from_the_plans_pre_grasp_q() 
         q = servo.link.hold(q)
     way = _way_home(servo, watch, q, q_pre)
     assert len(way) == 1  # home alone
+
+
+def test_the_back_out_hands_over_ahead_of_the_arm_only_within_2_cm() -> None:
+    """The back-out ends on where the commands sent put the arm once the arm is measured
+    within 2 cm of the pre-grasp pose (``BACK_OUT_AHEAD_WITHIN``): the way home begins while the
+    arm is still farther than ``placement_tolerance`` out (before: 7 mm, once measured
+    within it three steps in a row), but never while it is farther than 2 cm (ended
+    ahead from anywhere, at 36 mm here: the way home cut the corner through the canes)."""
+    clock, plant, _, servo, watch, _ = _slow_rig()
+    config = servo.link.cfg
+    axis = np.array([0.0, 1.0, 0.0])
+    q_pre = (BERRIES[1] - (config.standoff + config.grasp_offset) * axis - P0) / K
+    grasp_q = (BERRIES[1] - config.grasp_offset * axis - P0) / (GAIN_ERROR * K)
+    q = servo.transport.ramp(watch, HarvestState.FINE_POSITIONING, np.zeros(3), grasp_q, 30.0)
+    while clock.now() < 8 * TAU + 30.0 * PERIOD:  # the arm at the grasp pose, settled
+        q = servo.link.hold(q)
+    handed: list[float] = []
+
+    def spy(watch, stage, q, way, start):  # type: ignore[no-untyped-def]
+        handed.append(_pre_grasp_error(plant, config))
+        return q
+
+    servo.transport.way_back = spy  # type: ignore[method-assign]
+    servo.go_home(
+        watch, HarvestState.RETURN_HOME, q, np.full(3, 0.0167), axis, (q_pre,), BERRIES[1]
+    )
+    assert config.placement_tolerance < handed[0] <= 0.02
 
 
 def test_a_back_out_that_did_not_settle_goes_home_by_the_plans_way() -> None:

@@ -84,9 +84,12 @@ class BerryLoop:
         the arm. On a slow plant the arm trails the loop's last command by seconds,
         most of it the regulators' lag with a channel near 0 or 70 psi: the loop's
         commands have stopped changing long before the measured pose is within the
-        tolerances. Without ``goal.ahead`` or a lag model, ``aim`` itself."""
+        tolerances. Without ``goal.ahead`` or a lag model, or with the arm measured
+        farther than ``goal.ahead_within`` from the goal, ``aim`` itself."""
         flight = self.link.actuator.in_flight()
         if not goal.ahead or flight is None or seen.pose is None:
+            return aim
+        if aim.error > goal.ahead_within:
             return aim
         sent = self.link.actuator.sent
         model_pose = self.link.controller.model_pose

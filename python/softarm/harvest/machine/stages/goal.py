@@ -24,12 +24,15 @@ class ServoGoal:
     UNREACHABLE; ``record_errors``: keep every step's errors at the grasp;
     ``placed_on_limit`` (placement): a saturated arm within ``tol`` hands over;
     ``frozen`` (the way back): the berry is this fixed point, held in the fingers;
-    ``ahead`` (placement): the stage ends on where the commands already sent put the
-    arm once it has caught up (the lag model's motion in flight carried through the
-    model), not on where it is measured now: the next stage goes on from there while
-    the arm is still on its way (docs/harvest.md, 'The moves'). Not the back-out: the
-    way home, begun with most of the back-out still in flight, cut the corner from
-    the approach line towards home, 6 mm from a cane (diagnosis seed 1347)."""
+    ``ahead`` (placement, the back-out): the stage ends on where the commands already
+    sent put the arm once it has caught up (the lag model's motion in flight carried
+    through the model), not on where it is measured now: the next stage goes on from
+    there while the arm is still on its way (docs/harvest.md, 'The moves');
+    ``ahead_within`` (m): only once the arm is also measured this near the goal. The
+    back-out's: the way home, begun with most of the back-out still in flight, cut the
+    corner from the approach line towards home, 6 mm from a cane (diagnosis seed 1347);
+    begun within 2 cm of the pre-grasp pose, the corner it cuts is inside the last 2 cm
+    of the approach line, which is clear of the canes."""
 
     distance: float
     tol: float
@@ -40,6 +43,7 @@ class ServoGoal:
     placed_on_limit: bool = False
     frozen: FloatArray | None = None
     ahead: bool = False
+    ahead_within: float = float("inf")
 
 
 @dataclass(frozen=True)

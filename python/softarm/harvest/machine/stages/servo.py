@@ -25,7 +25,14 @@ from softarm.harvest.machine.states import FaultReason, HarvestState
 from softarm.harvest.records.log import HarvestLog
 from softarm.harvest_config import HarvestConfig
 
-__all__ = ["Fault", "Servo"]
+__all__ = ["BACK_OUT_AHEAD_WITHIN", "Fault", "Servo"]
+
+#: How near (m) the pre-grasp pose the back-out must measure the arm before it may end on
+#: where the commands already sent put it (:class:`ServoGoal` ``ahead_within``): the way
+#: home then starts while the arm is still on the approach line's last 2 cm, which the
+#: plan checked clear of the canes. Ended ahead from farther out, the way home cut the
+#: corner from the approach line to 5.4 mm from a cane (fresh seed 1356).
+BACK_OUT_AHEAD_WITHIN = 0.02
 
 
 class Servo:
@@ -151,21 +158,25 @@ class Servo:
     ) -> FloatArray:
         """RETURN_HOME: back out to the pre-grasp pose (the approach line is free of
         branches) of the ``berry`` last seen, along ``axis``, ramp back through the
-        placement plan's ``waypoints``, then to ``home``."""
+        placement plan's ``waypoints``, then to ``home``. Within
+        ``BACK_OUT_AHEAD_WITHIN`` of the pre-grasp pose the back-out ends on where the
+        commands sent put the arm, as placement does."""
         c = self.link.cfg
         start = self.link.clock.now()
         try:
             back_out = ServoGoal(
                 c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2,
-                record_errors=False, frozen=berry,
+                record_errors=False, frozen=berry, ahead=True,
+                ahead_within=BACK_OUT_AHEAD_WITHIN,
             )  # fmt: skip
             backed = self.berry_loop.run(watch, stage, q, axis, back_out)
             q = backed.q
             if backed.ending is Ending.SETTLED and waypoints:
                 # The back-out has the arm at the pre-grasp pose, the plan's last
-                # waypoint, measured on the berry: the way home starts at the leg after
-                # it. Sent back to the plan's q there first, the arm moved by the
-                # model's error (1-4 cm on a slow plant) and waited to arrive.
+                # waypoint, measured on the berry (or within 2 cm of it with the commands
+                # sent putting it there): the way home starts at the leg after it. Sent
+                # back to the plan's q there first, the arm moved by the model's error
+                # (1-4 cm on a slow plant) and waited to arrive.
                 waypoints = waypoints[:-1]
         except Fault as fault:
             # Backing out is best effort: the berry is already in the fingers (or the
