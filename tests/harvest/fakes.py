@@ -118,7 +118,7 @@ class FakeVision:
     def select(self, berry: BerryTarget) -> None:
         self.locator.select(berry)
 
-    def observe(self, time: float) -> Observation:
+    def observe(self, time: float, need_fix: bool = True) -> Observation:
         pose = self.tracker.track(time)
         return Observation(time, pose, self.locator.locate(time, pose))
 

@@ -41,7 +41,7 @@ class _Blank:
     def select(self, berry: BerryTarget) -> None:
         pass
 
-    def observe(self, time: float) -> Observation:
+    def observe(self, time: float, need_fix: bool = True) -> Observation:
         return Observation(time, None, None)
 
 
@@ -63,7 +63,7 @@ def test_marker_loss_counts_from_the_last_restart() -> None:
 class _CubeOnly(_Blank):
     """Sees the cube, never the berry."""
 
-    def observe(self, time: float) -> Observation:
+    def observe(self, time: float, need_fix: bool = True) -> Observation:
         return Observation(time, np.eye(4), None)
 
 

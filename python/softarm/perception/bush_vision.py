@@ -5,7 +5,9 @@ is near (eq. 21): C2 finds the berry without a tag in each frame, and the berry 
 C2's ray to it crosses C1's (:class:`~softarm.perception.approach.RayCrossing`). While
 the map holds ripe fruit C1 found but could not place, C2 is also read every
 PLACING_EVERY periods wherever the arm is, and a fruit it sees on one of their sight
-lines is placed (:mod:`softarm.perception.sight_lines`)."""
+lines is placed (:mod:`softarm.perception.sight_lines`). A period whose fix the harvest
+throws away (the back-out, the moves between berries) reads C2 only for that placing:
+up close, C2's frames are the costliest part of a period in the rendered row."""
 
 from __future__ import annotations
 
@@ -52,6 +54,7 @@ class BushVision(CameraVision):
         self._track: RayCrossing | None = None
         self._near = False  # the grasp point within C2_RANGE of the selected berry
         self._period = 0
+        self._for_fix = False  # this period's C2 frame would serve the fix
 
     def select(self, berry: BerryTarget) -> None:
         """Track the map's berry ``berry.tag_id``; its C2 sightings start afresh."""
@@ -84,15 +87,22 @@ class BushVision(CameraVision):
         p = self._mapped()
         return None if p is None else (invert(self.T_base_c1) @ np.append(p, 1.0))[:3]
 
-    def _want_c2(self, T_c1_ee: FloatArray | None) -> bool:
-        self._period += 1
+    def _want_c2(self, T_c1_ee: FloatArray | None, need_fix: bool) -> bool:
+        """Near the berry for the fix (if ``need_fix``), or every PLACING_EVERY periods
+        while fruit waits to be placed: the map's placing goes on whatever the fix."""
+        self._period += 1  # counted every period: the placing's rhythm is the clock's
+        self._for_fix = False
         p = self._mapped()
         if T_c1_ee is None:
             return False
         grasp = (self.T_base_c1 @ T_c1_ee @ self._grasp)[:3]
         self._near = p is not None and float(np.linalg.norm(grasp - p)) < C2_RANGE
         placing = bool(self.bush_map.unplaced) and self._period % PLACING_EVERY == 0
-        return self._near or placing
+        self._for_fix = self._near and not placing
+        return (self._near and need_fix) or placing
+
+    def _want_c2_for_fix(self) -> bool:
+        return self._for_fix
 
     def _berry_c2(self, image: Any, T_c1_ee: FloatArray | None) -> FloatArray | None:
         track = self._track

@@ -62,6 +62,10 @@ class Vision(Protocol):
         """Track ``berry`` from now on, forgetting any held fix."""
         ...
 
-    def observe(self, time: float) -> Observation:
-        """The end-effector pose and the berry at ``time``."""
+    def observe(self, time: float, need_fix: bool = True) -> Observation:
+        """The end-effector pose and the berry at ``time``. Without ``need_fix`` the
+        caller throws the berry fix away (the back-out holds the berry frozen, the moves
+        between berries need none): the vision then spends nothing on finding the berry
+        up close (C2 is neither rendered nor read for it); the fix it still gives (C1's,
+        or the held one) is what it has without that."""
         ...

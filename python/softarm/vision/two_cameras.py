@@ -5,9 +5,11 @@ first berry position; the eye-in-hand camera C2 gives the berry close up, carrie
 base frame through the tracked end-effector pose (eq. 21). :class:`CameraFusion` picks
 the source: C1 until the grasp point is within 6 cm of the berry, C2 after, the most
 recent fix while the berry is hidden (section III-D, fig. 4). Implements
-:class:`~softarm.harvest.machine.interfaces.Vision`: one :meth:`CameraVision.observe` per control
-step reads both cameras. (In the vision layer, so that identification and calibration
-track the cube without the harvest.)
+:class:`~softarm.harvest.machine.interfaces.Vision`: one :meth:`CameraVision.observe` per
+control step reads C1, and C2 where the berry fix is needed (a period whose fix the
+harvest throws away reads no C2 frame: the back-out, the moves between berries). (In the
+vision layer, so that identification and calibration track the cube without the
+harvest.)
 """
 
 from __future__ import annotations
@@ -76,6 +78,11 @@ class CameraVision:
             dropped, unless ``max_rejects`` in a row agree it is real.
         max_speed: the fastest (m/s) the end effector is believed to move (the gate's
             velocity is bounded by it).
+        c2_unneeded: told the time of each period whose C2 frame is not taken because
+            the fix is not needed (:meth:`observe` without ``need_fix``), where it would
+            have been taken with it: the simulated row numbers its C2 frames (each
+            frame's noise is seeded by its number) and gives that number away, so that
+            the frames still read are the ones a run reading every frame sees.
     """
 
     def __init__(
@@ -94,6 +101,7 @@ class CameraVision:
         max_jump: float = 0.03,
         max_rejects: int = 3,
         max_speed: float = 2.0,
+        c2_unneeded: Callable[[float], None] | None = None,
     ) -> None:
         self.frame1, self.frame2 = frame1, frame2
         self.model1, self.model2 = model1, model2
@@ -106,17 +114,22 @@ class CameraVision:
         self.selected = BerryTarget(-1)
         self._cube_prev: FloatArray | None = None
         self.gate = PoseGate(max_jump, max_rejects, max_speed)
+        self.c2_unneeded = c2_unneeded
+        #: C2 frames taken by :meth:`observe` (read from the camera, dropped ones too).
+        self.c2_frames = 0
 
     def select(self, berry: BerryTarget) -> None:
         """Track ``berry`` from now on (the fusion forgets any held target)."""
         self.selected = berry
         self.fusion.reset()
 
-    def observe(self, time: float) -> Observation:
+    def observe(self, time: float, need_fix: bool = True) -> Observation:
         """Both cameras at ``time``: ``T_base_ee`` from the cube in C1 (eq. 22), and the
-        berry from the fusion of C1 and C2 (eq. 21), or the held fix."""
+        berry from the fusion of C1 and C2 (eq. 21), or the held fix. Without
+        ``need_fix`` C2 is taken only where something other than the fix wants it
+        (:meth:`_want_c2`); the fusion then goes on from C1 and the held fix."""
         T_c1_ee, berry_c1 = self._view_c1(time)
-        img = self.frame2(time) if self._want_c2(T_c1_ee) else None
+        img = self._take_c2(time, T_c1_ee, need_fix)
         berry_c2 = None if img is None else self._berry_c2(img, T_c1_ee)
         est = self.fusion.update(time, T_c1_ee, berry_c1, berry_c2)
         fix = None
@@ -167,8 +180,24 @@ class CameraVision:
         self._cube_prev = est.T_camera_cube
         return T_c1_ee, berry_c1
 
-    def _want_c2(self, T_c1_ee: FloatArray | None) -> bool:
-        """Whether to read C2 this period (always, for tags: they are cheap to find)."""
+    def _take_c2(self, time: float, T_c1_ee: FloatArray | None, need_fix: bool) -> Any:
+        """C2's frame at ``time`` if this period wants one, else None (nothing read)."""
+        wanted = self._want_c2(T_c1_ee, need_fix)
+        if wanted:
+            self.c2_frames += 1
+            return self.frame2(time)
+        if self.c2_unneeded is not None and not need_fix and self._want_c2_for_fix():
+            self.c2_unneeded(time)
+        return None
+
+    def _want_c2(self, T_c1_ee: FloatArray | None, need_fix: bool) -> bool:
+        """Whether to read C2 this period: where the fix is needed (every such period,
+        for tags: they are cheap to find). Called once a period."""
+        return need_fix
+
+    def _want_c2_for_fix(self) -> bool:
+        """Whether this period's C2 frame would have been read were the fix needed
+        (after :meth:`_want_c2` this period)."""
         return True
 
     def _berry_c1(self, dets: list[Detection]) -> FloatArray | None:

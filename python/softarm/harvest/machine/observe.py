@@ -68,14 +68,16 @@ class BerryWatch:
 
     def observe(self, need_fix: bool = True) -> Observation:
         """Read the vision now; check for NaN and for markers lost too long (the berry
-        only if ``need_fix``).
+        only if ``need_fix``). Without ``need_fix`` the vision is told so and spends
+        nothing on the berry up close (no C2 frame for it); the fix it gives then, C1's
+        or the held one, is counted in :attr:`cameras` as any other.
 
         Raises:
             NonFiniteError: a pose or berry position is not finite.
             Fault: MARKER_LOST.
         """
         t = self.clock.now()
-        seen = self.vision.observe(t)
+        seen = self.vision.observe(t, need_fix)
         pose, fix = seen.pose, seen.fix
         if pose is not None:
             pose = np.asarray(pose, dtype=np.float64)

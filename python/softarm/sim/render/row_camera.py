@@ -52,6 +52,18 @@ class RowCameras:
         self._count = dict.fromkeys(_CAMERAS, 0)
         self._exposure: float | None = None
 
+    def skip(self, camera: str) -> None:
+        """A frame of ``camera`` the rig did not take (the harvest needed no C2 fix that
+        period): its number is used up, so that the frames taken after it keep the
+        numbers, and so the noise, they have in a run that takes every frame.
+
+        Raises:
+            ParameterError: ``camera`` is none of c1_left, c1_right, c2, c1_window.
+        """
+        if camera not in self._count:
+            raise ParameterError(f"camera must be one of {', '.join(_CAMERAS)}, got {camera!r}")
+        self._count[camera] += 1
+
     def _rng(self, camera: str) -> np.random.Generator:
         self._count[camera] += 1
         return np.random.default_rng([self.look.seed, _CAMERAS.index(camera), self._count[camera]])

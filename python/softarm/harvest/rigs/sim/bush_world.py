@@ -131,6 +131,12 @@ class BushScene:
 
         return c1, c2
 
+    def c2_unneeded(self, t: float) -> None:
+        """C2's frame at ``t`` not taken (no fix needed): the row's camera model gives
+        its number away (:meth:`~softarm.sim.render.row_camera.RowCameras.skip`)."""
+        if self.world.effects is not None:
+            self.world.effects.skip("c2")
+
     def c1_whole(self, t: float) -> np.ndarray:
         """C1's whole left image with the arm as it is (registration finds the base tag
         in it)."""

@@ -182,5 +182,5 @@ def _bush_vision(
     cube = marker_body(cams.marker_body, cams.cube_marker)
     return BushVision(
         c1, c2, m1, m2, T_base_c1, cams.T_ee_c2, cams.T_ee_cube, cube, cams.berry_tag,
-        grasp_offset, bush_map=scene.bush_map,
+        grasp_offset, bush_map=scene.bush_map, c2_unneeded=scene.c2_unneeded,
     )  # fmt: skip
