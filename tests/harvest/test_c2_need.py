@@ -57,7 +57,7 @@ def _vision(c2: _Frames, skipped: list[float], cls: Any = CameraVision, **kw: An
 
 
 def test_the_tags_vision_reads_c2_only_where_the_fix_is_needed() -> None:
-    c2, skipped = _Frames(), []
+    c2, skipped = _Frames(), list[float]()
     vision = _vision(c2, skipped)
     vision.observe(0.0)
     vision.observe(0.05, need_fix=False)
@@ -68,7 +68,7 @@ def test_the_tags_vision_reads_c2_only_where_the_fix_is_needed() -> None:
 
 
 def test_the_watch_tells_the_vision_whether_the_fix_is_needed() -> None:
-    c2, skipped = _Frames(), []
+    c2, skipped = _Frames(), list[float]()
     clock = FakeClock()
     watch = BerryWatch(_vision(c2, skipped), clock, BerryTarget(1), HarvestLog(), 10.0)
     watch.observe(need_fix=False)
@@ -84,12 +84,12 @@ def _bush_vision(c2: _Frames, skipped: list[float], unplaced: bool) -> BushVisio
     vision: BushVision = _vision(c2, skipped, BushVision, bush_map=bush_map)
     vision.select(BerryTarget(7))
     # The cube seen at the origin each period (C1's marker detection is not the test's).
-    vision._view_c1 = lambda t: (np.eye(4), None)  # type: ignore[method-assign]
+    vision._view_c1 = lambda t: (np.eye(4), None)  # type: ignore[method-assign,assignment]
     return vision
 
 
 def test_the_markerless_vision_reads_no_c2_for_a_fix_thrown_away() -> None:
-    c2, skipped = _Frames(), []
+    c2, skipped = _Frames(), list[float]()
     vision = _bush_vision(c2, skipped, unplaced=False)
     times = [0.05 * k for k in range(10)]
     for t in times[:5]:
@@ -103,7 +103,7 @@ def test_the_markerless_vision_reads_no_c2_for_a_fix_thrown_away() -> None:
 def test_the_maps_placing_keeps_its_rhythm_whatever_the_fix() -> None:
     """With fruit waiting to be placed C2 is read every PLACING_EVERY periods, needed
     fix or not; only the frames the fix alone wanted are given away."""
-    c2, skipped = _Frames(), []
+    c2, skipped = _Frames(), list[float]()
     vision = _bush_vision(c2, skipped, unplaced=True)
     times = [0.05 * k for k in range(1, 2 * PLACING_EVERY + 1)]
     for t in times:
