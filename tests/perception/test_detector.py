@@ -27,7 +27,7 @@ from softarm.perception.detector.learned import LearnedDetector
 from softarm.perception.detector.network import (
     CLASSES,
     DEFAULT_WEIGHTS,
-    MAX_SIDE,
+    RUN_SIDE,
     Network,
     NetworkOutput,
 )
@@ -81,10 +81,23 @@ def test_a_truncated_copy_of_the_shipped_weights_is_refused(tmp_path: Path) -> N
 def test_the_network_gives_one_probability_per_class_at_its_resolution() -> None:
     net = Network()
     out = net.run(np.zeros((720, 1280, 3), np.uint8))
-    assert out.probabilities.shape == (MAX_SIDE * 720 // 1280, MAX_SIDE, len(CLASSES))
+    assert out.probabilities.shape == (RUN_SIDE * 720 // 1280, RUN_SIDE, len(CLASSES))
     np.testing.assert_allclose(out.probabilities.sum(axis=2), 1.0, atol=1e-4)
-    assert out.size == (1280, 720) and out.scale == 2.0
+    assert out.size == (1280, 720) and out.scale == 1280 / RUN_SIDE
     assert out.upsample(out.centres).shape == (720, 1280)
+
+
+def test_a_network_runs_at_the_longest_side_it_is_given() -> None:
+    out = LearnedDetector(max_side=320).output(np.zeros((720, 1280, 3), np.uint8))
+    assert out.probabilities.shape[:2] == (180, 320) and out.scale == 4.0
+    small = Network(max_side=2048).run(np.zeros((120, 160, 3), np.uint8))
+    assert small.probabilities.shape[:2] == (120, 160)  # never enlarged
+
+
+@pytest.mark.parametrize("side", [0, 7, -640, 640.0, True, "640"])
+def test_a_bad_longest_side_is_an_input_error_naming_it(side: object) -> None:
+    with pytest.raises(InputError, match="max_side"):
+        Network(max_side=side)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(
@@ -160,7 +173,8 @@ def test_detect_prints_and_draws_a_picture(
     assert main(["detect", str(image), "--out", str(out), "--detector", "colour"]) == 0
     text = capsys.readouterr().out
     assert "detect: 2 berries (1 ripe, 0 turning, 1 unripe) by colour" in text
-    assert cv2.imread(str(out)).shape == (H, W, 3)
+    drawn = cv2.imread(str(out))
+    assert drawn is not None and drawn.shape == (H, W, 3)
     assert main(["detect", str(image), "--detector", "net"]) == 0
 
 

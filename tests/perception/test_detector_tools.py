@@ -18,7 +18,6 @@ import pytest
 from detector_scenes import H, W, disc, draw, training_scenes, write_folder
 
 from softarm.cli import main
-from softarm.perception.detector import train as train_module
 from softarm.perception.detector.choice import detector
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.labels import _decode_counts, read_coco, stage_of
@@ -160,8 +159,9 @@ def test_train_without_the_extra_is_one_line_naming_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     real = importlib.util.find_spec
+    # train's require_train_extra looks the modules up through importlib.util.find_spec.
     monkeypatch.setattr(
-        train_module.importlib.util, "find_spec", lambda n, *a: None if n == "jax" else real(n, *a)
+        importlib.util, "find_spec", lambda n, *a: None if n == "jax" else real(n, *a)
     )
     out = tmp_path / "w.onnx"
     assert main(["detector", "train", "--data", str(tmp_path), "--out", str(out)]) == 2
@@ -216,6 +216,52 @@ def test_onnx_export_round_trips_the_parameters(tmp_path: Path) -> None:
 
 
 @NEEDS_JAX
+def test_a_network_of_other_widths_round_trips_and_bad_widths_are_refused(
+    tmp_path: Path,
+) -> None:
+    done = _in_child(
+        """
+        import sys
+        import numpy as np
+        from softarm.errors import InputError
+        from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
+        from softarm.perception.detector.train.unet import init_params, layers, widths_of
+
+        params = init_params(3, (4, 6, 8, 10))
+        export_onnx(params, sys.argv[1])
+        back = params_from_onnx(sys.argv[1])
+        assert widths_of(back) == (4, 6, 8, 10), widths_of(back)
+        np.testing.assert_array_equal(np.asarray(back["dec3"][0]), np.asarray(params["dec3"][0]))
+        for bad in [(8, 16, 24), (8, 16, 0, 32), (8, 16, 24.0, 32)]:
+            try:
+                layers(bad)
+            except InputError as exc:
+                assert "widths" in str(exc)
+            else:
+                raise AssertionError(bad)
+        """,
+        str(tmp_path / "w.onnx"),
+    )
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize(
+    ("option", "value"),
+    [("--widths", "8,16,24"), ("--widths", "8,16,0,32"), ("--widths", "8,a,24,32"),
+     ("--scale", "1.0"), ("--scale", "0,2"), ("--scale", "1,nan")],
+)  # fmt: skip
+def test_bad_widths_or_scale_are_one_usage_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str
+) -> None:
+    args = ["detector", "train", "--data", str(tmp_path), "--out", str(tmp_path / "w.onnx")]
+    with pytest.raises(SystemExit) as exit_info:
+        main([*args, option, value])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert option in err[-1] and value in err[-1] and "Traceback" not in "".join(err)
+
+
+@NEEDS_JAX
 def test_crops_are_the_same_for_the_same_seed(tmp_path: Path) -> None:
     write_folder(tmp_path, training_scenes(3, seed=1))
     done = _in_child(
@@ -247,16 +293,28 @@ def test_train_end_to_end_on_a_tiny_dataset(tmp_path: Path) -> None:
     write_folder(data, training_scenes(6, seed=2))
     out = tmp_path / "w.onnx"
     args = ["detector", "train", "--data", str(data), "--out", str(out), "--epochs", "1"]
-    done = _softarm(*args, "--seed", "3", "-q")
+    done = _softarm(*args, "--seed", "3", "--widths", "4,6,8,10", "--scale", "1,2", "-q")
     assert done.returncode == 0, done.stderr
     assert "detector train: 1 epochs" in done.stdout
     record = json.loads(out.with_suffix(".json").read_text())
     assert record["epochs"] == 1 and record["seed"] == 3 and len(record["losses"]) == 1
+    assert record["widths"] == [4, 6, 8, 10] and record["scale"] == [1.0, 2.0]
     assert np.isfinite(record["losses"][0])
     dets = LearnedDetector(out).detect_berries(
         np.zeros((H, W, 3), np.uint8), CameraModel.ideal(100.0, W, H)
     )
     assert isinstance(dets, list)
+
+
+@NEEDS_JAX
+def test_widths_with_a_network_to_fine_tune_are_one_line(tmp_path: Path) -> None:
+    data = tmp_path / "data"
+    write_folder(data, training_scenes(1, seed=2))
+    args = ["detector", "train", "--data", str(data), "--out", str(tmp_path / "w.onnx")]
+    done = _softarm(*args, "--from", "default", "--widths", "8,16,24,32")
+    assert done.returncode == 2
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and "widths" in err[0]
 
 
 @NEEDS_JAX

@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from softarm.commands._args import add_quiet, int_range, output_dir, output_file
 
@@ -65,11 +68,38 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
     t.add_argument("--epochs", type=int_range(1, MAX_EPOCHS), default=150, help="epochs")
     t.add_argument("--seed", type=int_range(0, 2**31 - 1), default=0, help="seed")
     t.add_argument(
+        "--widths", type=_numbers(int, 4), metavar="C1,C2,C3,C4",
+        help="a fresh network's channels at full, 1/2, 1/4 and 1/8 resolution (default 8,16,24,32)",
+    )  # fmt: skip
+    t.add_argument(
+        "--scale", type=_numbers(float, 2), metavar="LOW,HIGH",
+        help="range of the augmentation's scale factor (default 0.6,1.7); shift it up for a "
+        "network run on images larger than its training renders",
+    )  # fmt: skip
+    t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",
         help="start from these weights ('default': the shipped ones) instead of fresh ones",
     )  # fmt: skip
     add_quiet(t)
     t.set_defaults(run=run_train)
+
+
+def _numbers(kind: type[int] | type[float], count: int) -> Callable[[str], tuple[Any, ...]]:
+    """A ``type=`` accepting ``count`` positive comma-separated numbers of ``kind``."""
+
+    def parse(text: str) -> tuple[Any, ...]:
+        try:
+            values = tuple(kind(v) for v in text.split(","))
+        except ValueError:
+            values = ()
+        if len(values) != count or not all(math.isfinite(v) and v > 0 for v in values):
+            raise argparse.ArgumentTypeError(
+                f"must be {count} positive {kind.__name__}s separated by commas, got {text!r}"
+            )
+        return values
+
+    parse.__name__ = f"{count} {kind.__name__}s"
+    return parse
 
 
 def run_evaluate(args: argparse.Namespace) -> int:
@@ -104,7 +134,9 @@ def run_train(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(f"epoch {epoch}/{args.epochs}: loss {loss:.4f} ({seconds:.1f} s)", flush=True)
 
-    record = train(args.data, args.out, args.epochs, args.seed, start, on_epoch)
+    record = train(
+        args.data, args.out, args.epochs, args.seed, start, on_epoch, args.widths, args.scale
+    )
     print(
         f"detector train: {args.epochs} epochs in {record['seconds']} s on "
         f"{record['device']} -> {args.out} (record {Path(args.out).with_suffix('.json')})"

@@ -1,6 +1,7 @@
 """The berry detectors side by side, per condition: every detector of
-:data:`~softarm.perception.detector.choice.DETECTORS` (and optionally a network file of
-one's own) on each labelled folder (``softarm dataset`` output), and ``colour+depth`` and
+:data:`~softarm.perception.detector.choice.DETECTORS` (and optionally a candidate
+network file, ``--weights``, scored as ``cand`` beside the shipped one) on each
+labelled folder (``softarm dataset`` output), and ``colour+depth`` and
 ``net+colour+depth``, the same detectors given the folder's depth images (``depth/``),
 scored as ``softarm detector evaluate`` scores; the figures written as JSON
 (docs/data/detector_eval.json) and printed as the table of docs/perception.md ("The
@@ -26,8 +27,9 @@ import numpy as np
 from softarm.perception.detector.choice import DETECTORS, BerryDetector, detector
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
+from softarm.perception.detector.network import RUN_SIDE
 
-__all__ = ["WITH_DEPTH", "candidates", "main", "table"]
+__all__ = ["CANDIDATE", "WITH_DEPTH", "candidates", "main", "table"]
 
 _SHOWN = ("precision", "ripe_precision", "recall_ripe", "recall", "stage_right")
 
@@ -54,35 +56,41 @@ class _Timed:
 #: The candidates: each detector of the harvest's choice on the colour image alone, and
 #: two of them with the frame's depth as a check (:mod:`~softarm.perception.detector.depth_check`).
 WITH_DEPTH = ("colour", "net+colour")
+#: The prefix of a candidate network's rows (``--weights``), scored beside the shipped one.
+CANDIDATE = "cand"
 
 
-def _detectors(weights: Path | None) -> dict[str, BerryDetector]:
-    if weights is None:
-        return {name: detector(name) for name in DETECTORS}
-    return {
-        "colour": detector("colour"),
-        "net": LearnedDetector(weights),
-        "net+colour": ConfirmedDetector(weights),
-    }
+def _detectors(weights: Path | None, max_side: int) -> dict[str, BerryDetector]:
+    dets = {name: detector(name) for name in DETECTORS}
+    if weights is not None:
+        dets[CANDIDATE] = LearnedDetector(weights, max_side)
+        dets[f"{CANDIDATE}+colour"] = ConfirmedDetector(weights, max_side)
+    return dets
 
 
-def candidates(weights: Path | None = None) -> dict[str, tuple[BerryDetector, bool]]:
+def candidates(
+    weights: Path | None = None, max_side: int = RUN_SIDE
+) -> dict[str, tuple[BerryDetector, bool]]:
     """{name: (detector, given depth)}: every detector without depth, then
-    ``colour+depth`` and ``net+colour+depth``."""
-    dets = _detectors(weights)
+    ``colour+depth`` and ``net+colour+depth``; with ``weights``, that network (run at
+    ``max_side``) as ``cand`` and ``cand+colour``, and ``cand+colour+depth``."""
+    dets = _detectors(weights, max_side)
     out = {name: (det, False) for name, det in dets.items()}
-    out.update({f"{name}+depth": (dets[name], True) for name in WITH_DEPTH})
+    with_depth = (*WITH_DEPTH, f"{CANDIDATE}+colour") if weights is not None else WITH_DEPTH
+    out.update({f"{name}+depth": (dets[name], True) for name in with_depth})
     return out
 
 
-def run(conditions: dict[str, Path], weights: Path | None = None) -> dict[str, Any]:
+def run(
+    conditions: dict[str, Path], weights: Path | None = None, max_side: int = RUN_SIDE
+) -> dict[str, Any]:
     """{condition: {candidate: figures}} with ``ms_per_image``; a ``+depth`` candidate
     reads each folder's ``depth/``."""
     cv2.setNumThreads(1)
     out: dict[str, Any] = {}
     for name, folder in conditions.items():
         out[name] = {}
-        for cand, (det, with_depth) in candidates(weights).items():
+        for cand, (det, with_depth) in candidates(weights, max_side).items():
             timed = _Timed(det)
             depth = folder / "depth" if with_depth else None
             figures = evaluate(timed, folder / "annotations.json", folder, depth)
@@ -114,10 +122,17 @@ def table(results: dict[str, Any]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    """python -m softarm.experiments.detector_eval NAME=FOLDER ... [--weights W] [--out F]."""
+    """python -m softarm.experiments.detector_eval NAME=FOLDER ... [--weights W
+    [--max-side N]] [--out F]."""
     p = argparse.ArgumentParser(prog="python -m softarm.experiments.detector_eval")
     p.add_argument("conditions", nargs="+", help="NAME=FOLDER (softarm dataset output)")
-    p.add_argument("--weights", type=Path, help="the network to score (default: shipped)")
+    p.add_argument(
+        "--weights", type=Path, help="a candidate network, scored beside the shipped one"
+    )
+    p.add_argument(
+        "--max-side", type=int, default=RUN_SIDE,
+        help=f"longer side (px) the candidate sees an image at (default {RUN_SIDE})",
+    )  # fmt: skip
     p.add_argument("--note", default="", help="a line stored with the figures")
     p.add_argument("--out", type=Path, help="JSON file for the figures")
     a = p.parse_args(argv)
@@ -127,7 +142,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         if not folder:
             p.error(f"{item!r}: expected NAME=FOLDER")
         conditions[name] = Path(folder)
-    results = run(conditions, a.weights)
+    results = run(conditions, a.weights, a.max_side)
     print(table(results))
     if a.out is not None:
         doc = {

@@ -14,7 +14,13 @@ import numpy.typing as npt
 from softarm.perception._inputs import depth_metres, instance, instance_or_default
 from softarm.perception.berries import DetectorSettings, _check, _close, fruit_mask
 from softarm.perception.detector.instances import FRUIT_THRESHOLD, StagedDetection, instances
-from softarm.perception.detector.network import CLASSES, DEFAULT_WEIGHTS, Network, NetworkOutput
+from softarm.perception.detector.network import (
+    CLASSES,
+    DEFAULT_WEIGHTS,
+    RUN_SIDE,
+    Network,
+    NetworkOutput,
+)
 from softarm.vision.camera_model import CameraModel
 
 __all__ = ["CONFIRM_SHARE", "ConfirmedDetector", "LearnedDetector", "default_detector"]
@@ -26,16 +32,18 @@ _U8 = npt.NDArray[np.uint8]
 
 
 class LearnedDetector:
-    """The network's berries (``net``); ``weights`` an ONNX file (default: the shipped one).
+    """The network's berries (``net``); ``weights`` an ONNX file (default: the shipped one)
+    run on images shrunk to ``max_side`` (default: the shipped weights').
 
     Raises:
         VisionError: the weights file is missing or broken (named in the message).
+        InputError: ``max_side`` is not an integer of at least STRIDE.
     """
 
     name = "net"
 
-    def __init__(self, weights: str | Path = DEFAULT_WEIGHTS) -> None:
-        self.network = Network(weights)
+    def __init__(self, weights: str | Path = DEFAULT_WEIGHTS, max_side: int = RUN_SIDE) -> None:
+        self.network = Network(weights, max_side)
 
     def output(self, image: npt.NDArray[np.uint8]) -> NetworkOutput:
         """The network's output for a BGR uint8 image (checked as detect_berries does)."""

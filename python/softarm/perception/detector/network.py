@@ -7,8 +7,10 @@ The convention both sides share: the input ``image`` is (1, 3, H, W) float32, th
 image divided by 255, less 0.5, over 0.25, with H and W multiples of :data:`STRIDE`; the
 output is (1, :data:`N_OUTPUTS`, H, W): one logit per class of :data:`CLASSES` at each
 pixel and, last, the logit of the fruit-centre heatmap (a peak at each fruit's centre).
-Images are resized so that their longer side is at most :data:`MAX_SIDE` pixels (the
-scale the training renders were drawn at: C1's 1280 × 720 eye at half size).
+Training images are shrunk so that their longer side is at most :data:`MAX_SIDE` pixels
+(the scale the training renders were drawn at: C1's 1280 × 720 eye at half size); at run
+time images are shrunk to a network's own longest side, :data:`RUN_SIDE` for the
+shipped weights.
 """
 
 from __future__ import annotations
@@ -20,13 +22,14 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.errors import VisionError
+from softarm.errors import InputError, VisionError
 
 __all__ = [
     "CLASSES",
     "DEFAULT_WEIGHTS",
     "MAX_SIDE",
     "N_OUTPUTS",
+    "RUN_SIDE",
     "STRIDE",
     "Network",
     "NetworkOutput",
@@ -39,8 +42,10 @@ CLASSES = ("background", "ripe", "turning", "unripe", "cane")
 N_OUTPUTS = len(CLASSES) + 1
 #: The network pools three times: input sides must be multiples of 8.
 STRIDE = 8
-#: The longer side (px) an image is shrunk to before the network sees it.
+#: The longer side (px) a training image is shrunk to.
 MAX_SIDE = 640
+#: The longer side (px) an image is shrunk to before the shipped network sees it.
+RUN_SIDE = 640
 #: The weights that ship in the package.
 DEFAULT_WEIGHTS = Path(__file__).parent / "weights" / "berries.onnx"
 
@@ -80,14 +85,20 @@ class NetworkOutput:
 
 
 class Network:
-    """An ONNX segmentation network of this module's convention, read from ``path``.
+    """An ONNX segmentation network of this module's convention, read from ``path``, run
+    on images shrunk to at most ``max_side`` pixels on their longer side (the scale it
+    was trained for).
 
     Raises:
         VisionError: the file is missing, is not an ONNX network, or gives outputs of
             the wrong shape (the message names the file).
+        InputError: ``max_side`` is not a positive multiple of STRIDE.
     """
 
-    def __init__(self, path: str | Path = DEFAULT_WEIGHTS) -> None:
+    def __init__(self, path: str | Path = DEFAULT_WEIGHTS, max_side: int = RUN_SIDE) -> None:
+        if isinstance(max_side, bool) or not isinstance(max_side, int) or max_side < STRIDE:
+            raise InputError(f"max_side must be an integer >= {STRIDE}, got {max_side!r}")
+        self.max_side = max_side
         self.path = Path(path)
         if not self.path.is_file():
             raise VisionError(f"detector weights {self.path}: no such file")
@@ -117,9 +128,9 @@ class Network:
 
     def run(self, image: _U8) -> NetworkOutput:
         """The class probabilities and centre heatmap of a BGR uint8 (H, W, 3) image, at
-        the network's resolution (the image shrunk to MAX_SIDE)."""
+        the network's resolution (the image shrunk to ``max_side``)."""
         h, w = image.shape[:2]
-        scale = min(1.0, MAX_SIDE / max(h, w))
+        scale = min(1.0, self.max_side / max(h, w))
         sw, sh = max(1, round(w * scale)), max(1, round(h * scale))
         small = image if scale == 1.0 else cv2.resize(image, (sw, sh), interpolation=cv2.INTER_AREA)
         pw, ph = -sw % STRIDE, -sh % STRIDE

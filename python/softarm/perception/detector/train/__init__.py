@@ -17,7 +17,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from softarm.errors import SoftarmError
+from softarm.errors import InputError, SoftarmError
 
 __all__ = ["TrainExtraMissing", "require_train_extra", "train"]
 
@@ -48,28 +48,43 @@ def train(
     seed: int = 0,
     start: str | Path | None = None,
     on_epoch: Callable[[int, float, float], None] = lambda e, loss, s: None,
+    widths: tuple[int, ...] | None = None,
+    scale: tuple[float, float] | None = None,
 ) -> dict[str, Any]:
     """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
     and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
-    this architecture to fine-tune (the shipped weights for ``--from default``).
-    Returns the record.
+    this architecture to fine-tune (the shipped weights for ``--from default``; its
+    widths are the file's). ``widths`` are a fresh network's four channel counts and
+    ``scale`` the augmentation's scale range (defaults: :data:`.unet.WIDTHS`,
+    :data:`.augment.SCALE`). Returns the record.
 
     Raises:
         TrainExtraMissing: the ``train`` extra is not installed.
-        InputError: a data folder holds no labelled image, or ``start`` is not a network
-            of this architecture.
+        InputError: a data folder holds no labelled image, ``start`` is not a network
+            of this architecture, ``widths`` are given with ``start``, or ``widths`` or
+            ``scale`` are not valid.
     """
     require_train_extra()
     import jax
 
+    from softarm.perception.detector.train.augment import SCALE
     from softarm.perception.detector.train.loop import TrainSettings, fit
     from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
     from softarm.perception.detector.train.samples import describe, load_samples
-    from softarm.perception.detector.train.unet import WIDTHS
+    from softarm.perception.detector.train.unet import WIDTHS, layers, widths_of
 
+    if start is not None and widths is not None:
+        raise InputError("widths: a fine-tuned network keeps the widths of its --from file")
+    if scale is not None and not 0 < scale[0] <= scale[1]:
+        raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
+    layers(WIDTHS if widths is None else widths)  # checks them before the data is read
     samples, notes = load_samples(list(data))
-    settings = TrainSettings(epochs=epochs, seed=seed)
     params = None if start is None else params_from_onnx(start)
+    settings = TrainSettings(
+        epochs=epochs, seed=seed,
+        widths=widths_of(params) if params is not None else widths or WIDTHS,
+        scale=SCALE if scale is None else scale,
+    )  # fmt: skip
     began = time.perf_counter()
     params = fit(samples, settings, params, on_epoch)
     export_onnx(params, out)
@@ -82,7 +97,8 @@ def train(
         "seed": seed,
         "batch": settings.batch,
         "learning_rate": settings.learning_rate,
-        "widths": list(WIDTHS),
+        "widths": list(settings.widths),
+        "scale": list(settings.scale),
         "losses": [round(v, 5) for v in settings.losses],
         "seconds": round(time.perf_counter() - began, 1),
         "device": str(jax.devices()[0].platform),

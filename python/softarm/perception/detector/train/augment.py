@@ -18,7 +18,9 @@ __all__ = ["CROP", "crop_batch"]
 
 #: Side (px) of the square training crops.
 CROP = 128
-#: Log-uniform range of the scale applied before cropping.
+#: Log-uniform range of the scale applied before cropping, by default (the renders' own
+#: scale is the network's input scale; a network run on images larger than its training
+#: renders is trained on a range shifted up, ``TrainSettings.scale``).
 SCALE = (0.6, 1.7)
 #: Share of crops centred on a fruit pixel (else anywhere).
 ON_FRUIT = 0.7
@@ -26,8 +28,10 @@ _U8 = npt.NDArray[np.uint8]
 _F32 = npt.NDArray[np.float32]
 
 
-def _scaled(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
-    f = float(np.exp(rng.uniform(np.log(SCALE[0]), np.log(SCALE[1]))))
+def _scaled(
+    s: Sample, rng: np.random.Generator, scale: tuple[float, float]
+) -> tuple[_U8, _U8, _F32]:
+    f = float(np.exp(rng.uniform(np.log(scale[0]), np.log(scale[1]))))
     h, w = s.classes.shape
     size = (max(CROP // 4, round(w * f)), max(CROP // 4, round(h * f)))
     mode = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
@@ -37,8 +41,8 @@ def _scaled(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
     return image, classes, centres
 
 
-def _crop(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
-    image, classes, centres = _scaled(s, rng)
+def _crop(s: Sample, rng: np.random.Generator, scale: tuple[float, float]) -> tuple[_U8, _U8, _F32]:
+    image, classes, centres = _scaled(s, rng, scale)
     h, w = classes.shape
     pad_y, pad_x = max(0, CROP - h), max(0, CROP - w)
     if pad_y or pad_x:
@@ -115,9 +119,12 @@ def _cut_outs(image: _U8, classes: _U8, centres: _F32, rng: np.random.Generator)
         centres[y : y + hh, x : x + ww] = 0.0
 
 
-def augmented(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
-    """One augmented CROP × CROP (image, classes, centres) of ``s``."""
-    image, classes, centres = _crop(s, rng)
+def augmented(
+    s: Sample, rng: np.random.Generator, scale: tuple[float, float] = SCALE
+) -> tuple[_U8, _U8, _F32]:
+    """One augmented CROP × CROP (image, classes, centres) of ``s``, scaled by a factor
+    drawn log-uniformly from ``scale``."""
+    image, classes, centres = _crop(s, rng, scale)
     image = _sensor(_blur(_colour(image, rng), rng), rng)
     image, classes, centres = image.copy(), classes.copy(), centres.copy()
     _cut_outs(image, classes, centres, rng)
@@ -125,12 +132,16 @@ def augmented(s: Sample, rng: np.random.Generator) -> tuple[_U8, _U8, _F32]:
 
 
 def crop_batch(
-    samples: list[Sample], indices: npt.NDArray[np.int64], seed: int, step: int
+    samples: list[Sample],
+    indices: npt.NDArray[np.int64],
+    seed: int,
+    step: int,
+    scale: tuple[float, float] = SCALE,
 ) -> tuple[_U8, _U8, _F32]:
     """A batch of augmented crops of ``samples[indices]``, the same for the same
-    ``seed`` and ``step``: (N, CROP, CROP, 3), (N, CROP, CROP), (N, CROP, CROP)."""
+    ``seed``, ``step`` and ``scale``: (N, CROP, CROP, 3), (N, CROP, CROP), (N, CROP, CROP)."""
     out = [
-        augmented(samples[int(i)], np.random.default_rng([seed, step, k]))
+        augmented(samples[int(i)], np.random.default_rng([seed, step, k]), scale)
         for k, i in enumerate(indices)
     ]
     return (

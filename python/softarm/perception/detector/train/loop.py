@@ -16,9 +16,9 @@ import numpy as np
 import optax
 
 from softarm.perception.detector.network import CLASSES, normalise
-from softarm.perception.detector.train.augment import crop_batch
+from softarm.perception.detector.train.augment import SCALE, crop_batch
 from softarm.perception.detector.train.samples import IGNORE, Sample
-from softarm.perception.detector.train.unet import Params, apply, init_params
+from softarm.perception.detector.train.unet import WIDTHS, Params, apply, init_params
 
 __all__ = ["CLASS_WEIGHTS", "TrainSettings", "fit"]
 
@@ -31,12 +31,15 @@ CENTRE_POSITIVE = 20.0
 
 @dataclass(frozen=True)
 class TrainSettings:
-    """Epochs (one crop of every image each), batch size, peak learning rate, seed."""
+    """Epochs (one crop of every image each), batch size, peak learning rate, seed, the
+    network's channel widths and the augmentation's scale range."""
 
     epochs: int = 150
     batch: int = 12
     learning_rate: float = 3e-3
     seed: int = 0
+    widths: tuple[int, ...] = WIDTHS
+    scale: tuple[float, float] = SCALE
     losses: list[float] = field(default_factory=list, compare=False)
 
 
@@ -62,7 +65,7 @@ def fit(
 ) -> Params:
     """Train from ``params`` (default: fresh, from the seed) on ``samples``; calls
     ``on_epoch(epoch, mean loss, seconds)`` after each epoch."""
-    params = init_params(settings.seed) if params is None else params
+    params = init_params(settings.seed, settings.widths) if params is None else params
     per_epoch = max(1, int(np.ceil(len(samples) / settings.batch)))
     total = settings.epochs * per_epoch
     schedule = optax.warmup_cosine_decay_schedule(
@@ -87,7 +90,7 @@ def fit(
             idx = order[b * settings.batch : (b + 1) * settings.batch]
             if idx.size < settings.batch:  # a full batch keeps one compiled shape
                 idx = np.concatenate([idx, order[: settings.batch - idx.size]])
-            images, classes, centres = crop_batch(samples, idx, settings.seed, n)
+            images, classes, centres = crop_batch(samples, idx, settings.seed, n, settings.scale)
             params, state, loss = step(
                 params, state, jnp.asarray(normalise(images)), jnp.asarray(classes),
                 jnp.asarray(centres),

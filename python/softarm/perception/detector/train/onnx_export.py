@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from softarm.perception.detector.network import N_OUTPUTS
-from softarm.perception.detector.train.unet import LAYERS, Params
+from softarm.perception.detector.train.unet import Params, layers
 
 __all__ = ["export_onnx", "onnx_bytes", "params_from_onnx"]
 
@@ -80,7 +80,6 @@ def onnx_bytes(params: Params) -> bytes:
     import onnx
     from onnx import helper, numpy_helper
 
-    assert [name for name, *_ in LAYERS][-1] == "head"
     g = _Graph(helper, numpy_helper)
     s1 = g.conv(params, "enc1", "image")
     s2 = g.conv(params, "enc2b", g.conv(params, "enc2a", g.pool(s1)))
@@ -134,8 +133,13 @@ def params_from_onnx(path: str | Path) -> Params:
     except Exception as exc:  # onnx raises protobuf's DecodeError and others
         raise InputError(f"--from {path}: not a readable ONNX file ({exc})") from None
     arrays = {i.name: numpy_helper.to_array(i) for i in model.graph.initializer}
+    # The widths are the file's: each level's first convolution's output channels.
+    firsts = [arrays.get(f"{n}.w") for n in ("enc1", "enc2a", "enc3a", "enc4a")]
+    if any(w is None or w.ndim != 4 for w in firsts):
+        raise InputError(f"--from {path}: not a network of this architecture (no U-Net levels)")
+    widths = tuple(int(w.shape[0]) for w in firsts if w is not None)
     params: Params = {}
-    for name, k, cin, cout in LAYERS:
+    for name, k, cin, cout in layers(widths):
         w, b = arrays.get(f"{name}.w"), arrays.get(f"{name}.b")
         if w is None or b is None or w.shape != (cout, cin, k, k) or b.shape != (cout,):
             raise InputError(f"--from {path}: not a network of this architecture (layer {name})")

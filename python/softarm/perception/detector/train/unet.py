@@ -1,6 +1,7 @@
-"""The detector's network in JAX: a small U-Net (three poolings, 8–32 channels) whose
-layers are all ONNX operators OpenCV's DNN module runs (3×3 convolutions, ReLU, 2×2 max
-pooling, nearest upsampling, concatenation); :mod:`.onnx_export` writes the same graph.
+"""The detector's network in JAX: a small U-Net (three poolings, 8–32 channels by
+default, any four widths by :func:`layers`) whose layers are all ONNX operators
+OpenCV's DNN module runs (3×3 convolutions, ReLU, 2×2 max pooling, nearest upsampling,
+concatenation); :mod:`.onnx_export` writes the same graph.
 
 Parameters are a flat dict ``name -> (kernel (kh, kw, cin, cout), bias (cout,))`` of
 :data:`LAYERS`, images NHWC."""
@@ -13,40 +14,61 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from softarm.errors import InputError
 from softarm.perception.detector.network import N_OUTPUTS
 
-__all__ = ["LAYERS", "WIDTHS", "apply", "init_params"]
+__all__ = ["LAYERS", "WIDTHS", "apply", "init_params", "layers", "widths_of"]
 
-#: Channels of the four levels (full, 1/2, 1/4, 1/8 resolution).
+#: Channels of the four levels (full, 1/2, 1/4, 1/8 resolution) by default.
 WIDTHS = (8, 16, 24, 32)
-_C1, _C2, _C3, _C4 = WIDTHS
-#: (name, kernel size, in channels, out channels), in the order the graph runs them.
-LAYERS: tuple[tuple[str, int, int, int], ...] = (
-    ("enc1", 3, 3, _C1),
-    ("enc2a", 3, _C1, _C2),
-    ("enc2b", 3, _C2, _C2),
-    ("enc3a", 3, _C2, _C3),
-    ("enc3b", 3, _C3, _C3),
-    ("enc4a", 3, _C3, _C4),
-    ("enc4b", 3, _C4, _C4),
-    ("dec3", 3, _C4 + _C3, _C3),
-    ("dec2", 3, _C3 + _C2, _C2),
-    ("dec1", 3, _C2 + _C1, _C1),
-    ("head", 1, _C1, N_OUTPUTS),
-)
+
+
+def layers(widths: tuple[int, ...] = WIDTHS) -> tuple[tuple[str, int, int, int], ...]:
+    """(name, kernel size, in channels, out channels) of a network of ``widths`` (four
+    positive channel counts), in the order the graph runs them.
+
+    Raises:
+        InputError: ``widths`` is not four positive integers.
+    """
+    if len(widths) != 4 or any(not isinstance(c, int) or c < 1 for c in widths):
+        raise InputError(f"widths {widths!r}: four positive channel counts expected")
+    c1, c2, c3, c4 = widths
+    return (
+        ("enc1", 3, 3, c1),
+        ("enc2a", 3, c1, c2),
+        ("enc2b", 3, c2, c2),
+        ("enc3a", 3, c2, c3),
+        ("enc3b", 3, c3, c3),
+        ("enc4a", 3, c3, c4),
+        ("enc4b", 3, c4, c4),
+        ("dec3", 3, c4 + c3, c3),
+        ("dec2", 3, c3 + c2, c2),
+        ("dec1", 3, c2 + c1, c1),
+        ("head", 1, c1, N_OUTPUTS),
+    )
+
+
+#: The layers of the default widths.
+LAYERS = layers()
 
 Params = dict[str, tuple[Any, Any]]
 
 
-def init_params(seed: int) -> Params:
-    """He-initialised parameters, deterministic in ``seed``."""
+def init_params(seed: int, widths: tuple[int, ...] = WIDTHS) -> Params:
+    """He-initialised parameters of a network of ``widths``, deterministic in ``seed``."""
     rng = np.random.default_rng(seed)
     params: Params = {}
-    for name, k, cin, cout in LAYERS:
+    for name, k, cin, cout in layers(widths):
         std = np.sqrt(2.0 / (k * k * cin))
         w = rng.normal(0.0, std, (k, k, cin, cout)).astype(np.float32)
         params[name] = (jnp.asarray(w), jnp.zeros((cout,), jnp.float32))
     return params
+
+
+def widths_of(params: Params) -> tuple[int, int, int, int]:
+    """The four channel counts of ``params`` (their first layer of each level)."""
+    c1, c2, c3, c4 = (int(params[n][0].shape[-1]) for n in ("enc1", "enc2a", "enc3a", "enc4a"))
+    return c1, c2, c3, c4
 
 
 def _conv(params: Params, name: str, x: Any, relu: bool = True) -> Any:
