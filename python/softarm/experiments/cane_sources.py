@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from softarm.perception.cane_curves import CurveSearch, curve_points
+from softarm.perception.cane_evidence import CaneEvidence
 from softarm.perception.cane_metrics import DEFAULT_REACH, cane_map_error
 from softarm.perception.canes import (
     CaneFit,
@@ -70,13 +71,15 @@ _COUNTED = CurveSearch(min_support=70, support_length=0.0)
 #: The point budgets and supports: ``view``, 4,000 points over the whole view, a cane 70
 #: of them (as before the reach); ``reach``, 4,000 points within the reach, a cane 70 of
 #: them (the default); ``length``, 8,000 points within the reach, a cane 8 cm of cane
-#: covered and at least 20 points (``CurveSearch.support_length``; measured, not adopted).
+#: covered and at least 20 points (``CurveSearch.support_length``; measured, not adopted);
+#: ``evidence``, the ``length`` budget's fits kept only where they show a cane's evidence
+#: (:class:`~softarm.perception.cane_evidence.CaneEvidence`).
+_LENGTH = CurveSearch(min_support=20, support_length=0.08)
 BUDGETS: dict[str, CaneSettings] = {
     "view": CaneSettings(reach=None, max_points=4000, search=_COUNTED),
     "reach": CaneSettings(max_points=4000, search=_COUNTED),
-    "length": CaneSettings(
-        max_points=8000, search=CurveSearch(min_support=20, support_length=0.08)
-    ),
+    "length": CaneSettings(max_points=8000, search=_LENGTH),
+    "evidence": CaneSettings(max_points=8000, search=_LENGTH, evidence=CaneEvidence()),
 }
 
 

@@ -18,7 +18,9 @@ The pipeline (:func:`fit_canes`):
    canes in reach a few points each;
 5. in the base frame, sequential RANSAC splits the points into canes
    (:mod:`softarm.perception.cane_curves`) and each becomes a cubic in u ∈ [0, 1]
-   fitted by least squares with arc-length parameters.
+   fitted by least squares with arc-length parameters;
+6. with ``CaneSettings.evidence`` set, only the curves that show a cane's evidence
+   (:mod:`softarm.perception.cane_evidence`: points per metre, radius) are kept.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from softarm.checks import FloatArray, as_array
 from softarm.errors import ParameterError, VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
+from softarm.perception.cane_evidence import CaneEvidence, shows_a_cane
 from softarm.perception.cane_pixels import CaneLook, half_width_px, stereo_disparity
 from softarm.perception.cane_source import check_cane_source, source_mask
 from softarm.perception.self_filter import CANE_REACH
@@ -80,11 +83,14 @@ class CaneSettings:
     ``smoothness``: StereoSGBM's penalties P1, P2 (see
     :func:`softarm.perception.cane_pixels.stereo_disparity`); ``source``: where the cane
     pixels come from (:data:`softarm.perception.cane_source.CANE_SOURCES`; None: this
-    process's choice, :func:`~softarm.perception.cane_source.use_cane_source`).
+    process's choice, :func:`~softarm.perception.cane_source.use_cane_source`);
+    ``evidence``: what a fitted curve must show to be kept
+    (:class:`~softarm.perception.cane_evidence.CaneEvidence`; None: every curve the
+    search finds is kept).
 
     Raises:
         ParameterError: ``source`` is not None or one of CANE_SOURCES; ``reach`` is not
-            None or a finite number > 0.
+            None or a finite number > 0; ``evidence`` is not None or a CaneEvidence.
     """
 
     look: CaneLook = field(default_factory=CaneLook)
@@ -94,8 +100,13 @@ class CaneSettings:
     smoothness: tuple[int, int] = (4, 16)
     source: str | None = None
     reach: float | None = CANE_REACH
+    evidence: CaneEvidence | None = None
 
     def __post_init__(self) -> None:
+        if self.evidence is not None and not isinstance(self.evidence, CaneEvidence):
+            raise ParameterError(
+                f"settings.evidence must be None or a CaneEvidence, got {self.evidence!r}"
+            )
         if self.source is not None:
             check_cane_source(self.source, "settings.source")
         if self.reach is not None and not (
@@ -302,11 +313,15 @@ def _fit_all(points: FloatArray, radius: FloatArray, settings: CaneSettings) -> 
     fits = []
     for members in split_into_curves(points, settings.search):
         coeffs = arc_length_cubic(points[members])
+        cane_radius = float(np.median(radius[members]))
+        evidence = settings.evidence
+        if evidence is not None and not shows_a_cane(len(members), coeffs, cane_radius, evidence):
+            continue
         fits.append(
             CaneFit(
                 curve=PolynomialCurve(coeffs, (0.0, 1.0)),
                 coeffs=coeffs,
-                radius=float(np.median(radius[members])),
+                radius=cane_radius,
                 points=points[members],
                 support=len(members),
             )
