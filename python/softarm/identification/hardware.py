@@ -22,6 +22,7 @@ from softarm.hardware.arduino_devices import ArduinoPressureMonitor
 from softarm.hardware.camera import OpenCVCamera
 from softarm.hardware.clock import MonotonicClock
 from softarm.hardware.daq import NidaqPressureBank
+from softarm.hardware.latest_frame import newest_frames
 from softarm.hardware.pressure_map import VoltageMap
 from softarm.hardware.safety import SafePressureBank
 from softarm.vision.camera_model import camera_from_config
@@ -64,7 +65,8 @@ class HardwareIdentificationRig:
                 daq, ch.p_max, ch.max_rate_psi_per_s, ch.watchdog_timeout_s
             )
             stack.callback(self.bank.close)
-            cam = OpenCVCamera(cal.c1.source)
+            # Its newest frame: the lag measured is the arm's, not the driver's queue.
+            cam = newest_frames(OpenCVCamera(cal.c1.source), cal.c1.source)
             stack.callback(cam.close)
             self.vision = CameraVision(
                 lambda t: cam.read(), lambda t: None, model1, model1,

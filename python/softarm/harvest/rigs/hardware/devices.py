@@ -17,6 +17,7 @@ from softarm.hardware.arduino_devices import Link
 from softarm.hardware.camera import OpenCVCamera
 from softarm.hardware.clock import MonotonicClock
 from softarm.hardware.daq import NidaqPressureBank
+from softarm.hardware.latest_frame import newest_frames
 from softarm.hardware.pressure_map import VoltageMap
 from softarm.hardware.protocols import PressureBank
 from softarm.harvest.machine.interfaces import Clock
@@ -69,7 +70,7 @@ class DeviceDrivers:
         return link
 
     def stereo(self, perception: PerceptionConfig, stack: ExitStack) -> Callable[[], Pair]:
-        return open_stereo(perception, OpenCVCamera, stack)
+        return open_stereo(perception, _opened, stack)
 
     def c1_frames(self, config: Config, stack: ExitStack, stereo_left: Frame | None) -> Frame:
         if stereo_left is not None:
@@ -80,8 +81,14 @@ class DeviceDrivers:
         return _camera(config.calibration.c2.device, stack)
 
 
+def _opened(device: Any) -> Any:
+    """An OpenCV camera on ``device`` that gives its newest frame, not the oldest its
+    driver queued while the loop was not reading (:mod:`softarm.hardware.latest_frame`)."""
+    return newest_frames(OpenCVCamera(device), device)
+
+
 def _camera(device: Any, stack: ExitStack) -> Frame:
     """An OpenCV camera as ``(time) -> image``, closed by ``stack``."""
-    cam = OpenCVCamera(device)
+    cam = _opened(device)
     stack.callback(cam.close)
     return lambda t: cam.read()
