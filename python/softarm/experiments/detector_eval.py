@@ -27,7 +27,8 @@ import numpy as np
 from softarm.perception.detector.choice import DETECTORS, BerryDetector, detector
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
-from softarm.perception.detector.network import RUN_SIDE
+from softarm.perception.detector.misses import fruit_cases, miss_table
+from softarm.perception.detector.network import RUN_SIDE, STRIDE
 
 __all__ = ["CANDIDATE", "WITH_DEPTH", "candidates", "main", "table"]
 
@@ -123,7 +124,7 @@ def table(results: dict[str, Any]) -> str:
 
 def main(argv: Sequence[str] | None = None) -> None:
     """python -m softarm.experiments.detector_eval NAME=FOLDER ... [--weights W
-    [--max-side N]] [--out F]."""
+    [--max-side N]] [--out F | --misses]."""
     p = argparse.ArgumentParser(prog="python -m softarm.experiments.detector_eval")
     p.add_argument("conditions", nargs="+", help="NAME=FOLDER (softarm dataset output)")
     p.add_argument(
@@ -135,6 +136,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     )  # fmt: skip
     p.add_argument("--note", default="", help="a line stored with the figures")
     p.add_argument("--out", type=Path, help="JSON file for the figures")
+    p.add_argument(
+        "--misses", action="store_true",
+        help="instead: the ripe fruit the network (the candidate, else the shipped one) "
+        "misses in all the folders together, binned by what might explain it",
+    )  # fmt: skip
     a = p.parse_args(argv)
     conditions = {}
     for item in a.conditions:
@@ -142,6 +148,13 @@ def main(argv: Sequence[str] | None = None) -> None:
         if not folder:
             p.error(f"{item!r}: expected NAME=FOLDER")
         conditions[name] = Path(folder)
+    if a.max_side < STRIDE:
+        p.error(f"--max-side must be at least {STRIDE}, got {a.max_side}")
+    if a.misses:
+        net = LearnedDetector() if a.weights is None else LearnedDetector(a.weights, a.max_side)
+        cv2.setNumThreads(1)
+        print(miss_table([c for f in conditions.values() for c in fruit_cases(net, f)]))
+        return
     results = run(conditions, a.weights, a.max_side)
     print(table(results))
     if a.out is not None:
