@@ -73,13 +73,18 @@ _COUNTED = CurveSearch(min_support=70, support_length=0.0)
 #: them (the default); ``length``, 8,000 points within the reach, a cane 8 cm of cane
 #: covered and at least 20 points (``CurveSearch.support_length``; measured, not adopted);
 #: ``evidence``, the ``length`` budget's fits kept only where they show a cane's evidence
-#: (:class:`~softarm.perception.cane_evidence.CaneEvidence`).
+#: (:class:`~softarm.perception.cane_evidence.CaneEvidence`); ``far``, the same budget
+#: with C1's stereo matching out to 3 m (``CaneSettings.match_far``: the canes beyond the
+#: range dropped at their own depth) and the evidence of 70 points and 1.75 mm alone.
 _LENGTH = CurveSearch(min_support=20, support_length=0.08)
 BUDGETS: dict[str, CaneSettings] = {
     "view": CaneSettings(reach=None, max_points=4000, search=_COUNTED),
     "reach": CaneSettings(max_points=4000, search=_COUNTED),
     "length": CaneSettings(max_points=8000, search=_LENGTH),
     "evidence": CaneSettings(max_points=8000, search=_LENGTH, evidence=CaneEvidence()),
+    "far": CaneSettings(
+        max_points=8000, search=_LENGTH, evidence=CaneEvidence(min_density=0.0), match_far=3.0
+    ),
 }
 
 
@@ -185,22 +190,24 @@ def _rig_parts() -> Any:
 
 
 class _Placed:
-    """One mask's points, placed once per reach (the stereo is the costly part) and each
-    budget's even subsample of them taken after, as ``mask_points`` takes it; the time
-    of the placing counted in every budget that uses it."""
+    """One mask's points, placed once per reach and stereo range (the stereo is the costly
+    part) and each budget's even subsample of them taken after, as ``mask_points`` takes
+    it; the time of the placing counted in every budget that uses it."""
 
     def __init__(self, rect_left: Any, rect_right: Any, stereo: Any, mask: Any) -> None:
         self.args = (rect_left, rect_right, stereo, mask)
-        self.placed: dict[float, tuple[Any, float, float]] = {}
+        self.placed: dict[tuple[float, float | None], tuple[Any, float, float]] = {}
 
     def points(self, settings: CaneSettings) -> tuple[Any, float, float]:
         """(points, wall seconds, CPU seconds) for ``settings``."""
         # without a reach the budget is spent on pixels before they are placed
-        key = settings.reach if settings.reach is not None else -float(settings.max_points)
+        reach = settings.reach if settings.reach is not None else -float(settings.max_points)
+        key = (reach, settings.match_far)
         if key not in self.placed:
             whole = settings if settings.reach is None else CaneSettings(max_points=10**9)
             start, start_cpu = time.perf_counter(), time.process_time()
-            points = mask_points(*self.args, replace(whole, reach=settings.reach))
+            whole = replace(whole, reach=settings.reach, match_far=settings.match_far)
+            points = mask_points(*self.args, whole)
             wall, cpu = time.perf_counter() - start, time.process_time() - start_cpu
             self.placed[key] = (points, wall, cpu)
         points, wall, cpu = self.placed[key]

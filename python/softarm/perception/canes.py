@@ -72,6 +72,10 @@ class CaneFit:
 class CaneSettings:
     """``look``: which pixels are canes; ``search``: how points become canes;
     ``depth_range``: nearest and farthest depth (m) a cane is looked for at;
+    ``match_far``: the farthest depth (m) C1's stereo matches at, beyond
+    ``depth_range``'s far end (None: that end): a cane farther than the range (the next
+    row's, the hedge's) is then matched at its own depth and dropped, where a search
+    that stops at the range can only match it to a wrong, nearer disparity, a phantom;
     ``reach``: points farther than this (m) from the base origin are dropped before the
     budget is spent (the map's own reach, :data:`softarm.perception.self_filter.
     CANE_REACH`: canes beyond it cannot touch the arm; None: every point shares the
@@ -92,7 +96,9 @@ class CaneSettings:
 
     Raises:
         ParameterError: ``source`` is not None or one of CANE_SOURCES; ``reach`` is not
-            None or a finite number > 0; ``evidence`` is not None or a CaneEvidence.
+            None or a finite number > 0; ``evidence`` is not None or a CaneEvidence;
+            ``match_far`` is not None or a finite number beyond ``depth_range``'s far
+            end.
     """
 
     look: CaneLook = field(default_factory=CaneLook)
@@ -103,6 +109,7 @@ class CaneSettings:
     source: str | None = None
     reach: float | None = CANE_REACH
     evidence: CaneEvidence | None = None
+    match_far: float | None = None
 
     def __post_init__(self) -> None:
         if self.evidence is not None and not isinstance(self.evidence, CaneEvidence):
@@ -111,6 +118,16 @@ class CaneSettings:
             )
         if self.source is not None:
             check_cane_source(self.source, "settings.source")
+        if self.match_far is not None and not (
+            isinstance(self.match_far, (int, float))
+            and not isinstance(self.match_far, bool)
+            and np.isfinite(self.match_far)
+            and self.match_far >= self.depth_range[1]
+        ):
+            raise ParameterError(
+                f"settings.match_far must be None or a number >= depth_range's far end "
+                f"{self.depth_range[1]} m, got {self.match_far!r}"
+            )
         if self.reach is not None and not (
             isinstance(self.reach, (int, float))
             and not isinstance(self.reach, bool)
@@ -220,9 +237,9 @@ def mask_points(
     choice of source, the same for every source (and for the comparison of sources,
     :mod:`softarm.experiments.cane_sources`)."""
     rect = stereo.rectification
-    disparity = stereo_disparity(
-        rect_left, rect_right, rect, mask, settings.depth_range, settings.smoothness
-    )
+    near, far = settings.depth_range
+    matched = (near, far if settings.match_far is None else settings.match_far)
+    disparity = stereo_disparity(rect_left, rect_right, rect, mask, matched, settings.smoothness)
     mask = mask & np.isfinite(disparity)
     rows, cols = _whole_view_budget(np.nonzero(mask), settings)
     pixels = np.column_stack([cols, rows]).astype(np.float64)
