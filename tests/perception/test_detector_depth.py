@@ -150,3 +150,31 @@ def test_the_candidates_are_each_detector_and_two_given_depth() -> None:
     names = list(candidates())
     assert names == [*DETECTORS, "colour+depth", "net+colour+depth"]
     assert [with_depth for _, with_depth in candidates().values()] == [False] * 3 + [True] * 2
+
+
+def test_a_candidate_network_is_scored_beside_the_shipped_one() -> None:
+    from softarm.perception.detector.learned import LearnedDetector
+    from softarm.perception.detector.network import DEFAULT_WEIGHTS
+
+    cands = candidates(DEFAULT_WEIGHTS, 1280)
+    assert list(cands) == [
+        *DETECTORS, "cand", "cand+colour", "colour+depth", "net+colour+depth",
+        "cand+colour+depth",
+    ]  # fmt: skip
+    cand, with_depth = cands["cand"]
+    assert isinstance(cand, LearnedDetector) and cand.network.max_side == 1280 and not with_depth
+    assert cands["cand+colour+depth"] == (cands["cand+colour"][0], True)
+
+
+@pytest.mark.parametrize("extra", [["--max-side", "4"], ["--max-side", "x"], []])
+def test_bad_evaluation_arguments_are_one_usage_line(
+    capsys: pytest.CaptureFixture[str], extra: list[str]
+) -> None:
+    from softarm.experiments.detector_eval import main
+
+    args = ["sun"] if not extra else ["sun=somewhere", *extra]
+    with pytest.raises(SystemExit) as exit_info:
+        main(args)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "error:" in err[-1] and "Traceback" not in "\n".join(err)
