@@ -18,7 +18,8 @@ The thresholds were tuned on seeds 311000–311008 (sun, overcast, dusk, bush) w
 8,000 points and an 8 cm support; on fresh seeds 310160–310179 the overcast map's
 precision after the self-filter fell 0.028 below today's default, so the check is an
 option (``CaneSettings.evidence``), off by default. A true cane placed at a wrong depth
-passes it: its run is as wide and as dense as a cane's.
+passes it: its run is as wide and as dense as a cane's (on the tuning renders, the
+next row's canes aliased into the stereo's range: ``CaneSettings.match_far``).
 """
 
 from __future__ import annotations
