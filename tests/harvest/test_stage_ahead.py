@@ -126,6 +126,21 @@ def test_placement_ends_on_where_the_commands_sent_put_the_slow_arm() -> None:
     assert _pre_grasp_error(plant, config) <= config.placement_tolerance
 
 
+def _at_the_grasp(
+    clock: FakeClock, servo: Servo, watch: BerryWatch
+) -> tuple[np.ndarray, np.ndarray]:
+    """The arm ramped to berry 1's grasp pose (through the model's gain error) and
+    settled there: (q sent, the plan's q of the pre-grasp pose, on the nominal gain)."""
+    config = servo.link.cfg
+    axis = np.array([0.0, 1.0, 0.0])
+    q_pre = (BERRIES[1] - (config.standoff + config.grasp_offset) * axis - P0) / K
+    grasp_q = (BERRIES[1] - config.grasp_offset * axis - P0) / (GAIN_ERROR * K)
+    q = servo.transport.ramp(watch, HarvestState.FINE_POSITIONING, np.zeros(3), grasp_q, 30.0)
+    while clock.now() < 8 * TAU + 30.0 * PERIOD:  # the arm at the grasp pose, settled
+        q = servo.link.hold(q)
+    return q, q_pre
+
+
 def _way_home(
     servo: Servo, watch: BerryWatch, q: np.ndarray, q_pre: np.ndarray
 ) -> tuple[np.ndarray, ...]:
@@ -151,13 +166,7 @@ def test_the_way_home_leaves_from_the_back_out_not_from_the_plans_pre_grasp_q() 
     before, its first leg sent the arm to the plan's q of the pre-grasp pose (the
     model's, 1-4 cm off it on the slow plant) and waited for it there."""
     clock, _, _, servo, watch, _ = _slow_rig(off=True)
-    config = servo.link.cfg
-    axis = np.array([0.0, 1.0, 0.0])
-    q_pre = (BERRIES[1] - (config.standoff + config.grasp_offset) * axis - P0) / K
-    grasp_q = (BERRIES[1] - config.grasp_offset * axis - P0) / (GAIN_ERROR * K)
-    q = servo.transport.ramp(watch, HarvestState.FINE_POSITIONING, np.zeros(3), grasp_q, 30.0)
-    while clock.now() < 8 * TAU + 30.0 * PERIOD:  # the arm at the grasp pose, settled
-        q = servo.link.hold(q)
+    q, q_pre = _at_the_grasp(clock, servo, watch)
     way = _way_home(servo, watch, q, q_pre)
     assert len(way) == 1  # home alone
 
@@ -170,12 +179,7 @@ def test_the_back_out_hands_over_ahead_of_the_arm_only_within_2_cm() -> None:
     ahead from anywhere, at 36 mm here: the way home cut the corner through the canes)."""
     clock, plant, _, servo, watch, _ = _slow_rig()
     config = servo.link.cfg
-    axis = np.array([0.0, 1.0, 0.0])
-    q_pre = (BERRIES[1] - (config.standoff + config.grasp_offset) * axis - P0) / K
-    grasp_q = (BERRIES[1] - config.grasp_offset * axis - P0) / (GAIN_ERROR * K)
-    q = servo.transport.ramp(watch, HarvestState.FINE_POSITIONING, np.zeros(3), grasp_q, 30.0)
-    while clock.now() < 8 * TAU + 30.0 * PERIOD:  # the arm at the grasp pose, settled
-        q = servo.link.hold(q)
+    q, q_pre = _at_the_grasp(clock, servo, watch)
     handed: list[float] = []
 
     def spy(watch, stage, q, way, start):  # type: ignore[no-untyped-def]
@@ -183,6 +187,7 @@ def test_the_back_out_hands_over_ahead_of_the_arm_only_within_2_cm() -> None:
         return q
 
     servo.transport.way_back = spy  # type: ignore[method-assign]
+    axis = np.array([0.0, 1.0, 0.0])
     servo.go_home(
         watch, HarvestState.RETURN_HOME, q, np.full(3, 0.0167), axis, (q_pre,), BERRIES[1]
     )

@@ -5,6 +5,17 @@ checks the two agree)."""
 
 from __future__ import annotations
 
-__all__ = ["LOOKS"]
+import argparse
+
+__all__ = ["LOOKS", "add_look"]
 
 LOOKS = ("sun", "overcast", "backlight", "dusk", "random")
+
+
+def add_look(p: argparse.ArgumentParser) -> None:
+    """``--look``, the daylight family of ``--world row`` (``harvest --sim``, ``demo``)."""
+    p.add_argument(
+        "--look", choices=LOOKS, default=None,
+        help="--world row: the daylight family (default random: one of the four drawn "
+        "from the seed; docs/perception.md, 'The daylight row')",
+    )  # fmt: skip

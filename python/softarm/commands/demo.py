@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from softarm.commands._args import add_quiet, int_range, non_negative_int, output_dir
-from softarm.commands._looks import LOOKS
+from softarm.commands._looks import add_look
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._worlds import world_metavar, world_type
 from softarm.commands.harvest import MAX_BERRIES
@@ -37,11 +37,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "harvest in the rendered bush (render extra), with harvest_c1.png, what C1 saw; "
         "'row': the same bush inside a hedgerow in daylight (--look)",
     )  # fmt: skip
-    p.add_argument(
-        "--look", choices=LOOKS, default=None,
-        help="--world row: the daylight family (default random: one of the four drawn "
-        "from the seed; docs/perception.md, 'The daylight row')",
-    )  # fmt: skip
+    add_look(p)
     add_plant_options(p, sim_only_flag=False)
     add_quiet(p)
     p.set_defaults(run=run)

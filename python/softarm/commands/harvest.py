@@ -32,7 +32,7 @@ from softarm.commands._dry_run import (
     replay_devices,
     replay_rounds,
 )
-from softarm.commands._looks import LOOKS
+from softarm.commands._looks import add_look
 from softarm.commands._marker_bodies import MARKER_BODIES
 from softarm.commands._plant import add_plant_options, plant_options
 from softarm.commands._progress import Progress
@@ -134,11 +134,7 @@ def add_world_options(p: argparse.ArgumentParser) -> None:
         "'row', the same bush inside a hedgerow in daylight (--look); "
         "--berries counts ripe and unripe together, 30%% unripe",
     )  # fmt: skip
-    p.add_argument(
-        "--look", choices=LOOKS, default=None,
-        help="--world row: the daylight family (default random: one of the four drawn "
-        "from the seed; docs/perception.md, 'The daylight row')",
-    )  # fmt: skip
+    add_look(p)
     p.add_argument(
         "--survey", action=argparse.BooleanOptionalAction, default=None,
         help="--world bush: before the first berry, take C2 to three pairs of views of the "
