@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import InputError
+from softarm.files.images import read_image
 from softarm.perception.berries import BerryDetection
 from softarm.perception.detector.choice import BerryDetector
 from softarm.perception.detector.evaluate import _camera
@@ -93,7 +94,8 @@ def fruit_cases(detector: BerryDetector, folder: str | Path) -> list[FruitCase]:
     output: annotations.json with visible shares) and what ``detector`` made of them.
 
     Raises:
-        InputError: the folder's labels cannot be read or name no image in it.
+        InputError: the folder's labels cannot be read or name no image in it, or an
+            image named cannot be read.
     """
     folder = Path(folder)
     items = read_coco(folder / "annotations.json", folder)
@@ -101,9 +103,7 @@ def fruit_cases(detector: BerryDetector, folder: str | Path) -> list[FruitCase]:
         raise InputError(f"folder {folder}: its labels name no image in it")
     out: list[FruitCase] = []
     for item in items:
-        image = cast(npt.NDArray[np.uint8] | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
-        if image is None:
-            continue
+        image = cast(npt.NDArray[np.uint8], read_image(item.path, "image", cv2.IMREAD_COLOR))
         dets = list(detector.detect_berries(image, _camera(item, None), None))
         fruit = [o for o in item.objects() if o.is_fruit]
         out.extend(_cases(image, fruit, dets, str(item.record.get("view", "?"))))
