@@ -18,17 +18,7 @@ import numpy.typing as npt
 # the gripper with its fingers around its axis, and of a blackberry cane.
 from softarm._core import ACTUATOR_RADIUS, CANE_RADIUS, GRIPPER_RADIUS
 
-__all__ = [
-    "ACTUATOR_RADIUS",
-    "APPROACH_CONE_DEG",
-    "CANE_RADIUS",
-    "FINGER_AHEAD",
-    "FINGER_ANGLES_DEG",
-    "FINGER_HALF",
-    "FINGER_RADIUS",
-    "GRIPPER_RADIUS",
-    "cone_axes",
-]
+__all__ = ["ACTUATOR_RADIUS", "APPROACH_CONE_DEG", "CANE_RADIUS", "GRIPPER_RADIUS", "cone_axes"]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -37,16 +27,6 @@ FloatArray = npt.NDArray[np.float64]
 #: out of (``softarm.sim.bush.Bush.generate``), so that every axis the planner may choose
 #: is clear of the canes.
 APPROACH_CONE_DEG = 20.0
-
-#: The gripper's three fingers in the end-effector frame: boxes of these half sizes (m;
-#: radial, tangential, along the axis), centred FINGER_RADIUS from the axis and
-#: FINGER_AHEAD in front of the frame, at these angles (deg) about the axis. The renderer
-#: draws them (``softarm.sim.render.mjcf``) and C2's markerless vision leaves out what it
-#: detects on them (``softarm.perception.bush_vision.finger_outlines``).
-FINGER_HALF = (0.004, 0.006, 0.022)
-FINGER_RADIUS = 0.024
-FINGER_AHEAD = 0.022
-FINGER_ANGLES_DEG = (90.0, 210.0, 330.0)
 
 
 def cone_axes(axis: FloatArray, cone_deg: float, rings: int = 2, per_ring: int = 8) -> FloatArray:

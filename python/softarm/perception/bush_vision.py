@@ -24,7 +24,6 @@ import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
-from softarm.geometry import FINGER_AHEAD, FINGER_ANGLES_DEG, FINGER_HALF, FINGER_RADIUS
 from softarm.perception.approach import RayCrossing, along_spread
 from softarm.perception.berries import BerryDetection, DetectorSettings
 from softarm.perception.bush_map import BushMap
@@ -48,6 +47,14 @@ PLACING_EVERY = 5
 #: A C2 detection is a mapped berry when its centre lies within the berry's projected
 #: radius, or this many pixels, of the berry's projection.
 MAPPED_GATE_PX = 8.0
+#: The gripper's fingers in the end-effector frame, as the renderer draws them
+#: (``softarm.sim.render.mjcf``): boxes of these half sizes (m; radial, tangential,
+#: along the axis), centred FINGER_RADIUS from the axis and FINGER_AHEAD in front of
+#: the frame, at these angles (deg) about the axis.
+FINGER_HALF = (0.004, 0.006, 0.022)
+FINGER_RADIUS = 0.024
+FINGER_AHEAD = 0.022
+FINGER_ANGLES_DEG = (90.0, 210.0, 330.0)
 
 #: A convex outline in an image: (K, 2) pixels.
 Outline = npt.NDArray[np.float32]

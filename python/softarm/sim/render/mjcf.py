@@ -20,7 +20,6 @@ import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
-from softarm.geometry import FINGER_AHEAD, FINGER_ANGLES_DEG, FINGER_HALF, FINGER_RADIUS
 from softarm.sim.bush import Berry, Bush
 from softarm.sim.render.look import BushLook
 from softarm.sim.render.row import Row
@@ -349,11 +348,11 @@ def _arm(spec: SceneSpec) -> str:
             f'size="0.045 0.004" rgba="{grey}" group="2" contype="0" conaffinity="0"/></body>'
         )
     fingers = "".join(
-        f'<geom name="arm_finger{i}" type="box" size="{_v(FINGER_HALF)}" '
-        f'pos="{_v([FINGER_RADIUS * np.cos(a), FINGER_RADIUS * np.sin(a), FINGER_AHEAD])}" '
+        f'<geom name="arm_finger{i}" type="box" size="0.004 0.006 0.022" '
+        f'pos="{_v([0.024 * np.cos(a), 0.024 * np.sin(a), 0.022])}" '
         f'quat="{_quat(Rotation.from_euler("z", a).as_matrix())}" rgba="{dark}" '
         f'group="2" contype="0" conaffinity="0"/>'
-        for i, a in enumerate(np.radians(FINGER_ANGLES_DEG))
+        for i, a in enumerate(np.arange(3) * 2 * np.pi / 3 + np.pi / 2)
     )
     cams = "".join(_camera(c) for c in spec.hand_cameras)
     out.append(f'<body name="arm_ee" mocap="true">{fingers}{cams}</body>')
