@@ -7,21 +7,13 @@ the map holds ripe fruit C1 found but could not place, C2 is also read every
 PLACING_EVERY periods wherever the arm is, and a fruit it sees on one of their sight
 lines is placed (:mod:`softarm.perception.sight_lines`). A period whose fix the harvest
 throws away (the back-out, the moves between berries) reads C2 only for that placing:
-up close, C2's frames are the costliest part of a period in the rendered row.
-
-C2 sees the gripper's three fingers in every frame, at the same pixels: dark, and in
-the row's sun the camera crushes them to black, so the berry detector takes each for a
-ripe fruit. A detection centred on a finger's outline (:func:`finger_outlines`) is the
-rig's own and is dropped before the gate and the placing."""
+up close, C2's frames are the costliest part of a period in the rendered row."""
 
 from __future__ import annotations
 
 from typing import Any
 
-import cv2
 import numpy as np
-import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
 from softarm.perception.approach import RayCrossing, along_spread
@@ -29,13 +21,12 @@ from softarm.perception.berries import BerryDetection, DetectorSettings
 from softarm.perception.bush_map import BushMap
 from softarm.perception.detector.choice import detect_berries  # the chosen detector
 from softarm.perception.sight_lines import crossing
-from softarm.vision.camera_model import CameraModel
 from softarm.vision.detector import Detection
 from softarm.vision.observation import BerryTarget
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision
 
-__all__ = ["BushVision", "finger_outlines", "off_fingers"]
+__all__ = ["BushVision"]
 
 #: C2 is read while the grasp point is this close (m) to the mapped berry: beyond, the
 #: fusion uses C1 (its hand-over is at 6 cm), so C2's frame would go unused.
@@ -47,49 +38,6 @@ PLACING_EVERY = 5
 #: A C2 detection is a mapped berry when its centre lies within the berry's projected
 #: radius, or this many pixels, of the berry's projection.
 MAPPED_GATE_PX = 8.0
-#: The gripper's fingers in the end-effector frame, as the renderer draws them
-#: (``softarm.sim.render.mjcf``): boxes of these half sizes (m; radial, tangential,
-#: along the axis), centred FINGER_RADIUS from the axis and FINGER_AHEAD in front of
-#: the frame, at these angles (deg) about the axis.
-FINGER_HALF = (0.004, 0.006, 0.022)
-FINGER_RADIUS = 0.024
-FINGER_AHEAD = 0.022
-FINGER_ANGLES_DEG = (90.0, 210.0, 330.0)
-
-#: A convex outline in an image: (K, 2) pixels.
-Outline = npt.NDArray[np.float32]
-
-
-def finger_outlines(T_ee_c2: FloatArray, camera: CameraModel) -> list[Outline]:
-    """Each finger's outline in C2's image: the convex hull (px, (K, 2) float32) of
-    its box's corners as ``camera``, at ``T_ee_c2`` in the end-effector frame, sees
-    them; a finger with a corner behind the camera is left out (C2 cannot see it)."""
-    T_c2_ee = invert(np.asarray(T_ee_c2, dtype=float))
-    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    outlines = []
-    for angle in np.radians(FINGER_ANGLES_DEG):
-        turn = Rotation.from_euler("z", angle).as_matrix()
-        centre = np.array([FINGER_RADIUS * np.cos(angle), FINGER_RADIUS * np.sin(angle),
-                           FINGER_AHEAD])  # fmt: skip
-        corners = centre + (signs * np.array(FINGER_HALF)) @ turn.T
-        in_c2 = corners @ T_c2_ee[:3, :3].T + T_c2_ee[:3, 3]
-        if np.any(in_c2[:, 2] <= 0.0):
-            continue
-        pixels = np.asarray(camera.project(in_c2), dtype=np.float32)
-        hull: Outline = np.asarray(cv2.convexHull(pixels), np.float32).reshape(-1, 2)
-        outlines.append(hull)
-    return outlines
-
-
-def off_fingers(dets: list[BerryDetection], outlines: list[Outline]) -> list[BerryDetection]:
-    """``dets`` less those centred inside one of the fingers' ``outlines``
-    (:func:`finger_outlines`): a blob centred on a finger is the finger, or a fruit the
-    finger hides the middle of, whose centre C2 cannot measure."""
-    return [
-        d for d in dets
-        if all(cv2.pointPolygonTest(o, (float(d.center[0]), float(d.center[1])), False) < 0
-               for o in outlines)
-    ]  # fmt: skip
 
 
 class BushVision(CameraVision):
@@ -107,14 +55,6 @@ class BushVision(CameraVision):
         self._near = False  # the grasp point within C2_RANGE of the selected berry
         self._period = 0
         self._for_fix = False  # this period's C2 frame would serve the fix
-        self._fingers = finger_outlines(self._T_ee_c2, self.model2)
-
-    def c2_berries(self, image: Any) -> list[BerryDetection]:
-        """The berries the detector finds in C2's ``image``, less the gripper's own
-        fingers (:func:`off_fingers`)."""
-        return off_fingers(
-            detect_berries(image, self.model2, settings=self.settings), self._fingers
-        )
 
     def select(self, berry: BerryTarget) -> None:
         """Track the map's berry ``berry.tag_id``; its C2 sightings start afresh."""
@@ -169,7 +109,7 @@ class BushVision(CameraVision):
         if T_c1_ee is None:
             return None
         T_base_c2 = self.T_base_c1 @ T_c1_ee @ self._T_ee_c2
-        dets = self.c2_berries(image)
+        dets = detect_berries(image, self.model2, settings=self.settings)
         self._place_unplaced(dets, T_base_c2)
         if track is None or not self._near:
             return None
@@ -185,7 +125,8 @@ class BushVision(CameraVision):
         ``T_base_c2`` (the cane survey's views: they face the bush from where the
         berries' approaches seldom take C2)."""
         if self.bush_map.unplaced:
-            self._place_unplaced(self.c2_berries(image), T_base_c2)
+            dets = detect_berries(image, self.model2, settings=self.settings)
+            self._place_unplaced(dets, T_base_c2)
 
     def _place_unplaced(self, dets: list[BerryDetection], T_base_c2: FloatArray) -> None:
         """Add the crossings of C2's ripe detections that are no mapped berry with the
