@@ -18,7 +18,7 @@ import numpy.typing as npt
 
 from softarm.errors import NonFiniteError, ParameterError, PoseError, ShapeError
 
-__all__ = ["FloatArray", "as_array", "as_pose", "numeric_array", "positive"]
+__all__ = ["FloatArray", "as_array", "as_pose", "finite_real", "numeric_array", "positive"]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -108,3 +108,11 @@ def positive(value: Any, name: str) -> float:
     if not np.isfinite(out) or out <= 0.0:
         raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
     return out
+
+
+def finite_real(value: Any) -> bool:
+    """Whether ``value`` is a finite int or float (not a bool, a string or an array):
+    the check of a settings field that must be a number as given, not one parsed."""
+    return (
+        isinstance(value, int | float) and not isinstance(value, bool) and bool(np.isfinite(value))
+    )

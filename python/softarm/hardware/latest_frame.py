@@ -13,7 +13,6 @@ that out, each frame once.
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from typing import Any
@@ -21,6 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from softarm.checks import finite_real
 from softarm.errors import HardwareError, ParameterError
 from softarm.hardware.protocols import Camera
 
@@ -55,7 +55,7 @@ class LatestFrame:
     """
 
     def __init__(self, camera: Camera, wait_s: float = WAIT_S) -> None:
-        if not (isinstance(wait_s, int | float) and math.isfinite(wait_s) and wait_s > 0):
+        if not (finite_real(wait_s) and wait_s > 0):
             raise ParameterError(f"wait_s must be a positive finite time (s), got {wait_s!r}")
         self.camera, self.wait_s = camera, float(wait_s)
         self._new = threading.Condition()

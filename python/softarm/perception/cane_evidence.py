@@ -24,12 +24,11 @@ next row's canes aliased into the stereo's range: ``CaneSettings.match_far``).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from softarm.checks import FloatArray
+from softarm.checks import FloatArray, finite_real
 from softarm.errors import ParameterError
 from softarm.perception.cane_curves import curve_points
 
@@ -58,12 +57,7 @@ class CaneEvidence:
             raise ParameterError(f"evidence.min_points must be an int, got {self.min_points!r}")
         for name in ("min_points", "min_density", "min_radius"):
             value = getattr(self, name)
-            if (
-                not isinstance(value, (int, float))
-                or isinstance(value, bool)
-                or not math.isfinite(value)
-                or value < 0
-            ):
+            if not finite_real(value) or value < 0:
                 raise ParameterError(f"evidence.{name} must be a number >= 0, got {value!r}")
 
 

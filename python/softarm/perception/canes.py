@@ -33,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import PolynomialCurve
-from softarm.checks import FloatArray, as_array
+from softarm.checks import FloatArray, as_array, finite_real
 from softarm.errors import ParameterError, VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
@@ -122,21 +122,13 @@ class CaneSettings:
         if self.source is not None:
             check_cane_source(self.source, "settings.source")
         if self.match_far is not None and not (
-            isinstance(self.match_far, (int, float))
-            and not isinstance(self.match_far, bool)
-            and np.isfinite(self.match_far)
-            and self.match_far >= self.depth_range[1]
+            finite_real(self.match_far) and self.match_far >= self.depth_range[1]
         ):
             raise ParameterError(
                 f"settings.match_far must be None or a number >= depth_range's far end "
                 f"{self.depth_range[1]} m, got {self.match_far!r}"
             )
-        if self.reach is not None and not (
-            isinstance(self.reach, (int, float))
-            and not isinstance(self.reach, bool)
-            and np.isfinite(self.reach)
-            and self.reach > 0
-        ):
+        if self.reach is not None and not (finite_real(self.reach) and self.reach > 0):
             raise ParameterError(
                 f"settings.reach must be None or a number > 0 m, got {self.reach!r}"
             )
