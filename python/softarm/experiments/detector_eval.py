@@ -10,7 +10,9 @@ learned detector").
     python -m softarm.experiments.detector_eval NAME=FOLDER ... --out docs/data/detector_eval.json
 
 Each NAME=FOLDER is one condition (a look of the row, held out or not, the bush); the
-time per image is the detector's alone (one OpenCV thread, median over the folder)."""
+time per image is the detector's alone (one OpenCV thread, median over the folder).
+``--split-touching`` runs every detector with touching fruit split at the necks of their
+distance map (:data:`SPLIT`; docs/data/detector_eval_touching.json)."""
 
 from __future__ import annotations
 
@@ -24,29 +26,32 @@ from typing import Any
 import cv2
 import numpy as np
 
+from softarm.perception.berries import DetectorSettings
 from softarm.perception.detector.choice import DETECTORS, BerryDetector, detector
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 from softarm.perception.detector.misses import fruit_cases, miss_table
 from softarm.perception.detector.network import RUN_SIDE, STRIDE
 
-__all__ = ["CANDIDATE", "WITH_DEPTH", "candidates", "main", "table"]
+__all__ = ["CANDIDATE", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
 
 _SHOWN = ("precision", "ripe_precision", "recall_ripe", "recall", "stage_right")
 
 
 class _Timed:
-    """A detector that keeps the time of each call."""
+    """A detector that keeps the time of each call, run with ``settings`` (None: each
+    call's own)."""
 
-    def __init__(self, inner: BerryDetector) -> None:
+    def __init__(self, inner: BerryDetector, settings: DetectorSettings | None = None) -> None:
         self.inner = inner
+        self.settings = settings
         self.seconds: list[float] = []
 
     def detect_berries(
         self, image: Any, camera: Any, depth: Any = None, settings: Any = None
     ) -> Any:
         start = time.perf_counter()
-        out = self.inner.detect_berries(image, camera, depth, settings)
+        out = self.inner.detect_berries(image, camera, depth, self.settings or settings)
         self.seconds.append(time.perf_counter() - start)
         return out
 
@@ -82,17 +87,27 @@ def candidates(
     return out
 
 
+#: The detectors' settings with touching fruit split at the necks of their distance map
+#: (:mod:`~softarm.perception.detector.touching`), the network's instances and the colour
+#: rule's ripe blobs: ``--split-touching``.
+SPLIT = DetectorSettings(split_touching=True, split_colour_blobs=True)
+
+
 def run(
-    conditions: dict[str, Path], weights: Path | None = None, max_side: int = RUN_SIDE
+    conditions: dict[str, Path],
+    weights: Path | None = None,
+    max_side: int = RUN_SIDE,
+    settings: DetectorSettings | None = None,
 ) -> dict[str, Any]:
     """{condition: {candidate: figures}} with ``ms_per_image``; a ``+depth`` candidate
-    reads each folder's ``depth/``."""
+    reads each folder's ``depth/``; every detector run with ``settings`` (None: the
+    default)."""
     cv2.setNumThreads(1)
     out: dict[str, Any] = {}
     for name, folder in conditions.items():
         out[name] = {}
         for cand, (det, with_depth) in candidates(weights, max_side).items():
-            timed = _Timed(det)
+            timed = _Timed(det, settings)
             depth = folder / "depth" if with_depth else None
             figures = evaluate(timed, folder / "annotations.json", folder, depth)
             figures.pop("per_image")
@@ -134,6 +149,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         "--max-side", type=int, default=RUN_SIDE,
         help=f"longer side (px) the candidate sees an image at (default {RUN_SIDE})",
     )  # fmt: skip
+    p.add_argument(
+        "--split-touching", action="store_true",
+        help="split touching fruit at the necks of their distance map (the network's "
+        "instances and the colour rule's ripe blobs), not the default",
+    )  # fmt: skip
     p.add_argument("--note", default="", help="a line stored with the figures")
     p.add_argument("--out", type=Path, help="JSON file for the figures")
     p.add_argument(
@@ -150,17 +170,20 @@ def main(argv: Sequence[str] | None = None) -> None:
         conditions[name] = Path(folder)
     if a.max_side < STRIDE:
         p.error(f"--max-side must be at least {STRIDE}, got {a.max_side}")
+    settings = SPLIT if a.split_touching else None
     if a.misses:
-        net = LearnedDetector() if a.weights is None else LearnedDetector(a.weights, a.max_side)
+        learned = LearnedDetector() if a.weights is None else LearnedDetector(a.weights, a.max_side)
+        net = _Timed(learned, settings)
         cv2.setNumThreads(1)
         print(miss_table([c for f in conditions.values() for c in fruit_cases(net, f)]))
         return
-    results = run(conditions, a.weights, a.max_side)
+    results = run(conditions, a.weights, a.max_side, settings)
     print(table(results))
     if a.out is not None:
         doc = {
             "note": a.note,
             "folders": {k: str(v) for k, v in conditions.items()},
+            "split_touching": a.split_touching,
             "results": results,
         }
         a.out.write_text(json.dumps(doc, indent=1) + "\n")

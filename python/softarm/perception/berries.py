@@ -27,6 +27,7 @@ from softarm.errors import VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.berry_centre import RING, silhouette_centre
 from softarm.perception.detector.depth_check import DepthCheck, rejection
+from softarm.perception.detector.touching import disc_seeds, split_discs
 from softarm.vision.camera_model import CameraModel
 
 __all__ = [
@@ -57,6 +58,9 @@ MAX_REFINED = 64
 #: close-up, 20-30 px) highlights on the lit edge read as background and the refined
 #: centre leans away from the light (0.6 px against the mask's 0.3 on C2 at the grasp).
 MAX_REFINED_RADIUS = 14.0
+#: The least radius (px, the distance map's height) of a second fruit in a colour blob:
+#: that of a fruit of the least area (40 px: 3.6 px), less a pixel of ragged outline.
+SEED_RADIUS = 2.5
 # What OpenCV returns for a uint8 image (its stubs say any number array).
 _U8 = npt.NDArray[np.uint8]
 _Contour = npt.NDArray[np.int32]
@@ -79,6 +83,15 @@ class DetectorSettings:
     min_area_px: int = 40
     min_solidity: float = 0.75
     max_elongation: float = 2.6
+    #: The network's instances: fruit that touch split at the necks of their part's
+    #: distance map (:mod:`softarm.perception.detector.touching`) where True, else at the
+    #: network's centre heatmap peaks. An option: on the held-out sets it found more ripe
+    #: fruit in every look of the row but cost precision in the bush world
+    #: (docs/perception.md, "Splitting touching fruit").
+    split_touching: bool = False
+    #: The colour rule's ripe blobs split the same way before the shape tests, where
+    #: True (an option: more ripe fruit found, precision lost in sun and dusk).
+    split_colour_blobs: bool = False
     #: What a depth image must say of a detection where one is given
     #: (:mod:`softarm.perception.detector.depth_check`); None: depth only places it.
     depth_check: DepthCheck | None = field(default_factory=DepthCheck)
@@ -218,7 +231,9 @@ def detections_in_masks(
     instance(camera, CameraModel, "camera")
     instance(s, DetectorSettings, "settings")
     depth = depth_metres(depth, ripe.shape)
-    blobs = [(c, area) for mask in (ripe, unripe) for c, area in _blobs(_close(mask), s)]
+    # Only the ripe class is split: the unripe one holds the yellow-green canes, whose
+    # strips split into fruit-sized pieces at every knot and crossing.
+    blobs = _blobs(_close(ripe), s, s.split_colour_blobs) + _blobs(_close(unripe), s, False)
     out = []
     for blob in _capped(blobs):
         det = _detection(blob, ripe, unripe, camera, depth, s)
@@ -298,22 +313,55 @@ def _close(mask: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
 
 
 def _blobs(
-    mask: npt.NDArray[np.uint8], s: DetectorSettings
+    mask: npt.NDArray[np.uint8], s: DetectorSettings, split: bool
 ) -> list[tuple[npt.NDArray[np.int32], float]]:
-    """Outer contours of the compact blobs of ``mask``, holes filled, with their areas."""
+    """Outer contours of the compact blobs of ``mask``, holes filled, with their areas;
+    with ``split``, every blob first divided into one per fruit it holds (a cluster of
+    fruit is neither compact nor disc-like as a whole), each piece then tested."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     out = []
-    for c in contours:
-        area = cv2.contourArea(c)
-        if area < s.min_area_px or len(c) < 5:
+    for found in contours:
+        c = cast(_Contour, found)
+        if not split:
+            if _fruit_shaped(c, s):
+                out.append((c, float(cv2.contourArea(c))))
             continue
-        hull = cv2.contourArea(cv2.convexHull(c))
-        (_, _), (a, b), _ = cv2.fitEllipse(c)
-        if hull <= 0 or area / hull < s.min_solidity:
-            continue
-        if max(a, b) > s.max_elongation * max(min(a, b), 1e-6):
-            continue
-        out.append((cast(_Contour, c), float(area)))
+        pieces = _touching_split(c, s)
+        out.extend((p, float(cv2.contourArea(p))) for p in pieces if _fruit_shaped(p, s))
+    return out
+
+
+def _fruit_shaped(c: _Contour, s: DetectorSettings) -> bool:
+    """A blob of a fruit's area that is compact (solid, not elongated)."""
+    area = cv2.contourArea(c)
+    if area < s.min_area_px or len(c) < 5:
+        return False
+    hull = cv2.contourArea(cv2.convexHull(c))
+    (_, _), (a, b), _ = cv2.fitEllipse(c)
+    if hull <= 0 or area / hull < s.min_solidity:
+        return False
+    return bool(max(a, b) <= s.max_elongation * max(min(a, b), 1e-6))
+
+
+def _touching_split(contour: _Contour, s: DetectorSettings) -> list[_Contour]:
+    """``contour``'s blob as one outline per fruit it holds (itself when one):
+    :mod:`softarm.perception.detector.touching`, on the blob filled. Only a blob that
+    could hold two fruit of the least area is looked at (the cost is its box's)."""
+    if cv2.contourArea(contour) < 2 * s.min_area_px:
+        return [contour]
+    bx, by, bw, bh = cv2.boundingRect(contour)
+    filled = np.zeros((bh, bw), np.uint8)
+    cv2.drawContours(filled, [contour], -1, 1, thickness=cv2.FILLED, offset=(-bx, -by))
+    blob = filled > 0
+    seeds = disc_seeds(blob, SEED_RADIUS)
+    if len(seeds) < 2:
+        return [contour]
+    out: list[_Contour] = []
+    for piece in split_discs(blob, seeds):
+        found, _ = cv2.findContours(
+            piece.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE, offset=(bx, by)
+        )
+        out.extend(cast(list[_Contour], list(found)))
     return out
 
 
