@@ -22,7 +22,7 @@ from softarm.geometry import APPROACH_CONE_DEG, cone_axes
 from softarm.sim.bush import PLUS_Y, Branch, Bush
 from softarm.sim.render.row_look import RowLook
 
-__all__ = ["ROW_FRUIT_ID", "STAGES", "STAGE_RIPENESS", "Row", "RowFruit", "stage_of"]
+__all__ = ["ROW_FRUIT_ID", "STAGES", "STAGE_RIPENESS", "Row", "RowFruit", "row_canes", "stage_of"]
 
 #: Fruit stages, green to ripe (the fruit goes green -> red -> turning -> black).
 STAGES = ("green", "red", "turning", "ripe")
@@ -84,9 +84,7 @@ class Row:
     @classmethod
     def generate(cls, bush: Bush, look: RowLook) -> Row:
         """The row around ``bush`` drawn from ``look``'s seed."""
-        rng = np.random.default_rng([look.seed, 0x20E])
-        corridors = _corridors(bush)
-        canes = _row_canes(rng, corridors)
+        rng, corridors, canes = _first_draws(bush, look)
         fruit = [
             RowFruit(b.tag_id, b.position, stage_of(b.ripeness, rng), float(rng.uniform(0.9, 1.1)))
             for b in bush.berries
@@ -113,6 +111,23 @@ class Row:
     def find(self, fruit_id: int) -> RowFruit | None:
         """Fruit ``fruit_id``, None if no such fruit."""
         return next((f for f in self.fruit if f.fruit_id == fruit_id), None)
+
+
+def row_canes(bush: Bush, look: RowLook) -> list[Branch]:
+    """The canes :meth:`Row.generate` draws around ``bush`` for ``look``, without the rest
+    of the row (its leaflets take seconds to draw): the truth the simulated harvest
+    scores contacts and the cane map on."""
+    return _first_draws(bush, look)[2]
+
+
+def _first_draws(
+    bush: Bush, look: RowLook
+) -> tuple[np.random.Generator, list[tuple[FloatArray, FloatArray]], list[Branch]]:
+    """The row's generator, the bush's approach corridors and the row's canes, the
+    first thing drawn (so :func:`row_canes` draws the same canes as the whole row)."""
+    rng = np.random.default_rng([look.seed, 0x20E])
+    corridors = _corridors(bush)
+    return rng, corridors, _row_canes(rng, corridors)
 
 
 def stage_of(ripeness: float, rng: np.random.Generator) -> str:

@@ -247,7 +247,7 @@ def _bush_extra(scene: BushScene, delivered: list[int], name: WorldName) -> dict
         "ripe_never_mapped_c1_share": scene.c1_shares(unmapped),
         "cane_map": {
             k: v
-            for k, v in cane_map_error(scene.bush_map.canes, scene.bush.branches).items()
+            for k, v in cane_map_error(scene.bush_map.canes, scene.world.canes()).items()
             if k in ("median_mm", "p95_mm", "coverage", "precision", "length_m")
         },
     }

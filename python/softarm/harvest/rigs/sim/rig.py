@@ -37,7 +37,7 @@ from softarm.harvest.rigs.replay.dry_run import (
 from softarm.harvest.rigs.sim.bush_world import BushScene
 from softarm.harvest.rigs.sim.devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.rigs.sim.options import SimRigOptions, declared_plant, default_cameras
-from softarm.harvest.rigs.sim.worlds import WORLDS, HarvestWorld, WorldParts
+from softarm.harvest.rigs.sim.worlds import WORLDS, HarvestWorld, WorldParts, true_canes
 from softarm.harvest.runs.cane_survey import CaneSurvey
 from softarm.perception.self_filter import rig_parts
 from softarm.sim.arm import SimulatedArm
@@ -148,7 +148,7 @@ def _build_sim_rig(
     cams = default_cameras(o.scale, o.noise_std)
     cams.marker_body = check_marker_body(o.marker_body)
     bush = _bush(o, plant, cams)
-    canes = [b.curve() for b in bush.branches]  # the truth: contacts are scored on it
+    canes = true_canes(o, bush)  # the truth: contacts are scored on it
     watch = _watch(o, plant, canes)
     clock = SimClock([plant.advance, watch.sample])
     bank = _bank(plant, clock, recorder)

@@ -30,6 +30,7 @@ from softarm.perception.detector.choice import use_detector
 from softarm.perception.self_filter import CANE_REACH
 from softarm.sim.bush import Bush
 from softarm.sim.plant import ArmPlant
+from softarm.sim.render.row import row_canes
 from softarm.sim.render.row_look import RowLook
 from softarm.sim.render.world import world_for
 from softarm.sim.rig_cameras import BASE_TAG_ID, SimCameras, sim_vision
@@ -38,7 +39,7 @@ from softarm.vision.marker_body import marker_body
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision, register_c1
 
-__all__ = ["C2_SCALE", "WORLDS", "HarvestWorld", "WorldParts"]
+__all__ = ["C2_SCALE", "WORLDS", "HarvestWorld", "WorldParts", "true_canes"]
 
 
 class HarvestWorld(World, Protocol):
@@ -139,6 +140,15 @@ WORLDS: dict[WorldName, Callable[[WorldParts], HarvestWorld]] = {
     WorldName.BUSH: _rendered_world,
     WorldName.ROW: _rendered_world,
 }
+
+
+def true_canes(o: SimRigOptions, bush: Bush) -> list[softarm.PolynomialCurve]:
+    """Every cane of the world ``o`` harvests, as drawn: the bush's, and in the row the
+    row's own too (they stand clear of the berries' approach corridors, not of the arm's
+    sections, so the arm can touch them): the truth contacts are scored on."""
+    look = _look(o, bush)
+    row = [] if look is None else row_canes(bush, look)
+    return [b.curve() for b in [*bush.branches, *row]]
 
 
 def _look(o: SimRigOptions, bush: Bush) -> RowLook | None:
