@@ -96,6 +96,9 @@ def _pieces(
     """``part`` as one mask per fruit: at the necks of its distance map (``split``,
     :mod:`.touching`), else at its centre heatmap's peaks."""
     if split:
+        # Too few pixels for two fruit of the least radius: one fruit, no distance map.
+        if np.count_nonzero(part) < 2 * np.pi * SEED_RADIUS**2:
+            return [part]
         return split_discs(part, disc_seeds(part, SEED_RADIUS))
     return _split(part, _peaks(centres, part))
 

@@ -52,9 +52,23 @@ def _saddle(dist: _F32, a: tuple[int, int], b: tuple[int, int]) -> float:
     """The lowest distance on the straight line from ``a`` to ``b`` (both ends included):
     for two discs, the neck between their centres."""
     n = int(np.ceil(np.hypot(a[0] - b[0], a[1] - b[1]))) + 1
-    rows = np.rint(np.linspace(a[0], b[0], n)).astype(np.intp)
-    cols = np.rint(np.linspace(a[1], b[1], n)).astype(np.intp)
+    t = np.arange(n) / max(n - 1, 1)
+    rows = np.rint(a[0] + t * (b[0] - a[0])).astype(np.intp)
+    cols = np.rint(a[1] + t * (b[1] - a[1])).astype(np.intp)
     return float(dist[rows, cols].min())
+
+
+def _second_fruit(
+    dist: _F32, peak: tuple[int, int], kept: list[tuple[int, int]], neck: float
+) -> bool:
+    """Whether ``peak`` is a fruit apart from every ``kept`` (higher) one. A peak inside
+    a kept one's inscribed disc is that fruit's without a look at the saddle: two fruit
+    told apart lie more than 2 r sqrt(1 - NECK²) (1.32 r) apart, beyond r."""
+    height = float(dist[peak])
+    for k in kept:
+        if (peak[0] - k[0]) ** 2 + (peak[1] - k[1]) ** 2 < float(dist[k]) ** 2:
+            return False
+    return all(_saddle(dist, peak, k) < neck * height for k in kept)
 
 
 def disc_seeds(mask: npt.NDArray[np.bool_], min_radius: float, neck: float = NECK) -> list[Seed]:
@@ -69,10 +83,9 @@ def disc_seeds(mask: npt.NDArray[np.bool_], min_radius: float, neck: float = NEC
     order = np.argsort(-dist[rows, cols], kind="stable")[:MAX_PEAKS]
     kept: list[tuple[int, int]] = []
     for r, c in zip(rows[order].tolist(), cols[order].tolist(), strict=True):
-        height = float(dist[r, c])
-        if kept and height < min_radius:
+        if kept and float(dist[r, c]) < min_radius:
             break  # the rest are lower still
-        if all(_saddle(dist, (r, c), k) < neck * height for k in kept):
+        if _second_fruit(dist, (r, c), kept, neck):
             kept.append((r, c))
     return [(float(r), float(c), float(dist[r, c])) for r, c in kept]
 
