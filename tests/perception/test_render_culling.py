@@ -80,9 +80,9 @@ def test_a_window_leaves_most_of_the_bush_out() -> None:
     seen = []
     original = renderer._culled
 
-    def spy(camera: str, size: tuple[int, int], principal: tuple[float, float]):  # type: ignore[no-untyped-def]
+    def spy(camera: str, size: tuple[int, int], principal: tuple[float, float], **how):  # type: ignore[no-untyped-def]
         seen.append(renderer.model.geom_group.copy())
-        return original(camera, size, principal)
+        return original(camera, size, principal, **how)
 
     renderer._culled = spy
     world.c1_left_window((640.0, 360.0), 192)

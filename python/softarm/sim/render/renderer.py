@@ -25,6 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from softarm.checks import FloatArray
 from softarm.errors import MissingDependencyError
+from softarm.sim.render.cane_mesh import merged_and_members
 from softarm.sim.render.culling import in_frustum
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.last_render import LastRender, scene_state
@@ -152,6 +153,7 @@ class BushRenderer:
         self._backdrop = self.model.geom_rbound > BACKDROP_RADIUS
         self._planes = np.flatnonzero(self.model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
         self._backdrop[self._arm] = False
+        self._merged, self._members = merged_and_members(self.model, self.labels)
         self._shadow_travel: FloatArray | None = None
         self._sun: SunShadows | None = None
         if spec.row is not None and spec.shadows:
@@ -224,7 +226,8 @@ class BushRenderer:
         spec = self.cameras[camera]
         option = mj.MjvOption()
         option.geomgroup[OCCLUDER_GROUP] = int(occluders)
-        with self._culled(camera, spec.size, spec.principal) as local:
+        merged = not (depth or geoms) and spec.size[0] * spec.size[1] <= LOCAL_MAX_PIXELS
+        with self._culled(camera, spec.size, spec.principal, merged) as local:
             r = self._renderer(spec, local)
             return self._last.put(slot, state, self._render_passes(r, camera, option, depth, geoms))
 
@@ -295,7 +298,7 @@ class BushRenderer:
             mj.mj_camlight(m, self.data)
             window = CameraSpec(camera, spec.T_parent_camera, (side, side), spec.focal, (0, 0))
             principal = (spec.principal[0] - origin[0], spec.principal[1] - origin[1])
-            with self._culled(camera, (side, side), principal) as local:
+            with self._culled(camera, (side, side), principal, merged=True) as local:
                 r = self._renderer(window, local)
                 r.update_scene(self.data, camera=camera)
                 return self._last.put(slot, state, np.ascontiguousarray(r.render()[..., ::-1]))
@@ -304,14 +307,21 @@ class BushRenderer:
 
     @contextmanager
     def _culled(
-        self, camera: str, size: tuple[int, int], principal: tuple[float, float]
+        self,
+        camera: str,
+        size: tuple[int, int],
+        principal: tuple[float, float],
+        merged: bool = False,
     ) -> Iterator[bool]:
         """Within the block, every geom that cannot show in ``camera``'s ``size``
         picture with ``principal`` point (px) is in :data:`CULLED_GROUP`
         (:mod:`softarm.sim.render.culling`; the camera's pose is the data's, after
-        ``mj_camlight``). Yields whether the render takes a small shadow map (the sun
-        moved for it: :mod:`softarm.sim.render.shadow_map`)."""
+        ``mj_camlight``), and with ``merged`` the canes are their merged meshes
+        (:mod:`softarm.sim.render.cane_mesh`). Yields whether the render takes a small
+        shadow map (:mod:`softarm.sim.render.shadow_map`)."""
         mj, m, d = self._mj, self.model, self.data
+        if merged:  # the capsules out, their meshes in
+            m.geom_group[self._members], m.geom_group[self._merged] = CULLED_GROUP, OCCLUDER_GROUP
         cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
         centres = (d.geom_xpos[self._cullable] - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
         radii = m.geom_rbound[self._cullable]
@@ -352,6 +362,7 @@ class BushRenderer:
         centres = (d.geom_xpos - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
         seen = in_frustum(centres, radii, size, focal, principal) & (radii > 0)
         seen &= ~self._backdrop
+        seen[self._merged] = False  # their capsules stand for them
         return d.geom_xpos[seen], radii[seen]
 
     def close(self) -> None:

@@ -24,6 +24,7 @@ from scipy.spatial import ConvexHull
 
 from softarm.checks import FloatArray
 from softarm.sim.render import mjcf
+from softarm.sim.render.cane_mesh import merged_canes
 from softarm.sim.render.look import _mix
 from softarm.sim.render.row import (
     GROUND_Z,
@@ -54,6 +55,10 @@ ROW_CANE_SEGMENTS = 10
 #: a shadowed render's three passes. The small renders' context draws it coarser
 #: (softarm.sim.render.renderer.SMALL_RENDER_GROUND_GRID).
 GROUND_GRID = 0.1
+#: MuJoCo's tessellation of the scene's primitives (``<quality>``); the merged canes
+#: (softarm.sim.render.cane_mesh) are built to it.
+NUMSLICES = 14
+NUMSTACKS = 8
 #: Where the scene is, for the sun's position and shadow frustum.
 CENTRE = np.array([0.0, 0.45, 0.2])
 EXTENT = 1.6
@@ -71,11 +76,14 @@ def row_scene_xml(spec: mjcf.SceneSpec, row: Row, shadows: bool) -> tuple[str, d
         "hedge.png": _hedge_png(look, rng),
     }
     n_bush = len(spec.bush.branches)
+    canes = [mjcf._cane(i, b.points(24), look) for i, b in enumerate(spec.bush.branches)]
+    merged = merged_canes(canes, mjcf._rgba(look.cane_colour), NUMSLICES, NUMSTACKS)
+    assets.update(merged[0])
     parts = [
         _ground(look, rng),
         _trellis(),
         _next_row(look, rng),
-        *(mjcf._cane(i, b.points(24), look) for i, b in enumerate(spec.bush.branches)),
+        *canes,
         *(
             _row_cane(n_bush + i, b.points(ROW_CANE_SEGMENTS + 1), look)
             for i, b in enumerate(row.canes)
@@ -91,10 +99,11 @@ def row_scene_xml(spec: mjcf.SceneSpec, row: Row, shadows: bool) -> tuple[str, d
         ),
         *(mjcf._camera(c) for c in spec.world_cameras),
         mjcf._arm(spec),
+        merged[2],  # the last body: every other geom keeps its id
     ]
     sides = {spec.cube_marker, spec.tag_length}
     meshes = "".join(mjcf._quad_mesh(FACE_PER_MARKER * m) for m in sides)
-    meshes += _fruit_meshes() + _leaf_meshes()
+    meshes += _fruit_meshes() + _leaf_meshes() + merged[1]
     meshes += "".join(
         _tube_mesh(
             f"canetube{n_bush + i}", b.points(ROW_CANE_SEGMENTS + 1), _cane_radius(n_bush + i)
@@ -115,7 +124,7 @@ def _head(spec: mjcf.SceneSpec, look: RowLook, meshes: str, shadows: bool) -> st
         f'<mujoco model="row"><compiler angle="radian"/>'
         f'<visual><global offwidth="1280" offheight="720"/>'
         f'<quality shadowsize="{SHADOW_SIZE if shadows else 0}" '
-        f'offsamples="{mjcf.OFFSCREEN_SAMPLES}" numslices="14" numstacks="8"/>'
+        f'offsamples="{mjcf.OFFSCREEN_SAMPLES}" numslices="{NUMSLICES}" numstacks="{NUMSTACKS}"/>'
         f'<headlight ambient="{amb}" diffuse="0 0 0" specular="0 0 0"/>'
         f'<map znear="0.005" zfar="40" shadowclip="1.2"/></visual>'
         f'<statistic extent="{EXTENT}" center="{mjcf._v(CENTRE)}"/>'
