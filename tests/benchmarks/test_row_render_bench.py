@@ -1,9 +1,10 @@
 """What a small render of the daylight row costs (issue 37 item 6): C2's frame (at the
 harvest's half scale) and a 184-pixel window of C1's left eye around the marker cube,
 the arm reaching for a berry, drawn with the small shadow map (the harvest's way) and
-with the full one, on the same world; and with the small map on the same row whose
+with the full one, on the same world; with the small map on the same row whose
 small renders draw the ground on MuJoCo's finest grid (200 x 200 quads, as before
-renderer.SMALL_RENDER_GROUND_GRID)."""
+renderer.SMALL_RENDER_GROUND_GRID); and with the small map on the same world drawing
+the bush's canes as their capsules (as before softarm.sim.render.cane_mesh)."""
 
 from __future__ import annotations
 
@@ -111,4 +112,20 @@ def test_row_small_render_fine_ground(benchmark, fine_ground_row: Any, view: str
     else:
         origin = _window_origin(fine_ground_row)
         image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
+    assert image.ndim == 3
+
+
+@pytest.mark.parametrize("view", ["c2", "c1_window"])
+def test_row_small_render_capsule_canes(benchmark, row: Any, view: str) -> None:  # type: ignore[no-untyped-def]
+    renderer = row.renderer
+    kept = renderer._merged, renderer._members
+    renderer._merged = renderer._members = np.zeros(0, np.int64)  # the capsules drawn
+    try:
+        if view == "c2":
+            image = benchmark(lambda: _anew(renderer).render("c2").colour)
+        else:
+            origin = _window_origin(row)
+            image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
+    finally:
+        renderer._merged, renderer._members = kept
     assert image.ndim == 3

@@ -6,8 +6,9 @@ without a GPU, Mesa's software rasteriser). The bush: one directional light plus
 ambient, no shadows; the row: a sun with a shadow map, which a small render (C2, a C1
 window) draws small, at the full map's texel pitch, about what it sees
 (:mod:`softarm.sim.render.shadow_map`). Geoms that cannot show in a render are left out
-of it (:mod:`softarm.sim.render.culling`). Lens distortion is applied afterwards
-(:mod:`softarm.sim.render.distortion`).
+of it (:mod:`softarm.sim.render.culling`), and a small colour render draws the row's
+bush canes as merged meshes of fewer triangles (:mod:`softarm.sim.render.cane_mesh`).
+Lens distortion is applied afterwards (:mod:`softarm.sim.render.distortion`).
 """
 
 from __future__ import annotations
