@@ -135,3 +135,39 @@ def test_a_picked_berry_leaves_the_picture_and_hides_nothing_any_more() -> None:
     assert all(after[t] >= shares[t] - 1e-9 for t in shares if t != tag)
     world.hide_arm()  # the arm's moves and a render's culling leave it removed
     assert not world.labels.mask(world.c1_left(truth=True).geoms, "berry", tag).any()
+
+
+def test_the_arms_geoms_out_of_the_picture_are_left_out_and_nothing_changes() -> None:
+    """In the sunlit row, with the arm bent towards a berry: C2's frame and C1's windows
+    leave out arm geoms (bounded by their sizes, which change as it bends), and draw
+    what they drew with the whole arm drawn, shadows included."""
+    from row_world import sunlit_row_world
+    from softarm.sim.render.renderer import CULLED_GROUP
+
+    world = sunlit_row_world()
+    r = world.renderer
+    try:
+        arm, every = r._arm, r._cullable
+        drawn = []
+        made = r._renderer
+
+        def spy(*args):  # type: ignore[no-untyped-def]
+            drawn.append(r.model.geom_group[arm].copy())
+            return made(*args)
+
+        def draws() -> list[np.ndarray]:
+            r._last.__init__()  # draw anew
+            return [
+                r.render("c2").colour,
+                *(r.render_window("c1_left", o, 96) for o in ((560, 260), (900, 120))),
+            ]
+
+        r._renderer = spy
+        culled = draws()
+        assert any((groups == CULLED_GROUP).any() for groups in drawn)
+        r._cullable = np.setdiff1d(every, arm)  # the arm always drawn, as before
+        for a, b in zip(culled, draws(), strict=True):
+            np.testing.assert_array_equal(a, b)
+    finally:
+        r._renderer, r._cullable = made, every
+        world.close()

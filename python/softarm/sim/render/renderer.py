@@ -146,10 +146,9 @@ class BushRenderer:
         self._leaves = np.flatnonzero(self.labels.kind == KINDS.index("leaf"))
         self._leaf_home = self.model.geom_pos[self._leaves].copy()
         self._leaf_half = self.model.geom_size[self._leaves, 0].copy()
-        # The arm's geoms change size as it bends (their bounding spheres would go
-        # stale): only the rest of the scene is culled.
+        # Every geom may be culled, the arm's by a sphere their sizes bound (_bounds).
         self._groups = self.model.geom_group.copy()
-        self._cullable = np.flatnonzero(self.labels.kind != KINDS.index("arm"))
+        self._cullable = np.arange(self.model.ngeom)
         self._arm = np.flatnonzero(self.labels.kind == KINDS.index("arm"))
         self._backdrop = self.model.geom_rbound > BACKDROP_RADIUS
         self._planes = np.flatnonzero(self.model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
@@ -325,7 +324,7 @@ class BushRenderer:
             m.geom_group[self._members], m.geom_group[self._merged] = CULLED_GROUP, OCCLUDER_GROUP
         cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
         centres = (d.geom_xpos[self._cullable] - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
-        radii = m.geom_rbound[self._cullable]
+        radii = _bounds(m, self._arm)[self._cullable]
         focal = self.cameras[camera].focal
         shown = in_frustum(centres, radii, size, focal, principal)
         local = False
@@ -358,8 +357,7 @@ class BushRenderer:
         backdrop (larger than BACKDROP_RADIUS); the arm's geoms change size as it bends,
         so their size bounds their reach."""
         m, d = self.model, self.data
-        radii = m.geom_rbound.copy()
-        radii[self._arm] = np.maximum(radii[self._arm], m.geom_size[self._arm].sum(axis=1))
+        radii = _bounds(m, self._arm)
         centres = (d.geom_xpos - d.cam_xpos[cam]) @ d.cam_xmat[cam].reshape(3, 3)
         seen = in_frustum(centres, radii, size, focal, principal) & (radii > 0)
         seen &= ~self._backdrop
@@ -412,6 +410,16 @@ class BushRenderer:
         i = self._mocap[body]
         self.data.mocap_pos[i] = pos
         self.data.mocap_quat[i] = quat
+
+
+def _bounds(model: Any, arm: npt.NDArray[np.intp]) -> FloatArray:
+    """Every geom's bounding radius (m) about its centre: MuJoCo's, but for the
+    ``arm``'s geoms, which change size as it bends (MuJoCo's radius is the built
+    size's), the larger of it and the sum of their sizes (a capsule's radius and
+    half-length, a box's half-sides: a sphere about the centre holding the geom)."""
+    radii: FloatArray = model.geom_rbound.copy()
+    radii[arm] = np.maximum(radii[arm], model.geom_size[arm].sum(axis=1))
+    return radii
 
 
 def _sized(r: Any, mj: Any, w: int, h: int) -> Any:
