@@ -228,7 +228,9 @@ class HarvestMachine:
             try:
                 self.servo.place(watch, self.state, self.q, self.axis, waypoints)
                 self._transition(HarvestState.FINE_POSITIONING, berry, "pre-grasp pose reached")
-                self.servo.fine(watch, self.state, self.q, self.axis, policy.grasp_within())
+                self.servo.fine(
+                    watch, self.state, self.q, self.axis, policy.grasp_within(), policy.more()
+                )
                 return waypoints
             except Fault as fault:
                 if fault.retreat_from is None:

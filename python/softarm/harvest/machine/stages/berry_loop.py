@@ -14,8 +14,14 @@ from softarm.harvest.machine.interfaces import BerryFix, FloatArray, Observation
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault, StageOutcome
 from softarm.harvest.machine.stages.arm_link import ArmLink
-from softarm.harvest.machine.stages.end_rules import lost_near, settled_or_out_of_time, stalled
+from softarm.harvest.machine.stages.end_rules import (
+    jumpy,
+    lost_near,
+    settled_or_out_of_time,
+    stalled,
+)
 from softarm.harvest.machine.stages.goal import Aim, Progress, ServoGoal
+from softarm.harvest.machine.stages.jumps import JumpCounter
 from softarm.harvest.machine.states import HarvestState
 from softarm.harvest.machine.targets import grasp_point, pointing_error, tool_pose
 
@@ -38,6 +44,7 @@ class BerryLoop:
         start = self.link.clock.now()
         watch.excuse_berry(start)  # the open-loop ramp needed no berry
         progress = Progress(start)
+        jumps = None if goal.give_up is None else JumpCounter()
         last: Aim | None = None  # this stage's last measured aim
         while True:
             try:
@@ -59,6 +66,9 @@ class BerryLoop:
             )  # fmt: skip
             if ended is not None:
                 return ended
+            if jumps is not None:
+                self._count_jump(jumps, seen, aim, axis, goal.distance)
+                jumpy(self.link, stage, seen, q, aim, jumps.jumps, goal)
             q_next, saturated = self._loop_step(q, aim.goal, seen.pose)
             progress.update(seen.t, aim.error, saturated, self.link.cfg.stall_progress)
             if progress.stalled(seen.t, self.link.cfg.stall_time):
@@ -76,6 +86,23 @@ class BerryLoop:
         goal = tool_pose(seen.pose, point, axis, offset)
         error = float(np.linalg.norm(grasp_point(seen.pose, offset) - point))
         return Aim(goal, error, pointing_error(seen.pose, axis))
+
+    def _count_jump(
+        self, jumps: JumpCounter, seen: Observation, aim: Aim, axis: FloatArray, distance: float
+    ) -> None:
+        """Give ``jumps`` this step's measured offset of the grasp point from its goal and
+        where the model puts the grasp point at the lag model's q (the q sent less the
+        motion in flight); a jump is logged (``measurement_jump``)."""
+        assert seen.pose is not None and seen.fix is not None
+        offset = self.link.cfg.grasp_offset
+        point = seen.fix.position - (distance - offset) * axis
+        flight = self.link.actuator.in_flight()
+        q_arm = self.link.actuator.sent - (0.0 if flight is None else flight)
+        model = grasp_point(self.link.controller.model_pose(q_arm), offset)
+        before = jumps.jumps
+        residual = jumps.see(grasp_point(seen.pose, offset) - point, model)
+        if jumps.jumps > before:
+            self.link.log.event("measurement_jump", t=seen.t, residual_m=residual, error=aim.error)
 
     def _ahead(self, seen: Observation, axis: FloatArray, goal: ServoGoal, aim: Aim) -> Aim:
         """The aim a stage with ``goal.ahead`` ends on: the measured pose carried by the

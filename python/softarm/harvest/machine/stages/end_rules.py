@@ -19,7 +19,14 @@ from softarm.harvest.machine.stages.arm_link import ArmLink
 from softarm.harvest.machine.stages.goal import Aim, Progress, ServoGoal
 from softarm.harvest.machine.states import FaultReason, HarvestState
 
-__all__ = ["Estimate", "confidently_within", "lost_near", "settled_or_out_of_time", "stalled"]
+__all__ = [
+    "Estimate",
+    "confidently_within",
+    "jumpy",
+    "lost_near",
+    "settled_or_out_of_time",
+    "stalled",
+]
 
 #: The grasp error estimated from the last ``samples`` measurements: the norm of their
 #: mean offset (m) and its upper confidence bound (m).
@@ -135,6 +142,29 @@ def _bound(design: FloatArray, offsets: FloatArray, confidence: float) -> tuple[
 def _t_quantile(confidence: float, dof: int) -> float:
     """Student's t two-sided ``confidence`` quantile at ``dof`` degrees of freedom."""
     return float(stats.t.ppf(0.5 + 0.5 * confidence, dof))
+
+
+def jumpy(
+    link: ArmLink, stage: HarvestState, seen: Observation, q: FloatArray, aim: Aim,
+    jumps: int, goal: ServoGoal,
+) -> None:  # fmt: skip
+    """After ``goal.give_up`` jumps of the measurement (:class:`~softarm.harvest.
+    machine.stages.jumps.JumpCounter`; fine positioning with another axis left),
+    UNREACHABLE: the arm backs out and approaches along another axis of the cone, from
+    which C1 sees the cube from another side. A jumping measurement does not say where
+    the arm is: the attempt counts as ending at the edge of the gripper's reach
+    (``grasp_workspace``), to come back to only as the nearest attempt would be (no
+    other axis planned, or the last one stalled farther out), and then to grasp within
+    that reach at the budget, as without a re-approach."""
+    if goal.give_up is None or jumps < goal.give_up:
+        return
+    link.log.event("jumpy_axis", t=seen.t, jumps=jumps, error=aim.error)
+    raise Fault(
+        FaultReason.UNREACHABLE,
+        f"{stage.value}: the measurement jumped {jumps} times on this axis",
+        retreat_from=q,
+        grasp_error=link.cfg.grasp_workspace,
+    )
 
 
 def stalled(

@@ -28,6 +28,10 @@ class ServoGoal:
     sent put the arm once it has caught up (the lag model's motion in flight carried
     through the model), not on where it is measured now: the next stage goes on from
     there while the arm is still on its way (docs/harvest.md, 'The moves');
+    ``give_up`` (fine positioning with another axis left to try): after this many jumps
+    of the measured grasp error (:class:`~softarm.harvest.machine.stages.jumps.
+    JumpCounter`) the axis is given up, UNREACHABLE, to re-approach along another
+    (None: never, and the jumps are not counted);
     ``ahead_within`` (m): only once the arm is also measured this near the goal. The
     back-out's: the way home, begun with most of the back-out still in flight, cut the
     corner from the approach line towards home, 6 mm from a cane (diagnosis seed 1347);
@@ -44,6 +48,7 @@ class ServoGoal:
     frozen: FloatArray | None = None
     ahead: bool = False
     ahead_within: float = float("inf")
+    give_up: int | None = None
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from softarm.harvest.machine.states import FaultReason, HarvestState
 from softarm.harvest.records.log import HarvestLog
 from softarm.harvest_config import HarvestConfig
 
-__all__ = ["BACK_OUT_AHEAD_WITHIN", "Fault", "Servo"]
+__all__ = ["BACK_OUT_AHEAD_WITHIN", "FINE_GIVE_UP", "Fault", "Servo"]
 
 #: How near (m) the pre-grasp pose the back-out must measure the arm before it may end on
 #: where the commands already sent put it (:class:`ServoGoal` ``ahead_within``): the way
@@ -33,6 +33,12 @@ __all__ = ["BACK_OUT_AHEAD_WITHIN", "Fault", "Servo"]
 #: plan checked clear of the canes. Ended ahead from farther out, the way home cut the
 #: corner from the approach line to 5.4 mm from a cane (fresh seed 1356).
 BACK_OUT_AHEAD_WITHIN = 0.02
+
+#: After how many jumps of the measured grasp error (:mod:`.jumps`) fine positioning gives
+#: its approach axis up while another is left to try: on diagnosis seeds 1410-1419 a
+#: berry C1 saw well gave 0-2 in its whole fine positioning, one it did not 10 within
+#: 0.9-1.7 s, and 12 s of them after.
+FINE_GIVE_UP = 10
 
 
 class Servo:
@@ -134,16 +140,23 @@ class Servo:
         q: FloatArray,
         axis: FloatArray,
         grasp_within: float | None = None,
+        another_axis: bool = False,
     ) -> StageOutcome:
         """FINE_POSITIONING: grasp point onto the berry (eye-in-hand, eq. 21).
 
         Saturated on a joint limit without progress, or past ``fine_budget``, it grasps
         inside the gripper's ±1 cm (III-D), or only within ``grasp_within`` (m) when the
         machine has a better use for the arm (another axis to try, an earlier attempt
-        that ended nearer): farther out it is UNREACHABLE here, with the error."""
+        that ended nearer): farther out it is UNREACHABLE here, with the error. With
+        ``another_axis`` left to try, ``FINE_GIVE_UP`` jumps of the measured error
+        (:mod:`.jumps`: C1 does not see the cube well from this axis) give the axis up,
+        UNREACHABLE, at once."""
         c = self.link.cfg
         within = c.grasp_workspace if grasp_within is None else grasp_within
-        fine = ServoGoal(c.grasp_offset, c.fine_tolerance, c.fine_timeout, c.fine_budget, within)
+        fine = ServoGoal(
+            c.grasp_offset, c.fine_tolerance, c.fine_timeout, c.fine_budget, within,
+            give_up=FINE_GIVE_UP if another_axis else None,
+        )  # fmt: skip
         return self.berry_loop.run(watch, stage, q, axis, fine)
 
     def go_home(
