@@ -14,7 +14,7 @@ from softarm.experiments.detector_eval import run
 from softarm.perception.berries import DetectorSettings, detect_berries
 from softarm.perception.detector.instances import instances
 from softarm.perception.detector.network import CLASSES, NetworkOutput
-from softarm.perception.detector.touching import NECK, disc_seeds, split_discs
+from softarm.perception.detector.touching import NECK, _distance, disc_seeds, split_discs
 from softarm.vision.camera_model import CameraModel
 
 CAMERA = CameraModel.ideal(600.0, W, H)
@@ -122,3 +122,19 @@ def test_the_evaluation_scores_the_split_as_an_option(tmp_path: Path) -> None:
     split = run({"drawn": tmp_path}, settings=SPLIT)["drawn"]["colour"]
     assert whole["recall_ripe"] == pytest.approx(2 / 3, abs=1e-3)  # the pair: one matched
     assert split["recall_ripe"] == 1.0 and split["precision"] == 1.0
+
+
+def test_the_distance_map_is_exact_so_peaks_do_not_change_from_run_to_run() -> None:
+    # OpenCV's float distance differs in its last bit with the buffer's alignment, which
+    # flipped ties between neighbouring peaks from one run to the next: each value must be
+    # the correctly rounded root of the integer squared distance, whatever the buffer.
+    yy, xx = np.mgrid[:60, :90]  # a size at which OpenCV's last bits were seen to vary
+    blob = ((xx - 30) ** 2 + (yy - 30) ** 2 <= 400) | ((xx - 60) ** 2 + (yy - 30) ** 2 <= 400)
+    for offset in range(4):
+        buffer = np.zeros(blob.size + offset, bool)
+        shifted = buffer[offset:].reshape(blob.shape)
+        shifted[:] = blob
+        d = _distance(shifted)
+        exact = np.sqrt(np.rint(d.astype(np.float64) ** 2)).astype(np.float32)
+        assert np.array_equal(d, exact)
+        assert disc_seeds(shifted, 2.5) == disc_seeds(blob, 2.5)

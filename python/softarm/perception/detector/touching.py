@@ -44,8 +44,13 @@ def _distance(mask: npt.NDArray[np.bool_]) -> _F32:
     """The distance (px) of each pixel of ``mask`` to the nearest pixel outside it, the
     mask's own border counting as outside."""
     padded = np.pad(mask, 1).astype(np.uint8)
-    dist = cv2.distanceTransform(padded, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-    return cast(_F32, dist[1:-1, 1:-1])
+    dist = cv2.distanceTransform(padded, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+    # The exact Euclidean distance is the root of an integer; OpenCV's float differs in
+    # its last bit from call to call (with the buffer's alignment), which flipped ties
+    # between neighbours, and so peaks, from one run to the next. Rounded to that
+    # integer first, the map is the same every time.
+    squared = np.rint(dist.astype(np.float64) ** 2)
+    return cast(_F32, np.sqrt(squared).astype(np.float32))
 
 
 def _saddle(dist: _F32, a: tuple[int, int], b: tuple[int, int]) -> float:
