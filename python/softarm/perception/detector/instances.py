@@ -1,7 +1,8 @@
 """From the network's per-pixel output to berries: fruit pixels (ripe, turning and unripe
 together) split into connected parts; a part with two or more peaks of the centre
-heatmap (fruit that touch) is split between them, each pixel going to its nearest peak;
-each instance's stage is the stage most of its pixels' probability says. Everything runs
+heatmap (fruit that touch) is split between them, each pixel going to its nearest peak
+(or, with ``DetectorSettings.split_touching``, at the necks of the part's shape:
+:mod:`.touching`); each instance's stage is the stage most of its pixels' probability says. Everything runs
 at the network's resolution; each instance's mask is then resized to the image, and
 placed and sized as :mod:`softarm.perception.berries` places and sizes its blobs."""
 
@@ -109,7 +110,7 @@ Piece = tuple[npt.NDArray[np.bool_], int, int]
 
 
 def instance_masks(
-    output: NetworkOutput, fruit: npt.NDArray[np.float32], split: bool = True
+    output: NetworkOutput, fruit: npt.NDArray[np.float32], split: bool = False
 ) -> list[Piece]:
     """The fruit instances at the network's resolution (``fruit``: output.fruit()), fruit
     that touch split at the necks of their part's distance map (``split``) or at the
