@@ -2,9 +2,10 @@
 together) split into connected parts; a part with two or more peaks of the centre
 heatmap (fruit that touch) is split between them, each pixel going to its nearest peak
 (or, with ``DetectorSettings.split_touching``, at the necks of the part's shape:
-:mod:`.touching`); each instance's stage is the stage most of its pixels' probability says. Everything runs
-at the network's resolution; each instance's mask is then resized to the image, and
-placed and sized as :mod:`softarm.perception.berries` places and sizes its blobs."""
+:mod:`.touching`); each instance's stage is the stage most of its pixels' probability
+says. Everything runs at the network's resolution; each instance's mask is then
+resized to the image, and placed and sized as :mod:`softarm.perception.berries` places
+and sizes its blobs."""
 
 from __future__ import annotations
 
