@@ -14,7 +14,7 @@ from softarm.harvest import BerryTarget, HarvestConfig, HarvestState
 from softarm.harvest.machine.stages.jumps import JumpCounter
 from softarm.harvest.machine.stages.servo import FINE_GIVE_UP
 
-from .fakes import BERRIES, make_rig
+from .fakes import BERRIES, Rig, make_rig
 from .test_reapproach import SQUARE, TILTED, AxisPlanner
 
 S = HarvestState
@@ -44,7 +44,7 @@ def test_a_pose_that_flips_away_while_the_arm_holds_is_a_jump() -> None:
     assert counter.jumps == 4
 
 
-def _rig(axes: list[np.ndarray], reapproaches: int = 1):
+def _rig(axes: list[np.ndarray], reapproaches: int = 1) -> Rig:
     """The fake rig with a planner along ``axes``; C1's pose of the arm flips 4 mm along
     y every other frame while the grasp point is within 2 cm of the berry AND the arm
     faces it square (the axis from which C1 sees the cube badly)."""
@@ -70,7 +70,7 @@ def _rig(axes: list[np.ndarray], reapproaches: int = 1):
     return rig
 
 
-def _fine_seconds(rig) -> list[float]:
+def _fine_seconds(rig: Rig) -> list[float]:
     """Each fine positioning's duration (s), in order."""
     recs = [r for r in rig.machine.log.records if r["kind"] == "transition"]
     starts = [r["t"] for r in recs if r["new"] == S.FINE_POSITIONING]
