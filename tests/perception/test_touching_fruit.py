@@ -4,6 +4,7 @@ network's instances, and never a lone fruit."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -138,3 +139,23 @@ def test_the_distance_map_is_exact_so_peaks_do_not_change_from_run_to_run() -> N
         exact = np.sqrt(np.rint(d.astype(np.float64) ** 2)).astype(np.float32)
         assert np.array_equal(d, exact)
         assert disc_seeds(shifted, 2.5) == disc_seeds(blob, 2.5)
+
+
+def test_detect_and_evaluate_split_touching_fruit_on_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from softarm.cli import main
+
+    pair = [("ripe", disc(50, 60, 9), True), ("ripe", disc(68, 60, 9), True)]
+    labels = write_folder(tmp_path, [pair])
+    image = next((tmp_path / "images").iterdir())
+    counts = []
+    for extra in ([], ["--split-touching"]):
+        assert main(["detect", str(image), "--detector", "colour", *extra]) == 0
+        counts.append(capsys.readouterr().out.strip().splitlines()[-1])
+        args = ["detector", "evaluate", "--images", str(tmp_path / "images")]
+        assert main([*args, "--labels", str(labels), "--detector", "colour", "-q", *extra]) == 0
+        shown = capsys.readouterr().out.split("\ndetector evaluate")[0]
+        counts.append(str(json.loads(shown)["recall_ripe"]))
+    assert counts[0].startswith("detect: 1 berries") and counts[1] == "0.5"
+    assert counts[2].startswith("detect: 2 berries") and counts[3] == "1.0"

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
 from softarm.commands._args import image_file
+
+if TYPE_CHECKING:
+    from softarm.perception.detector.choice import BerryDetector
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -28,7 +31,26 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--camera", type=Path, help="camera file of the photo")
     p.add_argument("--out", type=image_file, help="write the annotated picture here")
     p.add_argument("--detector", choices=DETECTORS, default=DEFAULT_DETECTOR, help="detector")
+    add_split_touching(p)
     p.set_defaults(run=run)
+
+
+def add_split_touching(p: argparse.ArgumentParser) -> None:
+    """The ``--split-touching`` option of ``detect`` and ``detector evaluate``."""
+    p.add_argument(
+        "--split-touching",
+        action="store_true",
+        help="split fruit that touch at the necks of their shape (more of a cluster's fruit "
+        "found, some precision lost; docs/perception.md, 'Splitting touching fruit')",
+    )
+
+
+def chosen_detector(args: argparse.Namespace) -> BerryDetector:
+    """The detector ``--detector`` names, with ``--split-touching`` applied."""
+    from softarm.perception.detector.choice import SPLIT_TOUCHING, WithSettings, detector
+
+    det = detector(args.detector)
+    return WithSettings(det, SPLIT_TOUCHING) if args.split_touching else det
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,7 +60,6 @@ def run(args: argparse.Namespace) -> int:
     import numpy.typing as npt
 
     from softarm.errors import InputError
-    from softarm.perception.detector.choice import detector
     from softarm.perception.detector.draw import draw_detections, write_image
     from softarm.perception.detector.evaluate import read_depth
     from softarm.perception.detector.scoring import stage_of_detection
@@ -59,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(
                 f"--depth {args.depth}: not a 16-bit PNG or .npy of the image's size {w}x{h}"
             )
-    dets = list(detector(args.detector).detect_berries(image, camera, depth))
+    dets = list(chosen_detector(args).detect_berries(image, camera, depth))
     stages = [stage_of_detection(d) for d in dets]
     for d, stage in zip(dets, stages, strict=True):
         where = "" if d.position is None else " at ({:.3f}, {:.3f}, {:.3f}) m".format(*d.position)

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from softarm.commands._args import add_quiet, int_range, output_dir, output_file
+from softarm.commands.detect import add_split_touching
 
 #: Most epochs a user may ask for (a typo's extra zeros, not a real run).
 MAX_EPOCHS = 10_000
@@ -49,6 +50,7 @@ def _add_evaluate(actions: argparse._SubParsersAction[argparse.ArgumentParser]) 
     e.add_argument("--camera", type=Path, help="camera file")
     e.add_argument("--out", type=output_dir, help="folder for metrics.json and the pictures")
     e.add_argument("--detector", choices=DETECTORS, default=DEFAULT_DETECTOR, help="detector")
+    add_split_touching(e)
     add_quiet(e)
     e.set_defaults(run=run_evaluate)
 
@@ -105,11 +107,11 @@ def _numbers(kind: type[int] | type[float], count: int) -> Callable[[str], tuple
 def run_evaluate(args: argparse.Namespace) -> int:
     """Exit 0 with the figures printed (and written with --out)."""
     from softarm.commands._progress import Progress
-    from softarm.perception.detector.choice import detector
+    from softarm.commands.detect import chosen_detector
     from softarm.perception.detector.evaluate import evaluate
     from softarm.vision.camera_model import CameraModel
 
-    det = detector(args.detector)
+    det = chosen_detector(args)
     camera = None if args.camera is None else CameraModel.load(args.camera)
     with Progress(None, "evaluate", "image", args.quiet) as progress:
         figures = evaluate(
