@@ -86,6 +86,15 @@ def _window_origin(world: Any) -> tuple[int, int]:
     return int(u - WINDOW / 2), int(v - WINDOW / 2)
 
 
+def _timed(benchmark: Any, row: Any, view: str) -> Any:
+    """``view`` of ``row`` (C2's frame or C1's window at the berry) drawn anew each round."""
+    renderer = row.renderer
+    if view == "c2":
+        return benchmark(lambda: _anew(renderer).render("c2").colour)
+    origin = _window_origin(row)
+    return benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
+
+
 @pytest.mark.parametrize("shadow_map", ["small", "full"])
 @pytest.mark.parametrize("view", ["c2", "c1_window"])
 def test_row_small_render(benchmark, row: Any, view: str, shadow_map: str) -> None:  # type: ignore[no-untyped-def]
@@ -94,11 +103,7 @@ def test_row_small_render(benchmark, row: Any, view: str, shadow_map: str) -> No
     if shadow_map == "full":
         renderer._sun.place = lambda *a: False
     try:
-        if view == "c2":
-            image = benchmark(lambda: _anew(renderer).render("c2").colour)
-        else:
-            origin = _window_origin(row)
-            image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
+        image = _timed(benchmark, row, view)
     finally:
         renderer._sun.place = place
     assert image.ndim == 3
@@ -106,13 +111,7 @@ def test_row_small_render(benchmark, row: Any, view: str, shadow_map: str) -> No
 
 @pytest.mark.parametrize("view", ["c2", "c1_window"])
 def test_row_small_render_fine_ground(benchmark, fine_ground_row: Any, view: str) -> None:  # type: ignore[no-untyped-def]
-    renderer = fine_ground_row.renderer
-    if view == "c2":
-        image = benchmark(lambda: _anew(renderer).render("c2").colour)
-    else:
-        origin = _window_origin(fine_ground_row)
-        image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
-    assert image.ndim == 3
+    assert _timed(benchmark, fine_ground_row, view).ndim == 3
 
 
 @pytest.mark.parametrize("view", ["c2", "c1_window"])
@@ -121,11 +120,7 @@ def test_row_small_render_capsule_canes(benchmark, row: Any, view: str) -> None:
     kept = renderer._merged, renderer._members
     renderer._merged = renderer._members = np.zeros(0, np.int64)  # the capsules drawn
     try:
-        if view == "c2":
-            image = benchmark(lambda: _anew(renderer).render("c2").colour)
-        else:
-            origin = _window_origin(row)
-            image = benchmark(lambda: _anew(renderer).render_window("c1_left", origin, WINDOW))
+        image = _timed(benchmark, row, view)
     finally:
         renderer._merged, renderer._members = kept
     assert image.ndim == 3

@@ -77,19 +77,9 @@ def _peaks(centres: npt.NDArray[np.float32], part: npt.NDArray[np.bool_]) -> lis
 def _split(
     part: npt.NDArray[np.bool_], peaks: list[tuple[int, int]]
 ) -> list[npt.NDArray[np.bool_]]:
-    """``part`` divided between its ``peaks`` (each pixel to the nearest)."""
-    if len(peaks) < 2:
-        return [part]
-    rows, cols = np.nonzero(part)
-    seeds = np.asarray(peaks, float)
-    d = (rows[:, None] - seeds[None, :, 0]) ** 2 + (cols[:, None] - seeds[None, :, 1]) ** 2
-    owner = np.argmin(d, axis=1)
-    out = []
-    for k in range(len(peaks)):
-        m = np.zeros_like(part)
-        m[rows[owner == k], cols[owner == k]] = True
-        out.append(m)
-    return out
+    """``part`` divided between its ``peaks`` (each pixel to the nearest: discs of no
+    radius)."""
+    return split_discs(part, [(float(r), float(c), 0.0) for r, c in peaks])
 
 
 def _pieces(
