@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, cast
 from softarm.commands._args import image_file
 
 if TYPE_CHECKING:
-    from softarm.perception.detector.choice import BerryDetector
+    from softarm.perception.berries import DetectorSettings
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -45,12 +45,11 @@ def add_split_touching(p: argparse.ArgumentParser) -> None:
     )
 
 
-def chosen_detector(args: argparse.Namespace) -> BerryDetector:
-    """The detector ``--detector`` names, with ``--split-touching`` applied."""
-    from softarm.perception.detector.choice import SPLIT_TOUCHING, WithSettings, detector
+def split_settings(args: argparse.Namespace) -> DetectorSettings | None:
+    """The detector's settings ``--split-touching`` asks for (None: its own)."""
+    from softarm.perception.detector.choice import SPLIT_TOUCHING
 
-    det = detector(args.detector)
-    return WithSettings(det, SPLIT_TOUCHING) if args.split_touching else det
+    return SPLIT_TOUCHING if args.split_touching else None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -60,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy.typing as npt
 
     from softarm.errors import InputError
+    from softarm.perception.detector.choice import detector
     from softarm.perception.detector.draw import draw_detections, write_image
     from softarm.perception.detector.evaluate import read_depth
     from softarm.perception.detector.scoring import stage_of_detection
@@ -80,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(
                 f"--depth {args.depth}: not a 16-bit PNG or .npy of the image's size {w}x{h}"
             )
-    dets = list(chosen_detector(args).detect_berries(image, camera, depth))
+    found = detector(args.detector).detect_berries(image, camera, depth, split_settings(args))
+    dets = list(found)
     stages = [stage_of_detection(d) for d in dets]
     for d, stage in zip(dets, stages, strict=True):
         where = "" if d.position is None else " at ({:.3f}, {:.3f}, {:.3f}) m".format(*d.position)

@@ -107,16 +107,18 @@ def _numbers(kind: type[int] | type[float], count: int) -> Callable[[str], tuple
 def run_evaluate(args: argparse.Namespace) -> int:
     """Exit 0 with the figures printed (and written with --out)."""
     from softarm.commands._progress import Progress
-    from softarm.commands.detect import chosen_detector
+    from softarm.commands.detect import split_settings
+    from softarm.perception.detector.choice import detector
     from softarm.perception.detector.evaluate import evaluate
     from softarm.vision.camera_model import CameraModel
 
-    det = chosen_detector(args)
+    det = detector(args.detector)
     camera = None if args.camera is None else CameraModel.load(args.camera)
     with Progress(None, "evaluate", "image", args.quiet) as progress:
         figures = evaluate(
-            det, args.labels, args.images, args.depth, camera, args.out, progress.advance
-        )
+            det, args.labels, args.images, args.depth, camera, args.out, progress.advance,
+            split_settings(args),
+        )  # fmt: skip
     shown = {k: v for k, v in figures.items() if k != "per_image"}
     print(json.dumps(shown, indent=1))
     if args.out is not None:

@@ -9,7 +9,6 @@ C2's vision (:mod:`softarm.perception.bush_vision`) call :func:`detect_berries` 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -25,7 +24,6 @@ __all__ = [
     "DETECTORS",
     "SPLIT_TOUCHING",
     "BerryDetector",
-    "WithSettings",
     "current_detector",
     "detect_berries",
     "detector",
@@ -74,29 +72,6 @@ class _Colour:
         self, image: npt.NDArray[np.uint8], settings: DetectorSettings | None = None
     ) -> _U8:
         return berries.fruit_mask(image, settings)
-
-
-@dataclass(frozen=True)
-class WithSettings:
-    """``base`` run with ``settings`` wherever its caller gives none (``softarm detect``
-    and ``softarm detector evaluate`` with ``--split-touching``)."""
-
-    base: BerryDetector
-    settings: DetectorSettings
-
-    def detect_berries(
-        self,
-        image: npt.NDArray[np.uint8],
-        camera: CameraModel,
-        depth: npt.NDArray[np.floating] | None = None,
-        settings: DetectorSettings | None = None,
-    ) -> Sequence[BerryDetection]:
-        return self.base.detect_berries(image, camera, depth, settings or self.settings)
-
-    def fruit_mask(
-        self, image: npt.NDArray[np.uint8], settings: DetectorSettings | None = None
-    ) -> _U8:
-        return self.base.fruit_mask(image, settings or self.settings)
 
 
 #: Fruit that touch split at the necks of their shape (docs/perception.md, "Splitting

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import InputError
-from softarm.perception.berries import _position
+from softarm.perception.berries import DetectorSettings, _position
 from softarm.perception.detector.choice import BerryDetector
 from softarm.perception.detector.draw import draw_detections, write_image
 from softarm.perception.detector.labels import LabelledImage, LabelledObject, read_coco
@@ -90,9 +90,11 @@ def evaluate(
     camera: CameraModel | None = None,
     out: str | Path | None = None,
     on_image: Callable[[], None] = lambda: None,
+    settings: DetectorSettings | None = None,
 ) -> dict[str, Any]:
-    """The figures of ``detector`` on the labelled images (also written to
-    OUT/metrics.json with one annotated picture per image when ``out`` is given).
+    """The figures of ``detector`` (with ``settings``; None: its own) on the labelled
+    images (also written to OUT/metrics.json with one annotated picture per image when
+    ``out`` is given).
 
     Raises:
         InputError: the labels cannot be read, or name no image found in ``images``.
@@ -108,7 +110,7 @@ def evaluate(
             continue
         cam = _camera(item, camera)
         d = None if depth is None else read_depth(Path(depth), item.path, image.shape[:2])
-        dets = list(detector.detect_berries(image, cam, d))
+        dets = list(detector.detect_berries(image, cam, d, settings))
         fruit = [o for o in item.objects() if o.is_fruit]
         pairs = tally.add(dets, fruit, _truth(fruit, cam, d))
         per_image.append({"image": item.path.name, "detections": len(dets), "matched": len(pairs)})
