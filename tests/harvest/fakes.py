@@ -148,7 +148,7 @@ class FakeController:
     def limits(self) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros(3), np.full(3, Q_MAX)
 
-    def way_gaps(self, q0: np.ndarray, q1: np.ndarray) -> None:
+    def way_gaps(self, q0: np.ndarray, q1: np.ndarray, steps: int = 8) -> None:
         return None  # no known canes
 
 

@@ -126,6 +126,15 @@ def test_inside_the_margin_the_way_may_close_in_on_a_cane_only_by_the_slack() ->
     assert servo.transport.clear_way(q, (nearer_by_twice_the_slack,)) is q
 
 
+def test_a_whole_way_is_clear_only_if_every_periods_step_of_it_is() -> None:
+    q = np.array([0.45, 0.0])
+    servo = _servo(_CaneAtHalf(), flight=np.array([0.25, 0.0]))  # the arm is at 0.2
+    assert servo.transport.way_clear(q, np.array([0.3, 0.0]))
+    # Its ends are both clear of the cane, the way between them is not.
+    assert not servo.transport.way_clear(q, np.array([0.8, 0.0]))
+    assert _servo(FakeController(), flight=None).transport.way_clear(q, np.array([0.8, 0.0]))
+
+
 def test_a_controller_without_known_canes_takes_the_first_command() -> None:
     q = np.array([0.45, 0.0])
     first = np.array([0.8, 0.0])

@@ -112,6 +112,21 @@ def test_a_lagging_arm_harvests_a_fresh_bush_without_touching_a_cane(tmp_path) -
     assert report.success_rate >= 7 / 8
 
 
+def test_the_way_home_keeps_the_plans_waypoint_where_the_straight_way_is_not_clear() -> None:
+    # Seed 1432's first berry (a diagnosis seed): the back-out left the arm at the
+    # pre-grasp pose a few mm of elongation off the plan's q, and from there the straight
+    # way home ran into a cane within one step (model gap 45 mm -> 1 mm). The way home
+    # then held its first command for the whole home timeout (10 s) and ramped home open
+    # loop, unchecked, touching the cane. The way home now passes the plan's q, whose way
+    # home the plan checked.
+    rig = build_sim_rig(SimRigOptions(n_berries=6, seed=1432))
+    result = rig.machine.run_berry(_target(rig))
+    assert result.harvested
+    kinds = [r["kind"] for r in rig.machine.log.records]
+    assert "return_open_loop" not in kinds and "transport_held" not in kinds
+    assert rig.watch.contacts == 0
+
+
 def _on_a_slow_plant(tmp_path, n_berries: int, seed: int):  # type: ignore[no-untyped-def]
     """Harvest a bush on a 1 s / 5 psi plant (the nominal model, not calibrated):
     ``(rig, report, the kinds of the log's records)``."""

@@ -83,9 +83,10 @@ class Controller(Protocol):
         """The model's (lower, upper) elongations (m), which every command stays inside."""
         ...
 
-    def way_gaps(self, q0: FloatArray, q1: FloatArray) -> FloatArray | None:
+    def way_gaps(self, q0: FloatArray, q1: FloatArray, steps: int = 8) -> FloatArray | None:
         """The model arm's gaps (m) to the known canes along the straight line ``q0`` to
-        ``q1`` in actuator space, ends included; None when no canes are known."""
+        ``q1`` in actuator space at ``steps`` points, ends included; None when no canes
+        are known."""
         ...
 
 

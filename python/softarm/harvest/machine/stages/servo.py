@@ -184,12 +184,15 @@ class Servo:
             )  # fmt: skip
             backed = self.berry_loop.run(watch, stage, q, axis, back_out)
             q = backed.q
-            if backed.ending is Ending.SETTLED and waypoints:
+            after = waypoints[-2] if len(waypoints) > 1 else home
+            if backed.ending is Ending.SETTLED and waypoints and self.transport.way_clear(q, after):
                 # The back-out has the arm at the pre-grasp pose, the plan's last
                 # waypoint, measured on the berry (or within 2 cm of it with the commands
                 # sent putting it there): the way home starts at the leg after it. Sent
                 # back to the plan's q there first, the arm moved by the model's error
-                # (1-4 cm on a slow plant) and waited to arrive.
+                # (1-4 cm on a slow plant) and waited to arrive. Where the straight way
+                # on from the arm's q is not clear of the canes (the plan checked its
+                # own q's), the plan's q stays the first leg.
                 waypoints = waypoints[:-1]
         except Fault as fault:
             # Backing out is best effort: the berry is already in the fingers (or the

@@ -227,13 +227,34 @@ class Transport:
         flight = self.link.actuator.in_flight()
         arm_q = q if flight is None else q - flight
         for candidate in candidates:
-            gaps = self.link.controller.way_gaps(arm_q, candidate)
-            if gaps is None:
-                return candidate
-            need = min(self.link.cfg.transport_margin, gaps[0] - WAY_SLACK)
-            if float(np.min(gaps)) >= need:
+            if self._clear(arm_q, candidate):
                 return candidate
         return q
+
+    def way_clear(self, q: FloatArray, goal: FloatArray) -> bool:
+        """Whether the whole straight way in actuator space from where the lag model has
+        the arm (``q`` less the motion in flight) to ``goal`` keeps clear of the canes by
+        :meth:`clear_way`'s rule, checked at every period's step of it: a leg that is
+        not would hold :meth:`follow` at its first step (each step comes nearer to a cane
+        than the arm is) until the way home's timeout, and the open-loop ramp after it
+        checks no cane (tag-world seed 1432: 10 s held, then a contact)."""
+        flight = self.link.actuator.in_flight()
+        arm_q = q if flight is None else q - flight
+        c = self.link.cfg
+        most = float(np.max(np.abs(np.asarray(goal) - arm_q), initial=0.0))
+        steps = max(8, math.ceil(most / (c.home_speed * c.period)) + 1)
+        return self._clear(arm_q, goal, steps)
+
+    def _clear(self, arm_q: FloatArray, candidate: FloatArray, steps: int | None = None) -> bool:
+        """:meth:`clear_way`'s rule for one straight way from ``arm_q`` to ``candidate``,
+        checked at ``steps`` points (the controller's own count by default; True without
+        known canes)."""
+        way_gaps = self.link.controller.way_gaps
+        gaps = way_gaps(arm_q, candidate) if steps is None else way_gaps(arm_q, candidate, steps)
+        if gaps is None:
+            return True
+        need = min(self.link.cfg.transport_margin, float(gaps[0]) - WAY_SLACK)
+        return float(np.min(gaps)) >= need
 
     def ramp(
         self,
