@@ -327,3 +327,78 @@ def test_train_from_a_file_that_is_no_network_is_one_line(tmp_path: Path) -> Non
     assert done.returncode == 2
     err = done.stderr.strip().splitlines()
     assert len(err) == 1 and "bad.onnx" in err[0]
+
+
+@NEEDS_JAX
+def test_a_stem_network_runs_in_opencv_as_in_jax_at_half_size(tmp_path: Path) -> None:
+    done = _in_child(
+        """
+        import sys
+        import cv2
+        import jax.numpy as jnp
+        import numpy as np
+        from softarm.perception.detector.network import RUN_SIDE, Network, normalise
+        from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
+        from softarm.perception.detector.train.unet import apply, init_params, stem_of
+
+        params = init_params(4, (4, 6, 8, 10), stem=True)
+        export_onnx(params, sys.argv[1])
+        assert stem_of(params_from_onnx(sys.argv[1])) and not stem_of(init_params(4))
+        image = np.random.default_rng(0).integers(0, 256, (48, 64, 3), np.uint8)
+        x = normalise(image)
+        jax_out = np.asarray(apply(params, jnp.asarray(x[None])))[0]
+        net = cv2.dnn.readNetFromONNX(sys.argv[1])
+        net.setInput(np.ascontiguousarray(x.transpose(2, 0, 1)[None]))
+        cv_out = net.forward()[0].transpose(1, 2, 0)
+        assert jax_out.shape == cv_out.shape == (24, 32, 6), (jax_out.shape, cv_out.shape)
+        np.testing.assert_allclose(cv_out, jax_out, atol=1e-4)
+        network = Network(sys.argv[1])
+        assert network.stride == 2 and network.max_side == 2 * RUN_SIDE
+        out = network.run(np.zeros((720, 1280, 3), np.uint8))
+        assert out.probabilities.shape == (360, 640, 6 - 1) and out.size == (1280, 720)
+        odd = network.run(np.zeros((101, 75, 3), np.uint8))
+        assert odd.probabilities.shape[:2] == (51, 38)
+        assert odd.upsample(odd.centres).shape == (101, 75)
+        """,
+        str(tmp_path / "w.onnx"),
+    )
+    assert done.returncode == 0, done.stderr
+
+
+@NEEDS_JAX
+def test_train_a_stem_network_on_zoomed_renders_end_to_end(tmp_path: Path) -> None:
+    from softarm.perception.detector.learned import LearnedDetector
+    from softarm.vision.camera_model import CameraModel
+
+    data = tmp_path / "data"
+    write_folder(data, training_scenes(4, seed=2))
+    out = tmp_path / "w.onnx"
+    args = ["detector", "train", "--data", str(data), "--out", str(out), "--epochs", "1"]
+    done = _softarm(*args, "--widths", "4,6,8,10", "--stem", "--zoom", "2", "-q")
+    assert done.returncode == 0, done.stderr
+    record = json.loads(out.with_suffix(".json").read_text())
+    assert record["stem"] is True and "zoom 2" in record["data"][0]
+    det = LearnedDetector(out)
+    assert det.network.stride == 2 and det.network.max_side == 1280
+    assert isinstance(
+        det.detect_berries(np.zeros((H, W, 3), np.uint8), CameraModel.ideal(100.0, W, H)), list
+    )
+
+
+@NEEDS_JAX
+@pytest.mark.parametrize(
+    ("extra", "word"),
+    [(["--zoom", "2", "--zoom", "1"], "zoom"), (["--zoom", "0"], "zoom"),
+     (["--from", "default", "--stem"], "stem")],
+)  # fmt: skip
+def test_zooms_not_one_per_folder_or_a_stem_to_fine_tune_are_one_line(
+    tmp_path: Path, extra: list[str], word: str
+) -> None:
+    data = tmp_path / "data"
+    write_folder(data, training_scenes(1, seed=2))
+    args = ["detector", "train", "--data", str(data), "--out", str(tmp_path / "w.onnx")]
+    done = _softarm(*args, *extra)
+    assert done.returncode == 2, done.stderr
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and word in err[0], err
+    assert not (tmp_path / "w.onnx").exists()

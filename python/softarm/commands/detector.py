@@ -79,6 +79,16 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         "network run on images larger than its training renders",
     )  # fmt: skip
     t.add_argument(
+        "--stem", action="store_true",
+        help="a fresh network with a stride-2 first layer: it sees the full image's detail "
+        "and runs the rest at half size (trained and run at twice the size: 1280 px)",
+    )  # fmt: skip
+    t.add_argument(
+        "--zoom", type=float, action="append", metavar="F",
+        help="scale factor of each --data folder, in order (default 1 each; 2 for renders "
+        "drawn at --scale 0.5 for a network run at full size)",
+    )  # fmt: skip
+    t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",
         help="start from these weights ('default': the shipped ones) instead of fresh ones",
     )  # fmt: skip
@@ -139,8 +149,9 @@ def run_train(args: argparse.Namespace) -> int:
             print(f"epoch {epoch}/{args.epochs}: loss {loss:.4f} ({seconds:.1f} s)", flush=True)
 
     record = train(
-        args.data, args.out, args.epochs, args.seed, start, on_epoch, args.widths, args.scale
-    )
+        args.data, args.out, args.epochs, args.seed, start, on_epoch, args.widths, args.scale,
+        args.stem, args.zoom,
+    )  # fmt: skip
     print(
         f"detector train: {args.epochs} epochs in {record['seconds']} s on "
         f"{record['device']} -> {args.out} (record {Path(args.out).with_suffix('.json')})"

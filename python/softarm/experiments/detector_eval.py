@@ -31,7 +31,7 @@ from softarm.perception.detector.choice import DETECTORS, BerryDetector, detecto
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 from softarm.perception.detector.misses import fruit_cases, miss_table
-from softarm.perception.detector.network import RUN_SIDE, STRIDE
+from softarm.perception.detector.network import STRIDE
 
 __all__ = ["CANDIDATE", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
 
@@ -66,7 +66,7 @@ WITH_DEPTH = ("colour", "net+colour")
 CANDIDATE = "cand"
 
 
-def _detectors(weights: Path | None, max_side: int) -> dict[str, BerryDetector]:
+def _detectors(weights: Path | None, max_side: int | None) -> dict[str, BerryDetector]:
     dets = {name: detector(name) for name in DETECTORS}
     if weights is not None:
         dets[CANDIDATE] = LearnedDetector(weights, max_side)
@@ -75,11 +75,12 @@ def _detectors(weights: Path | None, max_side: int) -> dict[str, BerryDetector]:
 
 
 def candidates(
-    weights: Path | None = None, max_side: int = RUN_SIDE
+    weights: Path | None = None, max_side: int | None = None
 ) -> dict[str, tuple[BerryDetector, bool]]:
     """{name: (detector, given depth)}: every detector without depth, then
     ``colour+depth`` and ``net+colour+depth``; with ``weights``, that network (run at
-    ``max_side``) as ``cand`` and ``cand+colour``, and ``cand+colour+depth``."""
+    ``max_side``, None: the network's own) as ``cand`` and ``cand+colour``, and
+    ``cand+colour+depth``."""
     dets = _detectors(weights, max_side)
     out = {name: (det, False) for name, det in dets.items()}
     with_depth = (*WITH_DEPTH, f"{CANDIDATE}+colour") if weights is not None else WITH_DEPTH
@@ -96,7 +97,7 @@ SPLIT = DetectorSettings(split_touching=True, split_colour_blobs=True)
 def run(
     conditions: dict[str, Path],
     weights: Path | None = None,
-    max_side: int = RUN_SIDE,
+    max_side: int | None = None,
     settings: DetectorSettings | None = None,
 ) -> dict[str, Any]:
     """{condition: {candidate: figures}} with ``ms_per_image``; a ``+depth`` candidate
@@ -146,8 +147,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         "--weights", type=Path, help="a candidate network, scored beside the shipped one"
     )
     p.add_argument(
-        "--max-side", type=int, default=RUN_SIDE,
-        help=f"longer side (px) the candidate sees an image at (default {RUN_SIDE})",
+        "--max-side", type=int,
+        help="longer side (px) the candidate sees an image at (default: the network's own, "
+        "640 px for a plain one, 1280 for one with the stem)",
     )  # fmt: skip
     p.add_argument(
         "--split-touching", action="store_true",
@@ -168,7 +170,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         if not folder:
             p.error(f"{item!r}: expected NAME=FOLDER")
         conditions[name] = Path(folder)
-    if a.max_side < STRIDE:
+    if a.max_side is not None and a.max_side < STRIDE:
         p.error(f"--max-side must be at least {STRIDE}, got {a.max_side}")
     settings = SPLIT if a.split_touching else None
     if a.misses:

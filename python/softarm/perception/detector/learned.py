@@ -17,7 +17,6 @@ from softarm.perception.detector.instances import FRUIT_THRESHOLD, StagedDetecti
 from softarm.perception.detector.network import (
     CLASSES,
     DEFAULT_WEIGHTS,
-    RUN_SIDE,
     Network,
     NetworkOutput,
 )
@@ -33,16 +32,17 @@ _U8 = npt.NDArray[np.uint8]
 
 class LearnedDetector:
     """The network's berries (``net``); ``weights`` an ONNX file (default: the shipped one)
-    run on images shrunk to ``max_side`` (default: the shipped weights').
+    run on images shrunk to ``max_side`` (default: RUN_SIDE times the network's output
+    stride, the size it was trained for).
 
     Raises:
         VisionError: the weights file is missing or broken (named in the message).
-        InputError: ``max_side`` is not an integer of at least STRIDE.
+        InputError: ``max_side`` is not None or an integer of at least STRIDE.
     """
 
     name = "net"
 
-    def __init__(self, weights: str | Path = DEFAULT_WEIGHTS, max_side: int = RUN_SIDE) -> None:
+    def __init__(self, weights: str | Path = DEFAULT_WEIGHTS, max_side: int | None = None) -> None:
         self.network = Network(weights, max_side)
 
     def output(self, image: npt.NDArray[np.uint8]) -> NetworkOutput:

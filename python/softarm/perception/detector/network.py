@@ -7,10 +7,14 @@ The convention both sides share: the input ``image`` is (1, 3, H, W) float32, th
 image divided by 255, less 0.5, over 0.25, with H and W multiples of :data:`STRIDE`; the
 output is (1, :data:`N_OUTPUTS`, H, W): one logit per class of :data:`CLASSES` at each
 pixel and, last, the logit of the fruit-centre heatmap (a peak at each fruit's centre).
+A network with a stride-2 stem (``train.unet``: the full image's detail, the rest of the
+network at half its size) gives (1, N_OUTPUTS, H/2, W/2), H and W multiples of
+2 × STRIDE; the output's stride is read from the file by a probe.
 Training images are shrunk so that their longer side is at most :data:`MAX_SIDE` pixels
-(the scale the training renders were drawn at: C1's 1280 × 720 eye at half size); at run
-time images are shrunk to a network's own longest side, :data:`RUN_SIDE` for the
-shipped weights.
+(the scale the training renders were drawn at: C1's 1280 × 720 eye at half size) times
+the output's stride; at run time images are shrunk to a network's own longest side, by
+default :data:`RUN_SIDE` times its output's stride (C1's eye at half size for a plain
+network, at full size for one with the stem).
 """
 
 from __future__ import annotations
@@ -44,7 +48,8 @@ N_OUTPUTS = len(CLASSES) + 1
 STRIDE = 8
 #: The longer side (px) a training image is shrunk to.
 MAX_SIDE = 640
-#: The longer side (px) an image is shrunk to before the shipped network sees it.
+#: The longer side (px) of a plain network's input at run time (a stem network's is twice
+#: this): its output's longer side is at most this.
 RUN_SIDE = 640
 #: The weights that ship in the package.
 DEFAULT_WEIGHTS = Path(__file__).parent / "weights" / "berries.onnx"
@@ -87,18 +92,19 @@ class NetworkOutput:
 class Network:
     """An ONNX segmentation network of this module's convention, read from ``path``, run
     on images shrunk to at most ``max_side`` pixels on their longer side (the scale it
-    was trained for).
+    was trained for; None: RUN_SIDE times the network's output stride).
 
     Raises:
         VisionError: the file is missing, is not an ONNX network, or gives outputs of
             the wrong shape (the message names the file).
-        InputError: ``max_side`` is not a positive multiple of STRIDE.
+        InputError: ``max_side`` is not None or an integer of at least STRIDE.
     """
 
-    def __init__(self, path: str | Path = DEFAULT_WEIGHTS, max_side: int = RUN_SIDE) -> None:
-        if isinstance(max_side, bool) or not isinstance(max_side, int) or max_side < STRIDE:
+    def __init__(self, path: str | Path = DEFAULT_WEIGHTS, max_side: int | None = None) -> None:
+        if max_side is not None and (
+            isinstance(max_side, bool) or not isinstance(max_side, int) or max_side < STRIDE
+        ):
             raise InputError(f"max_side must be an integer >= {STRIDE}, got {max_side!r}")
-        self.max_side = max_side
         self.path = Path(path)
         if not self.path.is_file():
             raise VisionError(f"detector weights {self.path}: no such file")
@@ -112,12 +118,17 @@ class Network:
         if net.empty():
             raise VisionError(f"detector weights {self.path}: the ONNX network is empty")
         self._net = net
-        probe = self._forward(np.zeros((1, 3, STRIDE * 2, STRIDE * 2), np.float32))
-        if probe.shape != (1, N_OUTPUTS, STRIDE * 2, STRIDE * 2):
+        side = STRIDE * 4
+        probe = self._forward(np.zeros((1, 3, side, side), np.float32))
+        shapes = {(1, N_OUTPUTS, side // k, side // k): k for k in (1, 2)}
+        if probe.shape not in shapes:
             raise VisionError(
-                f"detector weights {self.path}: the network gives {probe.shape}, not "
-                f"(1, {N_OUTPUTS}, H, W)"
+                f"detector weights {self.path}: the network gives {probe.shape} for a "
+                f"{side} x {side} image, not (1, {N_OUTPUTS}, H, W) or (1, {N_OUTPUTS}, H/2, W/2)"
             )
+        #: Image pixels per output pixel of the network (2 for a network with the stem).
+        self.stride = shapes[probe.shape]
+        self.max_side = RUN_SIDE * self.stride if max_side is None else max_side
 
     def _forward(self, blob: _F32) -> _F32:
         try:
@@ -133,10 +144,11 @@ class Network:
         scale = min(1.0, self.max_side / max(h, w))
         sw, sh = max(1, round(w * scale)), max(1, round(h * scale))
         small = image if scale == 1.0 else cv2.resize(image, (sw, sh), interpolation=cv2.INTER_AREA)
-        pw, ph = -sw % STRIDE, -sh % STRIDE
+        k = self.stride
+        pw, ph = -sw % (STRIDE * k), -sh % (STRIDE * k)
         padded = cast(_U8, cv2.copyMakeBorder(small, 0, ph, 0, pw, cv2.BORDER_REFLECT))
         blob = normalise(padded).transpose(2, 0, 1)[None]
-        out = self._forward(np.ascontiguousarray(blob))[0, :, :sh, :sw]
+        out = self._forward(np.ascontiguousarray(blob))[0, :, : -(-sh // k), : -(-sw // k)]
         logits = out[: len(CLASSES)]
         e = np.exp(logits - logits.max(axis=0, keepdims=True))
         probs = (e / e.sum(axis=0, keepdims=True)).transpose(1, 2, 0)

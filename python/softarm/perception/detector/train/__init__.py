@@ -50,40 +50,50 @@ def train(
     on_epoch: Callable[[int, float, float], None] = lambda e, loss, s: None,
     widths: tuple[int, ...] | None = None,
     scale: tuple[float, float] | None = None,
+    stem: bool = False,
+    zooms: list[float] | None = None,
 ) -> dict[str, Any]:
     """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
     and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
     this architecture to fine-tune (the shipped weights for ``--from default``; its
     widths are the file's). ``widths`` are a fresh network's four channel counts and
     ``scale`` the augmentation's scale range (defaults: :data:`.unet.WIDTHS`,
-    :data:`.augment.SCALE`). Returns the record.
+    :data:`.augment.SCALE`). ``stem``: a fresh network with the stride-2 stem (run on
+    images twice the size: the samples are shrunk to twice MAX_SIDE and cropped twice as
+    large; a fine-tuned one keeps its file's); ``zooms``: one scale factor per data folder
+    (default 1; 2 for renders drawn at half the size the network runs at). Returns the
+    record.
 
     Raises:
         TrainExtraMissing: the ``train`` extra is not installed.
         InputError: a data folder holds no labelled image, ``start`` is not a network
-            of this architecture, ``widths`` are given with ``start``, or ``widths`` or
-            ``scale`` are not valid.
+            of this architecture, ``widths`` or ``stem`` are given with ``start``, or
+            ``widths``, ``scale`` or ``zooms`` are not valid.
     """
     require_train_extra()
     import jax
 
+    from softarm.perception.detector.network import MAX_SIDE
     from softarm.perception.detector.train.augment import SCALE
     from softarm.perception.detector.train.loop import TrainSettings, fit
     from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
     from softarm.perception.detector.train.samples import describe, load_samples
-    from softarm.perception.detector.train.unet import WIDTHS, layers, widths_of
+    from softarm.perception.detector.train.unet import WIDTHS, layers, stem_of, widths_of
 
-    if start is not None and widths is not None:
-        raise InputError("widths: a fine-tuned network keeps the widths of its --from file")
+    if start is not None and (widths is not None or stem):
+        raise InputError(
+            "widths, stem: a fine-tuned network keeps the widths and stem of its --from file"
+        )
     if scale is not None and not 0 < scale[0] <= scale[1]:
         raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
     layers(WIDTHS if widths is None else widths)  # checks them before the data is read
-    samples, notes = load_samples(list(data))
     params = None if start is None else params_from_onnx(start)
+    stem = stem_of(params) if params is not None else stem
+    samples, notes = load_samples(list(data), MAX_SIDE * (2 if stem else 1), zooms)
     settings = TrainSettings(
         epochs=epochs, seed=seed,
         widths=widths_of(params) if params is not None else widths or WIDTHS,
-        scale=SCALE if scale is None else scale,
+        scale=SCALE if scale is None else scale, stem=stem,
     )  # fmt: skip
     began = time.perf_counter()
     params = fit(samples, settings, params, on_epoch)
@@ -99,6 +109,7 @@ def train(
         "learning_rate": settings.learning_rate,
         "widths": list(settings.widths),
         "scale": list(settings.scale),
+        "stem": settings.stem,
         "losses": [round(v, 5) for v in settings.losses],
         "seconds": round(time.perf_counter() - began, 1),
         "device": str(jax.devices()[0].platform),

@@ -1,8 +1,8 @@
-"""Augmentation of training crops, deterministic in the random generator it is given:
-scale, crop (most of them centred near a fruit), mirror, then colour (white balance,
-hue, saturation), exposure and gamma, blur (Gaussian or motion), sensor noise, JPEG
-compression and cut-outs (a rectangle of flat colour hides what is under it, which the
-labels then call background)."""
+"""Augmentation of training crops, deterministic in the random generator it is given: scale
+(times the sample's own ``zoom``), crop (most of them centred near a fruit), mirror,
+then colour (white balance, hue, saturation), exposure and gamma, blur (Gaussian or
+motion), sensor noise, JPEG compression and cut-outs (a rectangle of flat colour hides
+what is under it, which the labels then call background)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,8 @@ from softarm.perception.detector.train.samples import IGNORE, Sample
 
 __all__ = ["CROP", "crop_batch"]
 
-#: Side (px) of the square training crops.
+#: Side (px) of the square training crops of a plain network (a stem network's are twice
+#: this, so that its half-resolution layers see the same CROP × CROP).
 CROP = 128
 #: Log-uniform range of the scale applied before cropping, by default (the renders' own
 #: scale is the network's input scale; a network run on images larger than its training
@@ -31,7 +32,7 @@ _F32 = npt.NDArray[np.float32]
 def _scaled(
     s: Sample, rng: np.random.Generator, scale: tuple[float, float]
 ) -> tuple[_U8, _U8, _F32]:
-    f = float(np.exp(rng.uniform(np.log(scale[0]), np.log(scale[1]))))
+    f = float(np.exp(rng.uniform(np.log(scale[0]), np.log(scale[1])))) * s.zoom
     h, w = s.classes.shape
     size = (max(CROP // 4, round(w * f)), max(CROP // 4, round(h * f)))
     mode = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
@@ -41,10 +42,12 @@ def _scaled(
     return image, classes, centres
 
 
-def _crop(s: Sample, rng: np.random.Generator, scale: tuple[float, float]) -> tuple[_U8, _U8, _F32]:
+def _crop(
+    s: Sample, rng: np.random.Generator, scale: tuple[float, float], crop: int
+) -> tuple[_U8, _U8, _F32]:
     image, classes, centres = _scaled(s, rng, scale)
     h, w = classes.shape
-    pad_y, pad_x = max(0, CROP - h), max(0, CROP - w)
+    pad_y, pad_x = max(0, crop - h), max(0, crop - w)
     if pad_y or pad_x:
         image = cast(
             _U8, cv2.copyMakeBorder(image, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=0)
@@ -59,11 +62,11 @@ def _crop(s: Sample, rng: np.random.Generator, scale: tuple[float, float]) -> tu
     fruit = np.flatnonzero((classes >= 1) & (classes <= 3))
     if fruit.size and rng.uniform() < ON_FRUIT:
         cy, cx = divmod(int(fruit[rng.integers(fruit.size)]), w)
-        y0 = int(np.clip(cy - CROP // 2 + rng.integers(-CROP // 4, CROP // 4 + 1), 0, h - CROP))
-        x0 = int(np.clip(cx - CROP // 2 + rng.integers(-CROP // 4, CROP // 4 + 1), 0, w - CROP))
+        y0 = int(np.clip(cy - crop // 2 + rng.integers(-crop // 4, crop // 4 + 1), 0, h - crop))
+        x0 = int(np.clip(cx - crop // 2 + rng.integers(-crop // 4, crop // 4 + 1), 0, w - crop))
     else:
-        y0, x0 = int(rng.integers(h - CROP + 1)), int(rng.integers(w - CROP + 1))
-    window = np.s_[y0 : y0 + CROP, x0 : x0 + CROP]
+        y0, x0 = int(rng.integers(h - crop + 1)), int(rng.integers(w - crop + 1))
+    window = np.s_[y0 : y0 + crop, x0 : x0 + crop]
     image, classes, centres = image[window], classes[window], centres[window]
     if rng.uniform() < 0.5:
         image, classes, centres = image[:, ::-1], classes[:, ::-1], centres[:, ::-1]
@@ -111,20 +114,21 @@ def _sensor(image: _U8, rng: np.random.Generator) -> _U8:
 def _cut_outs(image: _U8, classes: _U8, centres: _F32, rng: np.random.Generator) -> None:
     if rng.uniform() >= 0.4:
         return
+    crop = classes.shape[0]
     for _ in range(int(rng.integers(1, 4))):
-        hh, ww = (int(v) for v in rng.integers(8, 41, 2))
-        y, x = int(rng.integers(0, CROP - hh + 1)), int(rng.integers(0, CROP - ww + 1))
+        hh, ww = (int(v) * crop // CROP for v in rng.integers(8, 41, 2))
+        y, x = int(rng.integers(0, crop - hh + 1)), int(rng.integers(0, crop - ww + 1))
         image[y : y + hh, x : x + ww] = rng.integers(0, 256, 3).astype(np.uint8)
         classes[y : y + hh, x : x + ww] = 0
         centres[y : y + hh, x : x + ww] = 0.0
 
 
 def augmented(
-    s: Sample, rng: np.random.Generator, scale: tuple[float, float] = SCALE
+    s: Sample, rng: np.random.Generator, scale: tuple[float, float] = SCALE, crop: int = CROP
 ) -> tuple[_U8, _U8, _F32]:
-    """One augmented CROP × CROP (image, classes, centres) of ``s``, scaled by a factor
-    drawn log-uniformly from ``scale``."""
-    image, classes, centres = _crop(s, rng, scale)
+    """One augmented ``crop`` × ``crop`` (image, classes, centres) of ``s``, scaled by a
+    factor drawn log-uniformly from ``scale`` times the sample's ``zoom``."""
+    image, classes, centres = _crop(s, rng, scale, crop)
     image = _sensor(_blur(_colour(image, rng), rng), rng)
     image, classes, centres = image.copy(), classes.copy(), centres.copy()
     _cut_outs(image, classes, centres, rng)
@@ -137,11 +141,13 @@ def crop_batch(
     seed: int,
     step: int,
     scale: tuple[float, float] = SCALE,
+    crop: int = CROP,
 ) -> tuple[_U8, _U8, _F32]:
     """A batch of augmented crops of ``samples[indices]``, the same for the same
-    ``seed``, ``step`` and ``scale``: (N, CROP, CROP, 3), (N, CROP, CROP), (N, CROP, CROP)."""
+    ``seed``, ``step``, ``scale`` and ``crop``: (N, crop, crop, 3), (N, crop, crop),
+    (N, crop, crop)."""
     out = [
-        augmented(samples[int(i)], np.random.default_rng([seed, step, k]), scale)
+        augmented(samples[int(i)], np.random.default_rng([seed, step, k]), scale, crop)
         for k, i in enumerate(indices)
     ]
     return (

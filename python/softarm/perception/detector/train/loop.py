@@ -1,7 +1,9 @@
 """The training loop (JAX + optax): class-weighted cross-entropy over the pixels' classes
 plus a weighted logistic loss on the centre heatmap, AdamW with a cosine schedule, on
-batches of augmented crops; deterministic in the seed (the same crops, the same order,
-the same initial weights). JAX runs on a GPU where it sees one, else on the CPU."""
+batches of augmented crops (twice the side for a network with the stride-2 stem, whose
+outputs are scored against the labels at half resolution); deterministic in the seed
+(the same crops, the same order, the same initial weights). JAX runs on a GPU where it
+sees one, else on the CPU."""
 
 from __future__ import annotations
 
@@ -13,10 +15,11 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 import numpy as np
+import numpy.typing as npt
 import optax
 
 from softarm.perception.detector.network import CLASSES, normalise
-from softarm.perception.detector.train.augment import SCALE, crop_batch
+from softarm.perception.detector.train.augment import CROP, SCALE, crop_batch
 from softarm.perception.detector.train.samples import IGNORE, Sample
 from softarm.perception.detector.train.unet import WIDTHS, Params, apply, init_params
 
@@ -32,7 +35,8 @@ CENTRE_POSITIVE = 20.0
 @dataclass(frozen=True)
 class TrainSettings:
     """Epochs (one crop of every image each), batch size, peak learning rate, seed, the
-    network's channel widths and the augmentation's scale range."""
+    network's channel widths, the augmentation's scale range and whether the network
+    has the stride-2 stem (``unet``)."""
 
     epochs: int = 150
     batch: int = 12
@@ -40,6 +44,7 @@ class TrainSettings:
     seed: int = 0
     widths: tuple[int, ...] = WIDTHS
     scale: tuple[float, float] = SCALE
+    stem: bool = False
     losses: list[float] = field(default_factory=list, compare=False)
 
 
@@ -57,6 +62,17 @@ def _loss(params: Params, x: Any, classes: Any, centres: Any) -> Any:
     return class_loss + CENTRE_WEIGHT * centre_loss
 
 
+def _halved(
+    classes: npt.NDArray[np.uint8], centres: npt.NDArray[np.float32]
+) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
+    """The labels of a batch at a stem network's output resolution: each 2×2 block's
+    top-left class (the output pixel's, as the image shrinks for a plain network) and the
+    block's mean heatmap."""
+    n, h, w = centres.shape
+    mean = centres.reshape(n, h // 2, 2, w // 2, 2).mean(axis=(2, 4))
+    return np.ascontiguousarray(classes[:, ::2, ::2]), mean.astype(np.float32)
+
+
 def fit(
     samples: list[Sample],
     settings: TrainSettings,
@@ -65,7 +81,9 @@ def fit(
 ) -> Params:
     """Train from ``params`` (default: fresh, from the seed) on ``samples``; calls
     ``on_epoch(epoch, mean loss, seconds)`` after each epoch."""
-    params = init_params(settings.seed, settings.widths) if params is None else params
+    if params is None:
+        params = init_params(settings.seed, settings.widths, settings.stem)
+    crop = CROP * 2 if settings.stem else CROP
     per_epoch = max(1, int(np.ceil(len(samples) / settings.batch)))
     total = settings.epochs * per_epoch
     schedule = optax.warmup_cosine_decay_schedule(
@@ -90,7 +108,11 @@ def fit(
             idx = order[b * settings.batch : (b + 1) * settings.batch]
             if idx.size < settings.batch:  # a full batch keeps one compiled shape
                 idx = np.concatenate([idx, order[: settings.batch - idx.size]])
-            images, classes, centres = crop_batch(samples, idx, settings.seed, n, settings.scale)
+            images, classes, centres = crop_batch(
+                samples, idx, settings.seed, n, settings.scale, crop
+            )
+            if settings.stem:
+                classes, centres = _halved(classes, centres)
             params, state, loss = step(
                 params, state, jnp.asarray(normalise(images)), jnp.asarray(classes),
                 jnp.asarray(centres),

@@ -1,6 +1,7 @@
 """The trained U-Net (:mod:`.unet`) written as an ONNX graph with ``onnx.helper``: the
 same layers as :func:`.unet.apply`, NCHW, opset 13, the operators OpenCV's DNN module
-runs (Conv, Relu, MaxPool, Resize nearest, Concat). The convention of the input and
+runs (Conv, Relu, MaxPool, Resize nearest, Concat; the stem is a Conv of stride 2). The
+convention of the input and
 output is :mod:`softarm.perception.detector.network`'s."""
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from softarm.perception.detector.network import N_OUTPUTS
-from softarm.perception.detector.train.unet import Params, layers
+from softarm.perception.detector.train.unet import STEM_KERNEL, Params, layers
 
 __all__ = ["export_onnx", "onnx_bytes", "params_from_onnx"]
 
@@ -39,11 +40,12 @@ class _Graph:
         )
         self.inits.append(self.nh.from_array(b, f"{name}.b"))
         y = self._name(name)
-        pad = k // 2
+        stride = 2 if k == STEM_KERNEL else 1  # the stem (unet._conv)
+        pad = k // 2 - (stride - 1)
         self.nodes.append(
             self.h.make_node(
                 "Conv", [x, f"{name}.w", f"{name}.b"], [y], kernel_shape=[k, k],
-                pads=[pad, pad, pad, pad],
+                pads=[pad, pad, pad, pad], strides=[stride, stride],
             )
         )  # fmt: skip
         if not relu:
@@ -138,8 +140,9 @@ def params_from_onnx(path: str | Path) -> Params:
     if any(w is None or w.ndim != 4 for w in firsts):
         raise InputError(f"--from {path}: not a network of this architecture (no U-Net levels)")
     widths = tuple(int(w.shape[0]) for w in firsts if w is not None)
+    stem = firsts[0] is not None and int(firsts[0].shape[-1]) == STEM_KERNEL
     params: Params = {}
-    for name, k, cin, cout in layers(widths):
+    for name, k, cin, cout in layers(widths, stem):
         w, b = arrays.get(f"{name}.w"), arrays.get(f"{name}.b")
         if w is None or b is None or w.shape != (cout, cin, k, k) or b.shape != (cout,):
             raise InputError(f"--from {path}: not a network of this architecture (layer {name})")

@@ -1,7 +1,8 @@
 """Training samples: each labelled image (:mod:`..labels`) as the network sees it (shrunk
-to MAX_SIDE), its class map (an index into CLASSES per pixel, IGNORE where a fruit has no
-known stage) and its centre heatmap (a Gaussian peak of height 1 at each fruit's centre,
-its width a third of the fruit's radius)."""
+to MAX_SIDE, or twice it for a network with the stem), its class map (an index into
+CLASSES per pixel, IGNORE where a fruit has no known stage) and its centre heatmap (a
+Gaussian peak of height 1 at each fruit's centre, its width a third of the fruit's
+radius)."""
 
 from __future__ import annotations
 
@@ -29,11 +30,13 @@ _F32 = npt.NDArray[np.float32]
 @dataclass(frozen=True)
 class Sample:
     """One training image: ``image`` (H, W, 3) BGR uint8, ``classes`` (H, W) uint8 and
-    ``centres`` (H, W) float32."""
+    ``centres`` (H, W) float32; ``zoom`` multiplies the augmentation's scale (2 for a
+    render drawn at half the camera's size, trained for a network run at full size)."""
 
     image: _U8
     classes: _U8
     centres: _F32
+    zoom: float = 1.0
 
 
 def find_labels(data: str | Path) -> Path:
@@ -58,12 +61,12 @@ def find_labels(data: str | Path) -> Path:
     return found[0]
 
 
-def _sample(item: LabelledImage) -> Sample | None:
+def _sample(item: LabelledImage, max_side: int, zoom: float) -> Sample | None:
     image = cast(_U8 | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
     if image is None or image.shape[:2] != (item.height, item.width):
         return None
     h, w = image.shape[:2]
-    scale = min(1.0, MAX_SIDE / max(h, w))
+    scale = min(1.0, max_side / max(h, w))
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
     if scale < 1.0:
         image = cast(_U8, cv2.resize(image, size, interpolation=cv2.INTER_AREA))
@@ -79,7 +82,7 @@ def _sample(item: LabelledImage) -> Sample | None:
         classes[mask] = CLASSES.index(obj.stage) if obj.stage in CLASSES else IGNORE
         if obj.is_fruit:
             _add_peak(centres, mask)
-    return Sample(image, classes, centres)
+    return Sample(image, classes, centres, zoom)
 
 
 def _add_peak(centres: _F32, mask: npt.NDArray[np.bool_]) -> None:
@@ -94,22 +97,32 @@ def _add_peak(centres: _F32, mask: npt.NDArray[np.bool_]) -> None:
     np.maximum(centres[y0:y1, x0:x1], g, out=centres[y0:y1, x0:x1])
 
 
-def load_samples(folders: list[str | Path]) -> tuple[list[Sample], list[str]]:
-    """The samples of every data folder (or COCO file), and a line per folder saying
+def load_samples(
+    folders: list[str | Path], max_side: int = MAX_SIDE, zooms: list[float] | None = None
+) -> tuple[list[Sample], list[str]]:
+    """The samples of every data folder (or COCO file), shrunk to ``max_side``, each
+    folder's with its zoom of ``zooms`` (default 1 each), and a line per folder saying
     what it held.
 
     Raises:
-        InputError: a folder has no COCO file, or none of its images could be read.
+        InputError: a folder has no COCO file, or none of its images could be read, or
+            ``zooms`` is not one positive factor per folder.
     """
+    zooms = [1.0] * len(folders) if zooms is None else list(zooms)
+    if len(zooms) != len(folders) or not all(np.isfinite(z) and z > 0 for z in zooms):
+        raise InputError(
+            f"zoom {zooms!r}: one positive factor per --data folder ({len(folders)}) expected"
+        )
     out: list[Sample] = []
     notes = []
-    for folder in folders:
+    for folder, zoom in zip(folders, zooms, strict=True):
         labels = find_labels(folder)
         items = read_coco(labels, labels.parent)
-        samples = [s for s in map(_sample, items) if s is not None]
+        samples = [s for s in (_sample(i, max_side, zoom) for i in items) if s is not None]
         if not samples:
             raise InputError(f"--data {folder}: no readable labelled image in {labels}")
-        notes.append(f"{folder}: {len(samples)} images ({labels.name})")
+        zoomed = "" if zoom == 1 else f", zoom {zoom:g}"
+        notes.append(f"{folder}: {len(samples)} images ({labels.name}{zoomed})")
         out += samples
     return out, notes
 

@@ -3,6 +3,12 @@ default, any four widths by :func:`layers`) whose layers are all ONNX operators
 OpenCV's DNN module runs (3×3 convolutions, ReLU, 2×2 max pooling, nearest upsampling,
 concatenation); :mod:`.onnx_export` writes the same graph.
 
+With ``stem=True`` the first layer is a 6×6 convolution of stride 2 (:data:`STEM_KERNEL`):
+the same as a space-to-depth of the image (each 2×2 block of pixels as 12 channels)
+followed by a 3×3 convolution, so that the rest of the network runs at half the image's
+resolution (today's cost) while its first layer sees every pixel of the full image
+(fruit of a few pixels keep their detail). Its outputs are at half the input's size.
+
 Parameters are a flat dict ``name -> (kernel (kh, kw, cin, cout), bias (cout,))`` of
 :data:`LAYERS`, images NHWC."""
 
@@ -17,15 +23,29 @@ import numpy as np
 from softarm.errors import InputError
 from softarm.perception.detector.network import N_OUTPUTS
 
-__all__ = ["LAYERS", "WIDTHS", "apply", "init_params", "layers", "widths_of"]
+__all__ = [
+    "LAYERS",
+    "STEM_KERNEL",
+    "WIDTHS",
+    "apply",
+    "init_params",
+    "layers",
+    "stem_of",
+    "widths_of",
+]
 
 #: Channels of the four levels (full, 1/2, 1/4, 1/8 resolution) by default.
 WIDTHS = (8, 16, 24, 32)
+#: The stem's kernel (stride 2, padding 2): a 3×3 convolution over 2×2 pixel blocks.
+STEM_KERNEL = 6
 
 
-def layers(widths: tuple[int, ...] = WIDTHS) -> tuple[tuple[str, int, int, int], ...]:
+def layers(
+    widths: tuple[int, ...] = WIDTHS, stem: bool = False
+) -> tuple[tuple[str, int, int, int], ...]:
     """(name, kernel size, in channels, out channels) of a network of ``widths`` (four
-    positive channel counts), in the order the graph runs them.
+    positive channel counts), in the order the graph runs them; with ``stem`` the first
+    layer is the stride-2 stem.
 
     Raises:
         InputError: ``widths`` is not four positive integers.
@@ -34,7 +54,7 @@ def layers(widths: tuple[int, ...] = WIDTHS) -> tuple[tuple[str, int, int, int],
         raise InputError(f"widths {widths!r}: four positive channel counts expected")
     c1, c2, c3, c4 = widths
     return (
-        ("enc1", 3, 3, c1),
+        ("enc1", STEM_KERNEL if stem else 3, 3, c1),
         ("enc2a", 3, c1, c2),
         ("enc2b", 3, c2, c2),
         ("enc3a", 3, c2, c3),
@@ -54,11 +74,12 @@ LAYERS = layers()
 Params = dict[str, tuple[Any, Any]]
 
 
-def init_params(seed: int, widths: tuple[int, ...] = WIDTHS) -> Params:
-    """He-initialised parameters of a network of ``widths``, deterministic in ``seed``."""
+def init_params(seed: int, widths: tuple[int, ...] = WIDTHS, stem: bool = False) -> Params:
+    """He-initialised parameters of a network of ``widths`` (with the stride-2 stem when
+    ``stem``), deterministic in ``seed``."""
     rng = np.random.default_rng(seed)
     params: Params = {}
-    for name, k, cin, cout in layers(widths):
+    for name, k, cin, cout in layers(widths, stem):
         std = np.sqrt(2.0 / (k * k * cin))
         w = rng.normal(0.0, std, (k, k, cin, cout)).astype(np.float32)
         params[name] = (jnp.asarray(w), jnp.zeros((cout,), jnp.float32))
@@ -71,10 +92,21 @@ def widths_of(params: Params) -> tuple[int, int, int, int]:
     return c1, c2, c3, c4
 
 
+def stem_of(params: Params) -> bool:
+    """Whether ``params`` begin with the stride-2 stem (their first kernel's size says)."""
+    return int(params["enc1"][0].shape[0]) == STEM_KERNEL
+
+
 def _conv(params: Params, name: str, x: Any, relu: bool = True) -> Any:
     w, b = params[name]
+    if int(w.shape[0]) == STEM_KERNEL:  # the stem: stride 2, padding 2 (ONNX's pads)
+        pad = STEM_KERNEL // 2 - 1
+        strides: tuple[int, int] = (2, 2)
+        padding: str | tuple[tuple[int, int], tuple[int, int]] = ((pad, pad), (pad, pad))
+    else:
+        strides, padding = (1, 1), "SAME"
     y = jax.lax.conv_general_dilated(
-        x, w, (1, 1), "SAME", dimension_numbers=("NHWC", "HWIO", "NHWC")
+        x, w, strides, padding, dimension_numbers=("NHWC", "HWIO", "NHWC")
     )
     y = y + b
     return jax.nn.relu(y) if relu else y
@@ -89,7 +121,8 @@ def _up(x: Any) -> Any:
 
 
 def apply(params: Params, x: Any) -> Any:
-    """(N, H, W, N_OUTPUTS) logits of a normalised (N, H, W, 3) batch (H, W multiples of 8)."""
+    """(N, H, W, N_OUTPUTS) logits of a normalised (N, H, W, 3) batch (H, W multiples of
+    8), or (N, H/2, W/2, N_OUTPUTS) of a network with the stem (H, W multiples of 16)."""
     s1 = _conv(params, "enc1", x)
     s2 = _conv(params, "enc2b", _conv(params, "enc2a", _pool(s1)))
     s3 = _conv(params, "enc3b", _conv(params, "enc3a", _pool(s2)))
