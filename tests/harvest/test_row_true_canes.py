@@ -45,3 +45,17 @@ def test_the_bush_truth_is_the_bushs_canes_alone() -> None:
         o = SimRigOptions(world=world, seed=90013, n_berries=4)
         bush = sim_bush(o)
         assert len(true_canes(o, bush)) == len(bush.branches)
+
+
+def test_the_log_header_records_every_cane_drawn() -> None:
+    # The header's world.canes (plots, bags, the Foxglove scene) are the truth's too.
+    from softarm.harvest.rigs.sim.header import sim_settings
+    from softarm.harvest.rigs.sim.rig import build_sim_rig
+
+    o = SimRigOptions(world=WorldName.ROW, look="sun", seed=90014, n_berries=2)
+    rig = build_sim_rig(o)
+    recorded = sim_settings(rig, o)["world"]["canes"]
+    truth = true_canes(o, rig.bush)
+    assert len(recorded) == len(truth) > len(rig.bush.branches)
+    for coeffs, curve in zip(recorded, truth, strict=True):
+        np.testing.assert_array_equal(coeffs, np.asarray(curve.coeffs))

@@ -158,15 +158,19 @@ def arm_settings(arm: Any) -> dict[str, Any]:
     return {"sections": rows}
 
 
-def world_settings(bush: Any, unripe_fraction: float, kind: str = "tags") -> dict[str, Any]:
-    """The simulated bush (``kind``: ``--world``): its seed, canes (cubic coefficients)
-    and berries."""
+def world_settings(
+    bush: Any, unripe_fraction: float, kind: str = "tags", canes: Sequence[Any] | None = None
+) -> dict[str, Any]:
+    """The simulated bush (``kind``: ``--world``): its seed, canes (cubic coefficients:
+    ``canes``, every cane the world draws, each with ``coeffs``; None: the bush's) and
+    berries."""
+    drawn = bush.branches if canes is None else canes
     return {
         "source": "sim",
         "kind": kind,
         "seed": bush.seed,
         "unripe_fraction": unripe_fraction,
-        "canes": [np.asarray(b.coeffs) for b in bush.branches],
+        "canes": [np.asarray(c.coeffs) for c in drawn],
         "berries": [
             {"tag_id": b.tag_id, "position": np.asarray(b.position), "ripeness": b.ripeness}
             for b in bush.berries

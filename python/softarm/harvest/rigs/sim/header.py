@@ -26,8 +26,13 @@ def sim_settings(rig: SimRig, options: SimRigOptions) -> dict[str, Any]:
     return {
         "seed": options.seed,
         "berries": options.n_berries,
+        # Every cane drawn (the row's own too, which the arm can touch): the truth the
+        # contacts and the report's cane map are scored on.
         "world": world_settings(
-            rig.bush, options.unripe_fraction, str(getattr(options, "world", "tags"))
+            rig.bush,
+            options.unripe_fraction,
+            str(getattr(options, "world", "tags")),
+            canes=rig.watch.clearance.canes,
         ),
         "plant": plant,
         "arm": arm_settings(rig.model),
