@@ -75,7 +75,10 @@ _COUNTED = CurveSearch(min_support=70, support_length=0.0)
 #: ``evidence``, the ``length`` budget's fits kept only where they show a cane's evidence
 #: (:class:`~softarm.perception.cane_evidence.CaneEvidence`); ``far``, the same budget
 #: with C1's stereo matching out to 3 m (``CaneSettings.match_far``: the canes beyond the
-#: range dropped at their own depth) and the evidence of 70 points and 1.75 mm alone.
+#: range dropped at their own depth) and the evidence of 70 points and 1.75 mm alone,
+#: a pixel whose match out to 3 m is tied left unmatched (as the far match was first
+#: measured); ``ties``, the same with such a tie going to the match within the range
+#: (``CaneSettings.ties_in_range``).
 _LENGTH = CurveSearch(min_support=20, support_length=0.08)
 BUDGETS: dict[str, CaneSettings] = {
     "view": CaneSettings(reach=None, max_points=4000, search=_COUNTED),
@@ -83,7 +86,18 @@ BUDGETS: dict[str, CaneSettings] = {
     "length": CaneSettings(max_points=8000, search=_LENGTH),
     "evidence": CaneSettings(max_points=8000, search=_LENGTH, evidence=CaneEvidence()),
     "far": CaneSettings(
-        max_points=8000, search=_LENGTH, evidence=CaneEvidence(min_density=0.0), match_far=3.0
+        max_points=8000,
+        search=_LENGTH,
+        evidence=CaneEvidence(min_density=0.0),
+        match_far=3.0,
+        ties_in_range=False,
+    ),
+    "ties": CaneSettings(
+        max_points=8000,
+        search=_LENGTH,
+        evidence=CaneEvidence(min_density=0.0),
+        match_far=3.0,
+        ties_in_range=True,
     ),
 }
 
@@ -196,17 +210,20 @@ class _Placed:
 
     def __init__(self, rect_left: Any, rect_right: Any, stereo: Any, mask: Any) -> None:
         self.args = (rect_left, rect_right, stereo, mask)
-        self.placed: dict[tuple[float, float | None], tuple[Any, float, float]] = {}
+        self.placed: dict[tuple[float, float | None, bool], tuple[Any, float, float]] = {}
 
     def points(self, settings: CaneSettings) -> tuple[Any, float, float]:
         """(points, wall seconds, CPU seconds) for ``settings``."""
         # without a reach the budget is spent on pixels before they are placed
         reach = settings.reach if settings.reach is not None else -float(settings.max_points)
-        key = (reach, settings.match_far)
+        key = (reach, settings.match_far, settings.ties_in_range)
         if key not in self.placed:
             whole = settings if settings.reach is None else CaneSettings(max_points=10**9)
             start, start_cpu = time.perf_counter(), time.process_time()
-            whole = replace(whole, reach=settings.reach, match_far=settings.match_far)
+            whole = replace(
+                whole, reach=settings.reach, match_far=settings.match_far,
+                ties_in_range=settings.ties_in_range,
+            )  # fmt: skip
             points = mask_points(*self.args, whole)
             wall, cpu = time.perf_counter() - start, time.process_time() - start_cpu
             self.placed[key] = (points, wall, cpu)

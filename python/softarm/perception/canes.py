@@ -38,7 +38,7 @@ from softarm.errors import ParameterError, VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.cane_curves import CurveSearch, arc_length_cubic, split_into_curves
 from softarm.perception.cane_evidence import CaneEvidence, shows_a_cane
-from softarm.perception.cane_pixels import CaneLook, half_width_px, stereo_disparity
+from softarm.perception.cane_pixels import CaneLook, half_width_px, matched_disparity
 from softarm.perception.cane_source import check_cane_source, source_mask
 from softarm.perception.self_filter import CANE_REACH
 from softarm.vision.stereo_camera import StereoCamera
@@ -79,6 +79,11 @@ class CaneSettings:
     (3 m with 8,000 points, an 8 cm support and the evidence of 70 points and 1.75 mm:
     on fresh seeds 310180–310199 more coverage in every look of the row, but less
     precision in dusk and backlight: not the default, docs/perception.md);
+    ``ties_in_range``: with ``match_far`` set, a pixel the search out to ``match_far``
+    leaves unmatched because a match beyond the range ties with one within it (SGBM's
+    uniqueness ratio) takes the match within the range
+    (:func:`softarm.perception.cane_pixels.matched_disparity`; False: it stays
+    unmatched, as before the rule);
     ``reach``: points farther than this (m) from the base origin are dropped before the
     budget is spent (the map's own reach, :data:`softarm.perception.self_filter.
     CANE_REACH`: canes beyond it cannot touch the arm; None: every point shares the
@@ -101,7 +106,7 @@ class CaneSettings:
         ParameterError: ``source`` is not None or one of CANE_SOURCES; ``reach`` is not
             None or a finite number > 0; ``evidence`` is not None or a CaneEvidence;
             ``match_far`` is not None or a finite number beyond ``depth_range``'s far
-            end.
+            end; ``ties_in_range`` is not a bool.
     """
 
     look: CaneLook = field(default_factory=CaneLook)
@@ -113,11 +118,16 @@ class CaneSettings:
     reach: float | None = CANE_REACH
     evidence: CaneEvidence | None = None
     match_far: float | None = None
+    ties_in_range: bool = True
 
     def __post_init__(self) -> None:
         if self.evidence is not None and not isinstance(self.evidence, CaneEvidence):
             raise ParameterError(
                 f"settings.evidence must be None or a CaneEvidence, got {self.evidence!r}"
+            )
+        if not isinstance(self.ties_in_range, bool):
+            raise ParameterError(
+                f"settings.ties_in_range must be a bool, got {self.ties_in_range!r}"
             )
         if self.source is not None:
             check_cane_source(self.source, "settings.source")
@@ -232,9 +242,10 @@ def mask_points(
     choice of source, the same for every source (and for the comparison of sources,
     :mod:`softarm.experiments.cane_sources`)."""
     rect = stereo.rectification
-    near, far = settings.depth_range
-    matched = (near, far if settings.match_far is None else settings.match_far)
-    disparity = stereo_disparity(rect_left, rect_right, rect, mask, matched, settings.smoothness)
+    disparity = matched_disparity(
+        rect_left, rect_right, rect, mask, settings.depth_range, settings.match_far,
+        settings.smoothness, settings.ties_in_range,
+    )  # fmt: skip
     mask = mask & np.isfinite(disparity)
     rows, cols = _whole_view_budget(np.nonzero(mask), settings)
     pixels = np.column_stack([cols, rows]).astype(np.float64)
