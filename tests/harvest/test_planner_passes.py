@@ -128,3 +128,27 @@ def test_a_berry_only_the_survey_canes_block_is_planned_around_the_fallback_cane
     assert told == [False, True]  # each plan says whether it fell back
     planner.clearance = c1
     _assert_ramps_clear(planner, q, plan[0])
+
+
+def test_a_start_that_converges_does_so_well_within_the_planners_step_cap() -> None:
+    # The cap (ik.SOLVE_STEPS) only shortens the starts that never converge: from random
+    # starts towards random poses of the arm's workspace (reachable and not), every
+    # start that converges within 5x the cap does so within half of it.
+    from softarm.harvest.control.ik import SOLVE_STEPS
+
+    arm = SoftArm.blackberry()
+    resolver = planning_resolver(arm)
+    rng = np.random.default_rng(5)
+    lo, hi = np.asarray(arm.lower), np.asarray(arm.upper)
+    converged = []
+    for _ in range(120):
+        target = np.asarray(arm.forward(rng.uniform(lo, hi)))
+        target[:3, 3] += rng.normal(0.0, 0.02, 3)  # some out of reach
+        sol = resolver.solve(
+            rng.uniform(lo, hi), target, max_steps=5 * SOLVE_STEPS,
+            position_tolerance=1e-3, orientation_tolerance=0.02,
+        )  # fmt: skip
+        if sol.converged:
+            converged.append(sol.steps)
+    assert len(converged) >= 20
+    assert max(converged) <= SOLVE_STEPS // 2
