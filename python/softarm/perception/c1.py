@@ -1,7 +1,8 @@
 """C1's perception, on the arm and in the rendered worlds alike: the bush map built from
 the stereo pair (:func:`~softarm.perception.stereo.locate_berries`,
 :func:`~softarm.perception.canes.fit_canes`), the canes filtered of the rig's own
-parts (:mod:`softarm.perception.self_filter`)."""
+parts (:mod:`softarm.perception.self_filter`): the points seen through the rig before the
+fit, the fits that are the rig after it."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from softarm.checks import FloatArray
 from softarm.errors import HardwareUnavailableError, VisionError
 from softarm.perception.bush_map import BushMap
 from softarm.perception.canes import CaneFit, cane_points, fit_cane_points
-from softarm.perception.self_filter import a_cane
+from softarm.perception.self_filter import a_cane, behind_rig
 from softarm.perception.sight_lines import sight_lines
 from softarm.perception.stereo import locate_berries
 from softarm.perception.two_eyes import ray_origin
@@ -58,13 +59,23 @@ class StereoC1:
         self.bush_map.note_unplaced(sight_lines(detections, self.stereo))
         return new
 
-    def fit_canes(self, parts: FloatArray, reach: float) -> list[PolynomialCurve]:
+    def fit_canes(
+        self, parts: FloatArray, reach: float, outline: FloatArray | None = None
+    ) -> list[PolynomialCurve]:
         """The canes of one stereo view, the rig's own ``parts`` and what lies beyond
         ``reach`` left out (as in the rendered bush); the map keeps them and the
-        view's cane points."""
+        view's cane points. ``outline``: the rig as it stands while C1 takes the view
+        (:func:`~softarm.perception.self_filter.rig_outline`); the points either eye
+        could only have seen through it are dropped before the fit (None: none)."""
         left, right = self.pair()
-        self.bush_map.cane_points = cane_points(left, right, self.stereo)
-        return self._keep(fit_cane_points(self.bush_map.cane_points), parts, reach)
+        points = cane_points(left, right, self.stereo)
+        if outline is not None:
+            eyes = np.array(
+                [self.stereo.T_base_left, self.stereo.T_base_left @ self.stereo.T_left_right]
+            )
+            points = points[~behind_rig(points, eyes[:, :3, 3], outline)]
+        self.bush_map.cane_points = points
+        return self._keep(fit_cane_points(points), parts, reach)
 
     def refit_canes(
         self, parts: FloatArray, reach: float, more: Sequence[FloatArray]

@@ -42,7 +42,7 @@ from softarm.perception.bush_vision import BushVision
 from softarm.perception.c1 import StereoC1
 from softarm.perception.cane_source import use_cane_source
 from softarm.perception.detector.choice import use_detector
-from softarm.perception.self_filter import CANE_REACH, rig_parts
+from softarm.perception.self_filter import CANE_REACH, rig_outline, rig_parts
 from softarm.perception_config import BerryMode
 from softarm.vision.camera_model import camera_from_config
 from softarm.vision.marker_body import marker_body
@@ -136,7 +136,7 @@ def build_hardware_rig(
         parts = None
         if c1 is not None and not canes:
             parts = _rig_parts(config, cfg, inputs.model)
-            canes = c1.fit_canes(parts, CANE_REACH)
+            canes = c1.fit_canes(parts, CANE_REACH, _rig_outline(config, inputs.model))
         vision = _vision(config, cfg, dev, stack, c1)
         control = build_control_stack(cfg, inputs, canes, bank, clock.now)
         machine = HarvestMachine(
@@ -208,6 +208,13 @@ def _rig_parts(config: Config, cfg: HarvestConfig, model: SoftArm) -> FloatArray
     tag = None if cal.T_base_tag is None else np.array(cal.T_base_tag)
     body = marker_body(cal.marker_body, cal.marker_length)
     return rig_parts(model, cfg, np.array(cal.T_EE_cube), tag, body)
+
+
+def _rig_outline(config: Config, model: SoftArm) -> FloatArray:
+    """The rig as C1 sees it when it fits the canes: the arm vented, at rest."""
+    cal = config.calibration
+    body = marker_body(cal.marker_body, cal.marker_length)
+    return rig_outline(model, np.zeros(model.n_actuators), np.array(cal.T_EE_cube), body)
 
 
 def _vision(

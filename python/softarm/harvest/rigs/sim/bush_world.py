@@ -110,12 +110,15 @@ class BushScene:
         arm); the number of berries new to it."""
         return self.stereo_c1().look()
 
-    def fit_canes(self, rig_parts: FloatArray, reach: float) -> list[PolynomialCurve]:
+    def fit_canes(
+        self, rig_parts: FloatArray, reach: float, outline: FloatArray | None = None
+    ) -> list[PolynomialCurve]:
         """The canes fitted from one C1 stereo view, without what is the rig's own
         (:meth:`StereoC1.fit_canes`, as on the arm: a fit that comes within SELF_MARGIN
         of ``rig_parts``, the robot seen by its own camera, or lies wholly beyond
-        ``reach`` of the base is left out); the map keeps them."""
-        return self.stereo_c1().fit_canes(rig_parts, reach)
+        ``reach`` of the base is left out; the points seen only through the rig's
+        ``outline`` before the fit); the map keeps them."""
+        return self.stereo_c1().fit_canes(rig_parts, reach, outline)
 
     def frames(self) -> tuple[Callable[[float], np.ndarray], Callable[[float], np.ndarray]]:
         """C1's left eye and C2 as ``(time) -> image`` with the arm drawn as it is."""

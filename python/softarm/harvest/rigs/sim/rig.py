@@ -39,7 +39,7 @@ from softarm.harvest.rigs.sim.devices import ArmWatch, SimClock, SimGripper
 from softarm.harvest.rigs.sim.options import SimRigOptions, declared_plant, default_cameras
 from softarm.harvest.rigs.sim.worlds import WORLDS, HarvestWorld, WorldParts, true_canes
 from softarm.harvest.runs.cane_survey import CaneSurvey
-from softarm.perception.self_filter import rig_parts
+from softarm.perception.self_filter import rig_outline, rig_parts
 from softarm.sim.arm import SimulatedArm
 from softarm.sim.bush import Bush
 from softarm.sim.plant import ArmPlant
@@ -154,7 +154,11 @@ def _build_sim_rig(
     bank = _bank(plant, clock, recorder)
     body = marker_body(cams.marker_body, cams.cube_marker)
     parts = rig_parts(model, cfg, cams.T_ee_cube, cams.T_base_tag, body)
-    world = WORLDS[o.world](WorldParts(o, bush, canes, plant, model, cams, parts, clock, recorder))
+    # C1 fits the canes with the arm vented, at rest.
+    outline = rig_outline(model, np.zeros(model.n_actuators), cams.T_ee_cube, body)
+    world = WORLDS[o.world](
+        WorldParts(o, bush, canes, plant, model, cams, parts, clock, recorder, outline)
+    )
     stack = build_control_stack(
         cfg, control_inputs(o, model), list(world.known_canes()), bank, clock.now
     )

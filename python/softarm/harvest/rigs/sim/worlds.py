@@ -97,6 +97,9 @@ class WorldParts:
     parts: FloatArray
     clock: SimClock
     recorder: FrameRecorder | None
+    #: The rig at rest as C1 sees it (softarm.perception.self_filter.rig_outline): the
+    #: cane points seen only through it are left out of C1's fit; None keeps them.
+    outline: FloatArray | None = None
 
 
 def _tag_world(w: WorldParts) -> TagWorld:
@@ -119,7 +122,7 @@ def _rendered_world(w: WorldParts) -> RenderedWorld:
     use_detector(o.detector)
     use_cane_source(o.cane_source)
     scene = _bush_scene(w.bush, w.plant, w.cams, w.clock, w.recorder, _look(o, w.bush))
-    canes = scene.fit_canes(w.parts, CANE_REACH)
+    canes = scene.fit_canes(w.parts, CANE_REACH, w.outline)
     vision = _bush_vision(scene, w.cams, cfg.grasp_offset, w.recorder)
     gripper = BushGripper(
         scene, w.plant, vision, list(w.bush.berries), cfg.grasp_offset, cfg.grasp_workspace
