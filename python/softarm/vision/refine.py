@@ -9,6 +9,13 @@ normalised coordinates, where the sides are straight lines (pinhole projection o
 straight edge), a line is fitted to each side (total least squares), and adjacent lines
 intersect at the corners, which are then distorted back to pixels. Dozens of edge points
 per side average the pixel noise down, which the four-point corner fit cannot do.
+
+A clipped profile (a black level crushing the ink's foot, a white saturated in the sun)
+biases the centroid towards one side by a few hundredths of a pixel, a tenth of a
+millimetre or more in a marker body's pose. Where a marker's profiles read clipped
+pixels, that bias is measured on the marker's own black border
+(:mod:`softarm.vision.border_bias`) and the edges are moved back by it before the lines
+are fitted again.
 """
 
 from __future__ import annotations
@@ -18,11 +25,20 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.vision._checks import FloatArray
+from softarm.vision.border_bias import border_bias
 from softarm.vision.camera_model import CameraModel
 
 _STEP = 0.25  # px between profile samples across an edge
 _MAX_REACH = 4.0  # px: the widest half-profile across an edge
 _MAX_SHIFT = 2.0  # px: a refined corner further than this from the detection is refused
+#: Profile levels (DN) that only clipped pixels give: at or under CLIP_LOW the camera
+#: crushed the ink (its black level subtracted, then clipped at 0), at or over
+#: CLIP_HIGH the paper saturated. A marker without them keeps the centroid's corners.
+CLIP_LOW = 0.5
+CLIP_HIGH = 254.5
+#: The share of a marker's profile samples that must be clipped for the bias to be
+#: measured (a crushed ink or a saturated paper clips 1-30 % of them on the row).
+CLIPPED_SHARE = 0.002
 #: Pixels beyond the corners' bounding box that the refinement reads (the half-profile,
 #: one for the bilinear neighbour, one for rounding): a copy of this neighbourhood is
 #: enough to refine the marker later.
@@ -52,7 +68,7 @@ def refine_marker_corners(
     # a whole number of steps, so that the offsets are symmetric about 0.
     half = round(float(np.clip(0.4 * lengths.min() / cells, 1.0, _MAX_REACH)) / _STEP)
     reach = _STEP * half
-    offsets = _STEP * np.arange(-half, half + 1)
+    offsets: FloatArray = _STEP * np.arange(-half, half + 1, dtype=np.float64)
     normals = np.column_stack([sides[:, 1], -sides[:, 0]]) / lengths[:, None]
     # Profiles at evenly spaced points of each side, clear of the corners.
     counts = np.maximum(lengths.astype(int), 8)
@@ -89,12 +105,54 @@ def refine_marker_corners(
         return quad
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
+    pix = _corners(edge, side, camera, quad)
+    if pix is None:
+        return quad
+    clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
+    if clipped < CLIPPED_SHARE * prof[good].size:
+        return pix  # nothing clipped (a stray noisy pixel aside): the centroid is unbiased
+    # Ink to quiet zone along each side's normal: the sign of its profiles' step.
+    direction = np.sign(np.bincount(side, np.sign(wsum[good]), 4))
+    if np.any(direction == 0):
+        return pix
+    return _unbiased(
+        crop, lo, pix, cells, offsets, normals * direction[:, None], edge, side, camera
+    )
+
+
+def _unbiased(
+    crop: npt.NDArray[np.float32],
+    crop_origin: npt.NDArray[np.int_],
+    pix: FloatArray,
+    cells: int,
+    offsets: FloatArray,
+    outward: FloatArray,
+    edge: FloatArray,
+    side: npt.NDArray[np.intp],
+    camera: CameraModel,
+) -> FloatArray:
+    """The corners ``pix`` with the ``edge`` points (N, 2) moved back by the bias the
+    marker's border measures (:func:`~softarm.vision.border_bias.border_bias`); ``pix``
+    when it measures none or the moved corners fail."""
+    bias = border_bias(crop, crop_origin, pix, cells, offsets, outward)
+    if bias == 0.0:
+        return pix
+    moved = _corners(edge - bias * outward[side], side, camera, pix)
+    return pix if moved is None else moved
+
+
+def _corners(
+    edge: FloatArray, side: npt.NDArray[np.intp], camera: CameraModel, quad: FloatArray
+) -> FloatArray | None:
+    """The (4, 2) pixel corners where the lines through each side's ``edge`` points
+    meet (straight in normalised coordinates); None when two sides are parallel or a
+    corner lands further than _MAX_SHIFT from the detection's ``quad``."""
     lines = _fit_lines(camera.normalize(edge), side)  # one call for all four sides
     if lines is None:
-        return quad
+        return None
     pix = camera.project(np.column_stack([lines, np.ones(4)]))
     if np.max(np.linalg.norm(pix - quad, axis=1)) > _MAX_SHIFT:
-        return quad
+        return None
     return pix
 
 
