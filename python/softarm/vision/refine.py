@@ -105,7 +105,8 @@ def refine_marker_corners(
         return quad
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
-    pix = _corners(edge, side, camera, quad)
+    norm = camera.normalize(edge)
+    pix = _corners(norm, side, camera, quad)
     if pix is None:
         return quad
     clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
@@ -116,7 +117,7 @@ def refine_marker_corners(
     if np.any(direction == 0):
         return pix
     return _unbiased(
-        crop, lo, pix, cells, offsets, normals * direction[:, None], edge, side, camera
+        crop, lo, pix, cells, offsets, normals * direction[:, None], norm, side, camera
     )
 
 
@@ -127,27 +128,32 @@ def _unbiased(
     cells: int,
     offsets: FloatArray,
     outward: FloatArray,
-    edge: FloatArray,
+    norm: FloatArray,
     side: npt.NDArray[np.intp],
     camera: CameraModel,
 ) -> FloatArray:
-    """The corners ``pix`` with the ``edge`` points (N, 2) moved back by the bias the
-    marker's border measures (:func:`~softarm.vision.border_bias.border_bias`); ``pix``
-    when it measures none or the moved corners fail."""
+    """The corners ``pix`` with the edge points (N, 2, normalised: ``norm``) moved back
+    by the bias the marker's border measures
+    (:func:`~softarm.vision.border_bias.border_bias`); ``pix`` when it measures none or
+    the moved corners fail."""
     bias = border_bias(crop, crop_origin, pix, cells, offsets, outward)
     if bias == 0.0:
         return pix
-    moved = _corners(edge - bias * outward[side], side, camera, pix)
+    # A shift of hundredths of a pixel, made in normalised coordinates through the focal
+    # lengths (the lens's local stretch changes it by a few percent at most; undistorting
+    # the points again would cost as much as the first fit).
+    focal = np.array([camera.matrix[0, 0], camera.matrix[1, 1]])
+    moved = _corners(norm - bias * outward[side] / focal, side, camera, pix)
     return pix if moved is None else moved
 
 
 def _corners(
-    edge: FloatArray, side: npt.NDArray[np.intp], camera: CameraModel, quad: FloatArray
+    norm: FloatArray, side: npt.NDArray[np.intp], camera: CameraModel, quad: FloatArray
 ) -> FloatArray | None:
-    """The (4, 2) pixel corners where the lines through each side's ``edge`` points
-    meet (straight in normalised coordinates); None when two sides are parallel or a
-    corner lands further than _MAX_SHIFT from the detection's ``quad``."""
-    lines = _fit_lines(camera.normalize(edge), side)  # one call for all four sides
+    """The (4, 2) pixel corners where the lines through each side's edge points
+    (normalised: ``norm``, where the sides are straight) meet; None when two sides are
+    parallel or a corner lands further than _MAX_SHIFT from the detection's ``quad``."""
+    lines = _fit_lines(norm, side)  # one call for all four sides
     if lines is None:
         return None
     pix = camera.project(np.column_stack([lines, np.ones(4)]))
