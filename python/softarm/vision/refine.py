@@ -105,20 +105,19 @@ def refine_marker_corners(
         return quad
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
-    norm = camera.normalize(edge)
-    pix = _corners(norm, side, camera, quad)
+    centre, direction = _fit_lines(camera.normalize(edge), side)  # one call for all four
+    pix = _corners(centre, direction, camera, quad)
     if pix is None:
         return quad
     clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
     if clipped < CLIPPED_SHARE * prof[good].size:
         return pix  # nothing clipped (a stray noisy pixel aside): the centroid is unbiased
     # Ink to quiet zone along each side's normal: the sign of its profiles' step.
-    direction = np.sign(np.bincount(side, np.sign(wsum[good]), 4))
-    if np.any(direction == 0):
+    step = np.sign(np.bincount(side, np.sign(wsum[good]), 4))
+    if np.any(step == 0):
         return pix
-    return _unbiased(
-        crop, lo, pix, cells, offsets, normals * direction[:, None], norm, side, camera
-    )
+    outward = normals * step[:, None]
+    return _unbiased(crop, lo, pix, cells, offsets, outward, centre, direction, camera)
 
 
 def _unbiased(
@@ -128,44 +127,49 @@ def _unbiased(
     cells: int,
     offsets: FloatArray,
     outward: FloatArray,
-    norm: FloatArray,
-    side: npt.NDArray[np.intp],
+    centre: FloatArray,
+    direction: FloatArray,
     camera: CameraModel,
 ) -> FloatArray:
-    """The corners ``pix`` with the edge points (N, 2, normalised: ``norm``) moved back
-    by the bias the marker's border measures
+    """The corners ``pix`` with the sides' lines (normalised: ``centre``, ``direction``)
+    moved back by the bias the marker's border measures
     (:func:`~softarm.vision.border_bias.border_bias`); ``pix`` when it measures none or
     the moved corners fail."""
     bias = border_bias(crop, crop_origin, pix, cells, offsets, outward)
     if bias == 0.0:
         return pix
-    # A shift of hundredths of a pixel, made in normalised coordinates through the focal
-    # lengths (the lens's local stretch changes it by a few percent at most; undistorting
-    # the points again would cost as much as the first fit).
+    # Every edge point of a side moved alike moves its line, not its direction. A shift
+    # of hundredths of a pixel, made in normalised coordinates through the focal lengths
+    # (the lens's local stretch changes it by a few percent at most; undistorting the
+    # points again would cost as much as the first fit).
     focal = np.array([camera.matrix[0, 0], camera.matrix[1, 1]])
-    moved = _corners(norm - bias * outward[side] / focal, side, camera, pix)
+    moved = _corners(centre - bias * outward / focal, direction, camera, pix)
     return pix if moved is None else moved
 
 
 def _corners(
-    norm: FloatArray, side: npt.NDArray[np.intp], camera: CameraModel, quad: FloatArray
+    centre: FloatArray, direction: FloatArray, camera: CameraModel, quad: FloatArray
 ) -> FloatArray | None:
-    """The (4, 2) pixel corners where the lines through each side's edge points
-    (normalised: ``norm``, where the sides are straight) meet; None when two sides are
-    parallel or a corner lands further than _MAX_SHIFT from the detection's ``quad``."""
-    lines = _fit_lines(norm, side)  # one call for all four sides
-    if lines is None:
+    """The (4, 2) pixel corners where the sides' lines (normalised, where the sides are
+    straight: a point ``centre`` and a ``direction`` each) meet, corner k joining side
+    k - 1 and side k; None when two adjacent lines are parallel or a corner lands further
+    than _MAX_SHIFT from the detection's ``quad``."""
+    p1, d1 = np.roll(centre, 1, axis=0), np.roll(direction, 1, axis=0)  # side k - 1
+    cross = d1[:, 0] * direction[:, 1] - d1[:, 1] * direction[:, 0]
+    if np.min(np.abs(cross)) < 1e-9:
         return None
+    gap = centre - p1
+    s = (gap[:, 0] * direction[:, 1] - gap[:, 1] * direction[:, 0]) / cross
+    lines = p1 + s[:, None] * d1
     pix = camera.project(np.column_stack([lines, np.ones(4)]))
     if np.max(np.linalg.norm(pix - quad, axis=1)) > _MAX_SHIFT:
         return None
     return pix
 
 
-def _fit_lines(points: FloatArray, side: npt.NDArray[np.intp]) -> FloatArray | None:
-    """Corners (4, 2) where the total-least-squares lines through the ``points`` of each
-    side (``side`` = 0..3) meet, corner k joining side k - 1 and side k; None when two
-    adjacent lines are parallel."""
+def _fit_lines(points: FloatArray, side: npt.NDArray[np.intp]) -> tuple[FloatArray, FloatArray]:
+    """The total-least-squares line through the ``points`` of each side (``side`` =
+    0..3): its centroid (4, 2) and unit direction (4, 2)."""
     n = np.bincount(side, minlength=4).astype(np.float64)
     centre = np.column_stack(
         [np.bincount(side, points[:, 0], 4) / n, np.bincount(side, points[:, 1], 4) / n]
@@ -177,11 +181,4 @@ def _fit_lines(points: FloatArray, side: npt.NDArray[np.intp]) -> FloatArray | N
     # The line's direction is the principal axis of the scatter matrix [[sxx, sxy], [sxy, syy]].
     angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
     direction = np.column_stack([np.cos(angle), np.sin(angle)])
-    p1, d1 = np.roll(centre, 1, axis=0), np.roll(direction, 1, axis=0)  # side k - 1
-    cross = d1[:, 0] * direction[:, 1] - d1[:, 1] * direction[:, 0]
-    if np.min(np.abs(cross)) < 1e-9:
-        return None
-    gap = centre - p1
-    s = (gap[:, 0] * direction[:, 1] - gap[:, 1] * direction[:, 0]) / cross
-    result: FloatArray = p1 + s[:, None] * d1
-    return result
+    return centre, direction
