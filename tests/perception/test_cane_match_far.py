@@ -36,7 +36,7 @@ def _far_row(stereo: StereoCamera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def test_far_canes_give_no_points_when_matched_beyond_the_range(stereo: StereoCamera) -> None:
     left, right, mask = _far_row(stereo)
-    aliased = mask_points(left, right, stereo, mask, CaneSettings(reach=None))
+    aliased = mask_points(left, right, stereo, mask, CaneSettings(reach=None, match_far=None))
     assert len(aliased) > 1000  # matched to the neighbouring cane, inside the range
     assert np.all(aliased[:, 2] < 1.55)
     farther = CaneSettings(reach=None, match_far=3.5)

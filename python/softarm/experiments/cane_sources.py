@@ -78,13 +78,20 @@ _COUNTED = CurveSearch(min_support=70, support_length=0.0)
 #: range dropped at their own depth) and the evidence of 70 points and 1.75 mm alone,
 #: a pixel whose match out to 3 m is tied left unmatched (as the far match was first
 #: measured); ``ties``, the same with such a tie going to the match within the range
-#: (``CaneSettings.ties_in_range``).
+#: (``CaneSettings.ties_in_range``); ``ties_thin``, the same with a median radius of
+#: 1.5 mm (the mask's half width, the largest distance to its edge less half a pixel,
+#: reads a cane an even number of pixels wide half a pixel thin: the renderer's thinnest
+#: canes, 2.5 mm, read 1.7 mm at 1.1 m).
 _LENGTH = CurveSearch(min_support=20, support_length=0.08)
 BUDGETS: dict[str, CaneSettings] = {
-    "view": CaneSettings(reach=None, max_points=4000, search=_COUNTED),
-    "reach": CaneSettings(max_points=4000, search=_COUNTED),
-    "length": CaneSettings(max_points=8000, search=_LENGTH),
-    "evidence": CaneSettings(max_points=8000, search=_LENGTH, evidence=CaneEvidence()),
+    "view": CaneSettings(
+        reach=None, max_points=4000, search=_COUNTED, evidence=None, match_far=None
+    ),
+    "reach": CaneSettings(max_points=4000, search=_COUNTED, evidence=None, match_far=None),
+    "length": CaneSettings(max_points=8000, search=_LENGTH, evidence=None, match_far=None),
+    "evidence": CaneSettings(
+        max_points=8000, search=_LENGTH, evidence=CaneEvidence(), match_far=None
+    ),
     "far": CaneSettings(
         max_points=8000,
         search=_LENGTH,
@@ -96,6 +103,13 @@ BUDGETS: dict[str, CaneSettings] = {
         max_points=8000,
         search=_LENGTH,
         evidence=CaneEvidence(min_density=0.0),
+        match_far=3.0,
+        ties_in_range=True,
+    ),
+    "ties_thin": CaneSettings(
+        max_points=8000,
+        search=_LENGTH,
+        evidence=CaneEvidence(min_density=0.0, min_radius=0.0015),
         match_far=3.0,
         ties_in_range=True,
     ),
