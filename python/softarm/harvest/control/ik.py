@@ -46,9 +46,9 @@ def planning_resolver(model: SoftArm, joint_limit_gain: float = -1e-3) -> Resolv
 #: The most resolver steps one start of :meth:`ModelIK.solve` runs. A start that reaches
 #: its pose converges within a few dozen steps (at most 63 of the 1,749 that converged on
 #: diagnosis seeds 1410-1413, tag world, and 90155, row); one that does not runs to the
-#: cap, and those were 99 % of the planner's IK time at a cap of 1,500 (18.2 of 18.3 s on
-#: row 90155). Only converged starts are used, so the plans are the same wherever no
-#: start would have converged past the cap.
+#: cap, and at a cap of 1,500 those were 99 % of the IK's time on row 90155. Only
+#: converged starts are used, so the plans are the same wherever no start would have
+#: converged past the cap.
 SOLVE_STEPS = 300
 
 
