@@ -144,8 +144,11 @@ def matched_disparity(
     margin. Without it, the wider search loses 6–8 % of the near canes' correctly
     matched pixels in the row (1.8 % in the bush; tuning renders 311000–311008), 92–96 %
     of them left unmatched by such a tie, 2–6 % matched beyond the range: a cane so
-    thinned and thinned out can fail the fit's evidence (docs/perception.md, "Matching
-    beyond the range")."""
+    thinned and thinned out can fail the fit's evidence. But a tie does not say which
+    side is right: of the pixels the rule returns there, about as many lie beyond the
+    range (30–48 % in the row) as are near canes' pixels matched right (28–35 %), and
+    with it the far budget is less precise (docs/perception.md, "Ties between the range
+    and beyond")."""
     if match_far is None or match_far <= depth_range[1]:
         return stereo_disparity(left, right, rect, mask, depth_range, smoothness)
     wide = stereo_disparity(left, right, rect, mask, (depth_range[0], match_far), smoothness)
