@@ -9,6 +9,7 @@ import pytest
 
 import softarm
 import softarm.perception.c1 as c1_module
+from softarm.errors import NonFiniteError, ParameterError, ShapeError
 from softarm.harvest_config import HarvestConfig
 from softarm.perception.c1 import StereoC1
 from softarm.perception.self_filter import (
@@ -68,6 +69,35 @@ def test_a_point_is_behind_the_rig_only_where_its_sight_line_crosses_it() -> Non
     grazing = np.array([[0.0, 0.055 * 0.8 / 0.5, 0.8]])
     assert not behind_rig(grazing, eye, outline, margin=0.0)[0]
     assert behind_rig(grazing, eye, outline, margin=0.01)[0]
+
+
+@pytest.mark.parametrize(
+    ("points", "eyes", "outline", "margin", "error", "names"),
+    [
+        (np.zeros((2, 2)), np.zeros((1, 3)), np.ones((1, 4)), 0.01, ShapeError, "points"),
+        (np.zeros((2, 3)), np.zeros((1, 2)), np.ones((1, 4)), 0.01, ShapeError, "eyes"),
+        (np.zeros((2, 3)), np.zeros((1, 3)), np.ones((1, 3)), 0.01, ShapeError, "outline"),
+        (
+            np.full((2, 3), np.nan),
+            np.zeros((1, 3)),
+            np.ones((1, 4)),
+            0.01,
+            NonFiniteError,
+            "points",
+        ),
+        (np.zeros((2, 3)), np.zeros((1, 3)), np.ones((1, 4)), -0.01, ParameterError, "margin"),
+    ],
+)
+def test_bad_inputs_to_behind_rig_are_named(
+    points: np.ndarray,
+    eyes: np.ndarray,
+    outline: np.ndarray,
+    margin: float,
+    error: type,
+    names: str,
+) -> None:
+    with pytest.raises(error, match=names):
+        behind_rig(points, eyes, outline, margin)
 
 
 def test_the_outline_covers_the_frustums_plates_and_the_tube() -> None:

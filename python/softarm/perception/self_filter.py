@@ -9,7 +9,8 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm._core import SoftArm
-from softarm.checks import FloatArray
+from softarm.checks import FloatArray, as_array, finite_real, numeric_array
+from softarm.errors import ParameterError, ShapeError
 from softarm.harvest_config import HarvestConfig
 from softarm.vision.cube import MarkerCube
 from softarm.vision.marker_body import panel_corners
@@ -115,11 +116,23 @@ def behind_rig(
     no eye saw it there. A stereo match there is of the rig's own pixels (a plate's dark
     ink or edge) or of a cane one eye could not see, put at some wrong depth behind the
     rig, which the fit-level filter (:func:`a_cane`, by the distance to the rig's parts)
-    does not catch."""
-    p = np.asarray(points, np.float64)[:, :3]
-    centres, radii = outline[:, :3], outline[:, 3] + margin
+    does not catch.
+
+    Raises:
+        InputError: ``points``, ``eyes`` or ``outline`` of the wrong shape or not
+            finite (ShapeError, NonFiniteError); ``margin`` not finite and >= 0
+            (ParameterError).
+    """
+    p = numeric_array(points, "points")
+    if p.ndim != 2 or p.shape[1] < 3:
+        raise ShapeError(f"points must have shape (N, 3) or more columns, got {p.shape}")
+    p = as_array(p[:, :3], (None, 3), "points")
+    outline = as_array(outline, (None, 4), "outline")
+    if not (finite_real(margin) and margin >= 0.0):
+        raise ParameterError(f"margin must be finite and >= 0 m, got {margin!r}")
+    centres, radii = outline[:, :3], outline[:, 3] + float(margin)
     hidden = np.zeros(len(p), bool)
-    for eye in np.asarray(eyes, np.float64).reshape(-1, 3):
+    for eye in as_array(eyes, (None, 3), "eyes"):
         ray = p - eye
         length = np.linalg.norm(ray, axis=1)
         unit = ray / np.maximum(length, 1e-12)[:, None]
