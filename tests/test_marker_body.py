@@ -4,9 +4,11 @@ in the rendered world's scene, and the config and command-line spellings."""
 
 from __future__ import annotations
 
+import json
 import re
 import types
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,6 +22,7 @@ from softarm.sim.markers import cube_scene_markers
 from softarm.vision import CameraModel, MarkerCube
 from softarm.vision.marker_body import (
     MARKER_BODIES,
+    SIMULATED_BODY,
     body_markers,
     check_marker_body,
     marker_body,
@@ -194,3 +197,19 @@ def test_tracking_errors_binned_by_approach_angle() -> None:
     assert [(r["poses"], r["found"]) for r in rows] == [(1, 1), (2, 1), (0, 0), (1, 1), (1, 1)]
     assert rows[1]["median_mm"] == pytest.approx(0.3)
     assert np.isnan(rows[2]["median_mm"]) and rows[4]["p95_mm"] == pytest.approx(9.0)
+
+
+@pytest.mark.parametrize(
+    ("flag", "body"), [([], SIMULATED_BODY), (["--marker-body", "cube"], "cube")]
+)
+def test_the_simulator_carries_the_frustum_unless_told_and_logs_its_body(
+    tmp_path: Path, flag: list[str], body: str
+) -> None:
+    # The simulator's default is the frustum; the hardware's stays the cube (above).
+    from softarm.cli import main
+
+    log = tmp_path / "run.jsonl"
+    args = ["harvest", "--sim", "--berries", "1", "--seed", "90031", "--log", str(log), "-q"]
+    assert main([*args, *flag]) in (0, 1)  # 1: the berry not harvested
+    header = json.loads(log.read_text().splitlines()[0])
+    assert SIMULATED_BODY == "frustum" and header["marker_body"] == body

@@ -14,7 +14,9 @@ import pytest
 
 from render_required import need_mujoco, unavailable
 from softarm.cli import main
+from softarm.config import load_config
 from softarm.harvest.records.frame_files import INDEX
+from softarm.vision.marker_body import SIMULATED_BODY
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -90,6 +92,14 @@ def _run_events(path: Path) -> list[tuple[object, ...]]:
         elif r["kind"] in ("run_done", "run_stopped"):
             story.append((r["kind"],))
     return story
+
+
+def test_the_rig_files_name_the_body_the_recording_tracked(recording: Path) -> None:
+    # The hardware's default body is the cube: a recording of another body must say so,
+    # or its replay tracks the wrong tags' layout and leaves the recording.
+    calibration = load_config(recording / "hw.toml").calibration
+    assert SIMULATED_BODY != "cube"
+    assert calibration.marker_body == SIMULATED_BODY and calibration.marker_length == 0.08
 
 
 def test_both_rigs_run_the_recorded_harvest_by_one_policy(recording: Path, tmp_path: Path) -> None:

@@ -153,7 +153,7 @@ def add_world_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--marker-body", choices=MARKER_BODIES, default=None,
-        help="--sim: the marker body on the gripper that C1 tracks (default cube; "
+        help="--sim: the marker body on the gripper that C1 tracks (default frustum; "
         "docs/hardware.md, 'The marker body'); on the arm, [calibration] marker_body",
     )  # fmt: skip
 
@@ -202,7 +202,8 @@ def run(args: argparse.Namespace) -> int:
     gains = _gains(args)
     if args.sim:
         args.seed = 0 if args.seed is None else args.seed
-        options.update(marker_body=args.marker_body or "cube")
+        if args.marker_body is not None:
+            options.update(marker_body=args.marker_body)
         if args.world.rendered:
             options.update(world=args.world, unripe_fraction=BUSH_UNRIPE_FRACTION)
             options.update(survey=args.survey is not False, record_frames=args.record_frames)

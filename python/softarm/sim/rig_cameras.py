@@ -16,7 +16,7 @@ from softarm.sim.bush import Berry
 from softarm.sim.camera import SyntheticCamera
 from softarm.sim.markers import SceneMarker, cube_scene_markers
 from softarm.vision import CameraModel
-from softarm.vision.marker_body import marker_body
+from softarm.vision.marker_body import SIMULATED_BODY, marker_body
 from softarm.vision.poses import invert
 from softarm.vision.two_cameras import CameraVision, register_c1
 
@@ -63,7 +63,7 @@ class SimCameras:
     noise_std: float = 2.0
     cube_marker: float = 0.08
     #: The gripper's marker body (:data:`softarm.vision.marker_body.MARKER_BODIES`).
-    marker_body: str = "cube"
+    marker_body: str = SIMULATED_BODY
     base_tag: float = 0.08
     berry_tag: float = 0.03
     scale: float = 1.0

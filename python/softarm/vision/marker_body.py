@@ -28,6 +28,7 @@ from softarm.vision.cube import FACE_PER_MARKER, MarkerCube
 __all__ = [
     "FRUSTUM_TILT_DEG",
     "MARKER_BODIES",
+    "SIMULATED_BODY",
     "body_markers",
     "check_marker_body",
     "marker_body",
@@ -37,6 +38,12 @@ __all__ = [
 
 #: The marker bodies by name (``marker_body`` in hw.toml's [calibration], ``--marker-body``).
 MARKER_BODIES = ("cube", "frustum")
+#: The body the simulator's rig carries unless told otherwise (``--marker-body``,
+#: ``SimRigOptions.marker_body``): the frustum, which C1 sees within about 45° from every
+#: approach of the harvest. The hardware's default stays the paper's cube (hw.toml's
+#: ``[calibration] marker_body``): an hw.toml without the key belongs to an arm built
+#: with a cube.
+SIMULATED_BODY = "frustum"
 #: How far (degrees) the frustum's faces lean back from the cube's towards the arm: C1
 #: sees the body from 30–62° off its back axis in the harvest's poses (rendered bushes
 #: 400–409), and 40° puts the worst tag angle over all azimuths under 40° there.

@@ -25,7 +25,7 @@ from softarm.sim.render.look import BushLook
 from softarm.sim.render.row import Row
 from softarm.vision.cube import FACE_PER_MARKER
 from softarm.vision.dictionaries import get_dictionary
-from softarm.vision.marker_body import body_markers
+from softarm.vision.marker_body import SIMULATED_BODY, body_markers
 
 __all__ = ["ARM_SEGMENTS_PER_SECTION", "CameraSpec", "SceneSpec", "scene_xml", "z_to"]
 
@@ -79,7 +79,7 @@ class SceneSpec:
     cube_ids: tuple[int, int, int, int] = (0, 1, 2, 3)
     cube_marker: float = 0.08
     #: The gripper's marker body (softarm.vision.marker_body.MARKER_BODIES).
-    marker_body: str = "cube"
+    marker_body: str = SIMULATED_BODY
     n_sections: int = 3
     dictionary: str = "DICT_4X4_50"
     keep_clear: Sequence[tuple[FloatArray, FloatArray]] = field(default_factory=tuple)

@@ -37,8 +37,8 @@ from softarm.sim.render.row_camera import RowCameras
 from softarm.sim.render.row_look import RowLook
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
+from softarm.vision.marker_body import SIMULATED_BODY, panel_corners
 from softarm.vision.marker_body import marker_body as make_body
-from softarm.vision.marker_body import panel_corners
 from softarm.vision.poses import invert
 from softarm.vision.stereo_camera import StereoCamera
 
@@ -118,7 +118,7 @@ class RenderedBush:
         baseline: float = ZED2_BASELINE,
         n_sections: int = 3,
         shadows: bool = True,
-        marker_body: str = "cube",
+        marker_body: str = SIMULATED_BODY,
     ) -> None:
         self.bush = bush
         self.look = look or BushLook.random(bush.seed)
@@ -359,7 +359,7 @@ def world_for(
         bush, cams.T_base_c1, cams.model(1), scaled(cams.model(2), c2_scale), cams.T_ee_c2,
         cams.T_ee_cube,
         cams.T_base_tag, base_tag_id, cams.base_tag, cams.cube_marker, look,
-        marker_body=getattr(cams, "marker_body", "cube"),
+        marker_body=getattr(cams, "marker_body", SIMULATED_BODY),
     )  # fmt: skip
 
 

@@ -118,6 +118,10 @@ class RigDescription:
     T_ee_cube: FloatArray
     berry_tag: float
     T_base_tag: FloatArray
+    #: The body carrying the tags C1 tracks, and their side (m): the replay must track
+    #: the body the recording saw.
+    marker_body: str
+    marker_length: float
     #: Whether the rig surveyed the canes with C2 (``[perception] survey``).
     survey: bool = True
 
@@ -147,6 +151,8 @@ class RigDescription:
             T_EE_cube=_matrix(self.T_ee_cube),
             berry_tag=self.berry_tag,
             T_base_tag=_matrix(self.T_base_tag),
+            marker_body=self.marker_body,
+            marker_length=self.marker_length,
         )
         return Config(
             ArmConfig(sections),

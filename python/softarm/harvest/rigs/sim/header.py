@@ -37,6 +37,7 @@ def sim_settings(rig: SimRig, options: SimRigOptions) -> dict[str, Any]:
         "plant": plant,
         "arm": arm_settings(rig.model),
         "grasp_offset_m": options.config.grasp_offset,
+        "marker_body": options.marker_body,
         "pressure_map": pressure_settings(
             None if options.calibration is None else options.calibration.pressure_map(),
             rig.model.n_actuators,

@@ -19,6 +19,7 @@ from softarm.sim.arm import PlantConfig
 from softarm.sim.rig_cameras import SimCameras, look_at
 from softarm.sim.world import WorldName
 from softarm.units import METRES_PER_PSI
+from softarm.vision.marker_body import SIMULATED_BODY
 
 __all__ = ["SimRigOptions", "declared_plant", "default_cameras"]
 
@@ -82,7 +83,7 @@ class SimRigOptions:
     record_frames: str | Path | None = None
     #: The gripper's marker body C1 tracks (softarm.vision.marker_body.MARKER_BODIES;
     #: ``--marker-body``), drawn in every world; hw.toml's ``[calibration] marker_body``.
-    marker_body: str = "cube"
+    marker_body: str = SIMULATED_BODY
 
     def __post_init__(self) -> None:
         self.world = WorldName.parse(self.world)  # a name given as a string, checked

@@ -131,7 +131,8 @@ def _rendered_world(w: WorldParts) -> RenderedWorld:
         identified = o.identified or declared_plant(o.plant, w.model.n_actuators, cfg.period)
         rig = RigDescription(
             w.model, cfg, dict(o.gains), identified, scene, scene.world.c2,
-            w.cams.T_ee_c2, w.cams.T_ee_cube, w.cams.berry_tag, w.cams.T_base_tag, o.survey,
+            w.cams.T_ee_c2, w.cams.T_ee_cube, w.cams.berry_tag, w.cams.T_base_tag,
+            w.cams.marker_body, w.cams.cube_marker, o.survey,
         )  # fmt: skip
         write_rig_files(w.recorder.folder, rig)
     return RenderedWorld(o.world, scene, vision, gripper, canes, o.survey)
