@@ -89,6 +89,11 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         "drawn at --scale 0.5 for a network run at full size)",
     )  # fmt: skip
     t.add_argument(
+        "--heatmap", choices=("logistic", "focal"), default="logistic",
+        help="the centre heatmap's loss: logistic (default) or CenterNet's focal loss, "
+        "whose sharp peaks split touching fruit (the record beside OUT tells the detector)",
+    )  # fmt: skip
+    t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",
         help="start from these weights ('default': the shipped ones) instead of fresh ones",
     )  # fmt: skip
@@ -150,7 +155,7 @@ def run_train(args: argparse.Namespace) -> int:
 
     record = train(
         args.data, args.out, args.epochs, args.seed, start, on_epoch, args.widths, args.scale,
-        args.stem, args.zoom,
+        args.stem, args.zoom, args.heatmap,
     )  # fmt: skip
     print(
         f"detector train: {args.epochs} epochs in {record['seconds']} s on "

@@ -1,11 +1,11 @@
 """From the network's per-pixel output to berries: fruit pixels (ripe, turning and unripe
 together) split into connected parts; a part with two or more peaks of the centre
 heatmap (fruit that touch) is split between them, each pixel going to its nearest peak
-(or, with ``DetectorSettings.split_touching``, at the necks of the part's shape:
-:mod:`.touching`); each instance's stage is the stage most of its pixels' probability
-says. Everything runs at the network's resolution; each instance's mask is then
-resized to the image, and placed and sized as :mod:`softarm.perception.berries` places
-and sizes its blobs."""
+(the peaks found by the rule of the heatmap's kind, :data:`PEAK_RULES`; or, with
+``DetectorSettings.split_touching``, at the necks of the part's shape: :mod:`.touching`);
+each instance's stage is the stage most of its pixels' probability says. Everything
+runs at the network's resolution; each instance's mask is then resized to the image,
+and placed and sized as :mod:`softarm.perception.berries` places and sizes its blobs."""
 
 from __future__ import annotations
 
@@ -28,7 +28,15 @@ from softarm.perception.detector.network import NetworkOutput
 from softarm.perception.detector.touching import disc_seeds, split_discs
 from softarm.vision.camera_model import CameraModel
 
-__all__ = ["FRUIT_THRESHOLD", "RIPE_SHARE", "StagedDetection", "instance_stage", "instances"]
+__all__ = [
+    "FRUIT_THRESHOLD",
+    "PEAK_RULES",
+    "RIPE_SHARE",
+    "PeakRule",
+    "StagedDetection",
+    "instance_stage",
+    "instances",
+]
 
 #: A pixel is fruit where the three stages' probabilities sum to more than this.
 FRUIT_THRESHOLD = 0.5
@@ -37,6 +45,13 @@ FRUIT_THRESHOLD = 0.5
 #: the evaluation sets: the shipped network's heatmap is broad, and 0.35 split one fruit
 #: into many (precision 0.03 there, against 0.26 at 0.6).
 PEAK_THRESHOLD = 0.6
+#: A focal-loss heatmap's peak rule (``softarm detector train --heatmap focal``): its
+#: peaks are a pixel or two wide, one per fruit, so a peak of FOCAL_PEAK_THRESHOLD is a
+#: fruit and two peaks FOCAL_PEAK_SEPARATION apart are two (touching fruit at C1's half
+#: size lie 4-12 network px apart, inside PEAK_SEPARATION). Chosen on the validation
+#: renders (dataset seed 100300), not on the evaluation sets.
+FOCAL_PEAK_THRESHOLD = 0.3
+FOCAL_PEAK_SEPARATION = 2.5
 #: Fewest network pixels an instance may have (two or three image pixels across at the
 #: network's scale: smaller parts are speckle, not fruit C1 could place).
 MIN_PIXELS = 6
@@ -54,6 +69,22 @@ _U8 = npt.NDArray[np.uint8]
 
 
 @dataclass(frozen=True)
+class PeakRule:
+    """Which local maxima of a centre heatmap seed a fruit: at least ``threshold`` high
+    and more than ``separation`` network px from a stronger one."""
+
+    threshold: float
+    separation: float
+
+
+#: The peak rule of each heatmap kind (``NetworkOutput.heatmap``).
+PEAK_RULES = {
+    "logistic": PeakRule(PEAK_THRESHOLD, PEAK_SEPARATION),
+    "focal": PeakRule(FOCAL_PEAK_THRESHOLD, FOCAL_PEAK_SEPARATION),
+}
+
+
+@dataclass(frozen=True)
 class StagedDetection(BerryDetection):
     """A :class:`BerryDetection` with the fruit's ``stage`` ("ripe", "turning" or
     "unripe"; ``ripeness`` is "ripe" only for ripe, since turning fruit is not ripe)."""
@@ -61,15 +92,17 @@ class StagedDetection(BerryDetection):
     stage: str = "ripe"
 
 
-def _peaks(centres: npt.NDArray[np.float32], part: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
-    """(row, col) of the heatmap's local maxima inside ``part``."""
+def _peaks(
+    centres: npt.NDArray[np.float32], part: npt.NDArray[np.bool_], rule: PeakRule
+) -> list[tuple[int, int]]:
+    """(row, col) of the heatmap's local maxima inside ``part`` that ``rule`` keeps."""
     grown = cv2.dilate(centres, np.ones((3, 3), np.uint8))
-    rows, cols = np.nonzero(part & (centres >= grown) & (centres >= PEAK_THRESHOLD))
+    rows, cols = np.nonzero(part & (centres >= grown) & (centres >= rule.threshold))
     order = np.argsort(-centres[rows, cols], kind="stable")
     kept: list[tuple[int, int]] = []
     for r, c in zip(rows[order].tolist(), cols[order].tolist(), strict=True):
         # A plateau or a ragged peak gives neighbours of one centre: keep the strongest.
-        if all((r - kr) ** 2 + (c - kc) ** 2 > PEAK_SEPARATION**2 for kr, kc in kept):
+        if all((r - kr) ** 2 + (c - kc) ** 2 > rule.separation**2 for kr, kc in kept):
             kept.append((r, c))
     return kept
 
@@ -83,16 +116,16 @@ def _split(
 
 
 def _pieces(
-    part: npt.NDArray[np.bool_], centres: npt.NDArray[np.float32], split: bool
+    part: npt.NDArray[np.bool_], centres: npt.NDArray[np.float32], split: bool, rule: PeakRule
 ) -> list[npt.NDArray[np.bool_]]:
     """``part`` as one mask per fruit: at the necks of its distance map (``split``,
-    :mod:`.touching`), else at its centre heatmap's peaks."""
+    :mod:`.touching`), else at its centre heatmap's peaks (of ``rule``)."""
     if split:
         # Too few pixels for two fruit of the least radius: one fruit, no distance map.
         if np.count_nonzero(part) < 2 * np.pi * SEED_RADIUS**2:
             return [part]
         return split_discs(part, disc_seeds(part, SEED_RADIUS))
-    return _split(part, _peaks(centres, part))
+    return _split(part, _peaks(centres, part, rule))
 
 
 #: An instance at the network's resolution: its mask over its window, and the window's
@@ -106,6 +139,7 @@ def instance_masks(
     """The fruit instances at the network's resolution (``fruit``: output.fruit()), fruit
     that touch split at the necks of their part's distance map (``split``) or at the
     centre heatmap's peaks."""
+    rule = PEAK_RULES[output.heatmap]
     binary = cast(_U8, (fruit > FRUIT_THRESHOLD).astype(np.uint8))
     binary = cast(_U8, cv2.morphologyEx(binary, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)))
     n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
@@ -115,7 +149,7 @@ def instance_masks(
         if area < MIN_PIXELS:
             continue
         part = labels[y : y + h, x : x + w] == k
-        for piece in _pieces(part, output.centres[y : y + h, x : x + w], split):
+        for piece in _pieces(part, output.centres[y : y + h, x : x + w], split, rule):
             if np.count_nonzero(piece) >= MIN_PIXELS:
                 out.append((piece, x, y))
     return out

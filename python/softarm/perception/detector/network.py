@@ -9,7 +9,11 @@ output is (1, :data:`N_OUTPUTS`, H, W): one logit per class of :data:`CLASSES` a
 pixel and, last, the logit of the fruit-centre heatmap (a peak at each fruit's centre).
 A network with a stride-2 stem (``train.unet``: the full image's detail, the rest of the
 network at half its size) gives (1, N_OUTPUTS, H/2, W/2), H and W multiples of
-2 × STRIDE; the output's stride is read from the file by a probe.
+2 × STRIDE; the output's stride is read from the file by a probe. How the heatmap was
+trained (:data:`HEATMAPS`: the broad logistic heatmap, or the focal loss's sharp peaks),
+which the decoding into fruit must know, is read from the training record beside the
+weights (the same name with ``.json``, as ``softarm detector train`` writes it); without
+one, the heatmap is the logistic one (the shipped weights').
 Training images are shrunk so that their longer side is at most :data:`MAX_SIDE` pixels
 (the scale the training renders were drawn at: C1's 1280 × 720 eye at half size) times
 the output's stride; at run time images are shrunk to a network's own longest side, by
@@ -19,6 +23,7 @@ network, at full size for one with the stem).
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import cast
 
@@ -31,6 +36,7 @@ from softarm.errors import InputError, VisionError
 __all__ = [
     "CLASSES",
     "DEFAULT_WEIGHTS",
+    "HEATMAPS",
     "MAX_SIDE",
     "N_OUTPUTS",
     "RUN_SIDE",
@@ -53,6 +59,8 @@ MAX_SIDE = 640
 RUN_SIDE = 640
 #: The weights that ship in the package.
 DEFAULT_WEIGHTS = Path(__file__).parent / "weights" / "berries.onnx"
+#: The centre heatmap's kinds, by the loss it was trained with (the record's "heatmap").
+HEATMAPS = ("logistic", "focal")
 
 _F32 = npt.NDArray[np.float32]
 _U8 = npt.NDArray[np.uint8]
@@ -66,12 +74,16 @@ def normalise(image: _U8) -> _F32:
 class NetworkOutput:
     """The network's output for one image, at the network's resolution: ``probabilities``
     (h, w, len(CLASSES)) float32 summing to 1 per pixel and ``centres`` (h, w) float32 in
-    [0, 1]; ``size`` (W, H) is the image's, :meth:`upsample` brings a map to it."""
+    [0, 1]; ``size`` (W, H) is the image's, :meth:`upsample` brings a map to it;
+    ``heatmap`` is how the centres were trained (of HEATMAPS)."""
 
-    def __init__(self, probabilities: _F32, centres: _F32, size: tuple[int, int]) -> None:
+    def __init__(
+        self, probabilities: _F32, centres: _F32, size: tuple[int, int], heatmap: str = "logistic"
+    ) -> None:
         self.probabilities = probabilities
         self.centres = centres
         self.size = size
+        self.heatmap = heatmap
 
     @property
     def scale(self) -> float:
@@ -96,7 +108,8 @@ class Network:
 
     Raises:
         VisionError: the file is missing, is not an ONNX network, or gives outputs of
-            the wrong shape (the message names the file).
+            the wrong shape, or its training record is unreadable or names an unknown
+            heatmap (the message names the file).
         InputError: ``max_side`` is not None or an integer of at least STRIDE.
     """
 
@@ -129,6 +142,8 @@ class Network:
         #: Image pixels per output pixel of the network (2 for a network with the stem).
         self.stride = shapes[probe.shape]
         self.max_side = RUN_SIDE * self.stride if max_side is None else max_side
+        #: How the centre heatmap was trained (of HEATMAPS), from the record beside it.
+        self.heatmap = heatmap_of(self.path)
 
     def _forward(self, blob: _F32) -> _F32:
         try:
@@ -154,5 +169,29 @@ class Network:
         probs = (e / e.sum(axis=0, keepdims=True)).transpose(1, 2, 0)
         centres = 1.0 / (1.0 + np.exp(-out[len(CLASSES)]))
         return NetworkOutput(
-            np.ascontiguousarray(probs, np.float32), centres.astype(np.float32), (w, h)
+            np.ascontiguousarray(probs, np.float32), centres.astype(np.float32), (w, h),
+            self.heatmap,
+        )  # fmt: skip
+
+
+def heatmap_of(weights: Path) -> str:
+    """The heatmap kind of ``weights`` (of HEATMAPS): its training record's "heatmap"
+    (``weights`` with ``.json``), "logistic" where there is no record or it names none
+    (records written before the focal loss existed).
+
+    Raises:
+        VisionError: the record is not a JSON object, or names an unknown heatmap.
+    """
+    record = weights.with_suffix(".json")
+    if not record.is_file():
+        return "logistic"
+    try:
+        data = json.loads(record.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise VisionError(f"detector record {record}: not readable JSON ({exc})") from None
+    kind = data.get("heatmap", "logistic") if isinstance(data, dict) else None
+    if kind not in HEATMAPS:
+        raise VisionError(
+            f"detector record {record}: heatmap {kind!r} is not one of {', '.join(HEATMAPS)}"
         )
+    return str(kind)

@@ -52,6 +52,7 @@ def train(
     scale: tuple[float, float] | None = None,
     stem: bool = False,
     zooms: list[float] | None = None,
+    heatmap: str = "logistic",
 ) -> dict[str, Any]:
     """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
     and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
@@ -61,21 +62,22 @@ def train(
     :data:`.augment.SCALE`). ``stem``: a fresh network with the stride-2 stem (run on
     images twice the size: the samples are shrunk to twice MAX_SIDE and cropped twice as
     large; a fine-tuned one keeps its file's); ``zooms``: one scale factor per data folder
-    (default 1; 2 for renders drawn at half the size the network runs at). Returns the
-    record.
+    (default 1; 2 for renders drawn at half the size the network runs at); ``heatmap``:
+    the centre heatmap's loss, "logistic" or "focal" (CenterNet's: sharp peaks, which
+    the record tells the run-time decoding, :mod:`..network`). Returns the record.
 
     Raises:
         TrainExtraMissing: the ``train`` extra is not installed.
         InputError: a data folder holds no labelled image, ``start`` is not a network
             of this architecture, ``widths`` or ``stem`` are given with ``start``, or
-            ``widths``, ``scale`` or ``zooms`` are not valid.
+            ``widths``, ``scale``, ``zooms`` or ``heatmap`` are not valid.
     """
     require_train_extra()
     import jax
 
     from softarm.perception.detector.network import MAX_SIDE
     from softarm.perception.detector.train.augment import SCALE
-    from softarm.perception.detector.train.loop import TrainSettings, fit
+    from softarm.perception.detector.train.loop import HEATMAP_LOSSES, TrainSettings, fit
     from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
     from softarm.perception.detector.train.samples import describe, load_samples
     from softarm.perception.detector.train.unet import WIDTHS, layers, stem_of, widths_of
@@ -86,6 +88,8 @@ def train(
         )
     if scale is not None and not 0 < scale[0] <= scale[1]:
         raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
+    if heatmap not in HEATMAP_LOSSES:
+        raise InputError(f"heatmap {heatmap!r}: one of {', '.join(HEATMAP_LOSSES)} expected")
     layers(WIDTHS if widths is None else widths)  # checks them before the data is read
     params = None if start is None else params_from_onnx(start)
     stem = stem_of(params) if params is not None else stem
@@ -93,7 +97,7 @@ def train(
     settings = TrainSettings(
         epochs=epochs, seed=seed,
         widths=widths_of(params) if params is not None else widths or WIDTHS,
-        scale=SCALE if scale is None else scale, stem=stem,
+        scale=SCALE if scale is None else scale, stem=stem, heatmap=heatmap,
     )  # fmt: skip
     began = time.perf_counter()
     params = fit(samples, settings, params, on_epoch)
@@ -110,6 +114,7 @@ def train(
         "widths": list(settings.widths),
         "scale": list(settings.scale),
         "stem": settings.stem,
+        "heatmap": heatmap,
         "losses": [round(v, 5) for v in settings.losses],
         "seconds": round(time.perf_counter() - began, 1),
         "device": str(jax.devices()[0].platform),

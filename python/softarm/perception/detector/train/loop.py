@@ -1,5 +1,6 @@
 """The training loop (JAX + optax): class-weighted cross-entropy over the pixels' classes
-plus a weighted logistic loss on the centre heatmap, AdamW with a cosine schedule, on
+plus a weighted logistic loss on the centre heatmap (or CenterNet's focal loss:
+:mod:`.focal`), AdamW with a cosine schedule, on
 batches of augmented crops (twice the side for a network with the stride-2 stem, whose
 outputs are scored against the labels at half resolution); deterministic in the seed
 (the same crops, the same order, the same initial weights). JAX runs on a GPU where it
@@ -18,25 +19,29 @@ import numpy as np
 import numpy.typing as npt
 import optax
 
-from softarm.perception.detector.network import CLASSES, normalise
+from softarm.perception.detector.network import CLASSES, HEATMAPS, normalise
 from softarm.perception.detector.train.augment import CROP, SCALE, crop_batch
+from softarm.perception.detector.train.focal import focal_loss, prior_bias, sharpened
 from softarm.perception.detector.train.samples import IGNORE, Sample
 from softarm.perception.detector.train.unet import WIDTHS, Params, apply, init_params
 
-__all__ = ["CLASS_WEIGHTS", "TrainSettings", "fit"]
+__all__ = ["CLASS_WEIGHTS", "HEATMAP_LOSSES", "TrainSettings", "fit"]
 
 #: Loss weight of each class's pixels (fruit and canes are few pixels of a frame).
 CLASS_WEIGHTS = (1.0, 2.5, 3.0, 2.5, 1.5)
 #: Weight of the centre heatmap's loss, and how much more a peak's pixels count.
 CENTRE_WEIGHT = 1.0
 CENTRE_POSITIVE = 20.0
+#: The centre heatmap's losses: the weighted logistic loss (the default) and CenterNet's
+#: penalty-reduced focal loss (:mod:`.focal`: sharp peaks, one per fruit).
+HEATMAP_LOSSES = HEATMAPS
 
 
 @dataclass(frozen=True)
 class TrainSettings:
     """Epochs (one crop of every image each), batch size, peak learning rate, seed, the
-    network's channel widths, the augmentation's scale range and whether the network
-    has the stride-2 stem (``unet``)."""
+    network's channel widths, the augmentation's scale range, whether the network
+    has the stride-2 stem (``unet``) and the heatmap's loss (of HEATMAP_LOSSES)."""
 
     epochs: int = 150
     batch: int = 12
@@ -45,10 +50,11 @@ class TrainSettings:
     widths: tuple[int, ...] = WIDTHS
     scale: tuple[float, float] = SCALE
     stem: bool = False
+    heatmap: str = "logistic"
     losses: list[float] = field(default_factory=list, compare=False)
 
 
-def _loss(params: Params, x: Any, classes: Any, centres: Any) -> Any:
+def _loss(params: Params, x: Any, classes: Any, centres: Any, focal: bool = False) -> Any:
     out = apply(params, x)
     logits, centre = out[..., : len(CLASSES)], out[..., len(CLASSES)]
     valid = classes != IGNORE
@@ -56,6 +62,8 @@ def _loss(params: Params, x: Any, classes: Any, centres: Any) -> Any:
     ce = optax.softmax_cross_entropy_with_integer_labels(logits, target)
     w = jnp.asarray(CLASS_WEIGHTS)[target] * valid
     class_loss = jnp.sum(ce * w) / jnp.maximum(jnp.sum(w), 1.0)
+    if focal:
+        return class_loss + CENTRE_WEIGHT * focal_loss(centre, centres)
     bce = optax.sigmoid_binary_cross_entropy(centre, centres)
     cw = 1.0 + CENTRE_POSITIVE * centres
     centre_loss = jnp.sum(bce * cw) / jnp.sum(cw)
@@ -81,8 +89,12 @@ def fit(
 ) -> Params:
     """Train from ``params`` (default: fresh, from the seed) on ``samples``; calls
     ``on_epoch(epoch, mean loss, seconds)`` after each epoch."""
+    focal = settings.heatmap == "focal"
     if params is None:
         params = init_params(settings.seed, settings.widths, settings.stem)
+        if focal:  # the heatmap starts at PRIOR everywhere, as CenterNet's
+            w, b = params["head"]
+            params = {**params, "head": (w, b.at[len(CLASSES)].set(prior_bias()))}
     crop = CROP * 2 if settings.stem else CROP
     per_epoch = max(1, int(np.ceil(len(samples) / settings.batch)))
     total = settings.epochs * per_epoch
@@ -94,7 +106,7 @@ def fit(
 
     @jax.jit
     def step(p: Params, s: Any, x: Any, c: Any, h: Any) -> tuple[Params, Any, Any]:
-        loss, grads = jax.value_and_grad(_loss)(p, x, c, h)
+        loss, grads = jax.value_and_grad(_loss)(p, x, c, h, focal)
         updates, s = optimiser.update(grads, s, p)
         return optax.apply_updates(p, updates), s, loss
 
@@ -113,6 +125,8 @@ def fit(
             )
             if settings.stem:
                 classes, centres = _halved(classes, centres)
+            if focal:
+                centres = sharpened(centres)
             params, state, loss = step(
                 params, state, jnp.asarray(normalise(images)), jnp.asarray(classes),
                 jnp.asarray(centres),
