@@ -120,3 +120,20 @@ def test_the_pooled_figures() -> None:
     assert f["s_per_berry"] == 5.0 and f["true_over_05"] == 1 and f["true_n"] == 2
     assert f["harvested"] == 2 and f["ripe"] == 3
     assert summarise([row]) == {"grasps": 0}
+
+
+def test_the_residual_and_the_bias_are_split() -> None:
+    # Two grasps, 0.6 mm true along the approach: one from a bias of 0.45 mm and a
+    # residual of 0.15 mm (within 0.5 mm had it ended on the measured berry), one from
+    # a bias of 0.6 mm (not: the bias alone is over 0.5 mm).
+    def grasp(bias_mm: float) -> dict[str, Any]:
+        return {"true_vec_mm": [0.0, 0.0, 0.6], "bias": {"vec": [0.0, 0.0, bias_mm]},
+                "left_when_true": {s: {"vec": [0.0, 0.0, 0.0]} for s in SOURCES},
+                "carried_alone": {s: {"vec": [0.0, 0.0, bias_mm]} for s in SOURCES},
+                "c1_ray_px": 0.2}  # fmt: skip
+
+    out = summarise([{"seed": 1, "grasps": [grasp(0.45), grasp(0.6)]}])
+    assert out["true_within_0.5mm"] == 0
+    assert out["without_residual"] == 1 and out["without_bias"] == 2
+    assert out["residual_norm_median_mm"] == pytest.approx(0.075)
+    assert out["c1_ray"]["within_0.5mm_when_true_without_residual"] == 2
