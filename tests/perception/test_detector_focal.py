@@ -151,6 +151,9 @@ def test_focal_training_is_deterministic_in_its_seed_and_tells_the_detector(
         assert runs[0] == runs[1] and runs[0] != runs[2]
         assert json.loads((out / "a.json").read_text())["heatmap"] == "focal"
         assert LearnedDetector(out / "a.onnx").network.heatmap == "focal"
+        # fine-tuned, it keeps its file's heatmap
+        train([data], out / "d.onnx", 1, 5, start=out / "a.onnx")
+        assert json.loads((out / "d.json").read_text())["heatmap"] == "focal"
         print("ok")
         """,
         str(data),

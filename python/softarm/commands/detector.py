@@ -89,9 +89,10 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         "drawn at --scale 0.5 for a network run at full size)",
     )  # fmt: skip
     t.add_argument(
-        "--heatmap", choices=("logistic", "focal"), default="logistic",
-        help="the centre heatmap's loss: logistic (default) or CenterNet's focal loss, "
-        "whose sharp peaks split touching fruit (the record beside OUT tells the detector)",
+        "--heatmap", choices=("logistic", "focal"),
+        help="the centre heatmap's loss: logistic (default; with --from, that file's) or "
+        "CenterNet's focal loss, whose sharp peaks split touching fruit (the record beside "
+        "OUT tells the detector)",
     )  # fmt: skip
     t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",

@@ -52,7 +52,7 @@ def train(
     scale: tuple[float, float] | None = None,
     stem: bool = False,
     zooms: list[float] | None = None,
-    heatmap: str = "logistic",
+    heatmap: str | None = None,
 ) -> dict[str, Any]:
     """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
     and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
@@ -64,18 +64,20 @@ def train(
     large; a fine-tuned one keeps its file's); ``zooms``: one scale factor per data folder
     (default 1; 2 for renders drawn at half the size the network runs at); ``heatmap``:
     the centre heatmap's loss, "logistic" or "focal" (CenterNet's: sharp peaks, which
-    the record tells the run-time decoding, :mod:`..network`). Returns the record.
+    the record tells the run-time decoding, :mod:`..network`; default: the ``start``
+    file's, from its record, else logistic). Returns the record.
 
     Raises:
         TrainExtraMissing: the ``train`` extra is not installed.
         InputError: a data folder holds no labelled image, ``start`` is not a network
             of this architecture, ``widths`` or ``stem`` are given with ``start``, or
             ``widths``, ``scale``, ``zooms`` or ``heatmap`` are not valid.
+        VisionError: ``start``'s training record is unreadable.
     """
     require_train_extra()
     import jax
 
-    from softarm.perception.detector.network import MAX_SIDE
+    from softarm.perception.detector.network import MAX_SIDE, heatmap_of
     from softarm.perception.detector.train.augment import SCALE
     from softarm.perception.detector.train.loop import HEATMAP_LOSSES, TrainSettings, fit
     from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
@@ -88,6 +90,8 @@ def train(
         )
     if scale is not None and not 0 < scale[0] <= scale[1]:
         raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
+    if heatmap is None:
+        heatmap = "logistic" if start is None else heatmap_of(Path(start))
     if heatmap not in HEATMAP_LOSSES:
         raise InputError(f"heatmap {heatmap!r}: one of {', '.join(HEATMAP_LOSSES)} expected")
     layers(WIDTHS if widths is None else widths)  # checks them before the data is read
