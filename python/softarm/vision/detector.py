@@ -29,7 +29,7 @@ from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 from softarm.vision.dictionaries import get_dictionary
 from softarm.vision.poses import pose_from_rvec_tvec
-from softarm.vision.refine import READ_MARGIN, refine_marker_corners
+from softarm.vision.refine import read_margin, refine_marker_corners
 
 # A best IPPE solution worse than this (px RMS) triggers the SQPNP fallback.
 FALLBACK_RMS_PX = 1.0
@@ -177,8 +177,9 @@ class MarkerDetector:
         """The edge refinement of one marker, to run later on a copy of the pixels it reads
         (the caller may reuse the frame's buffer for the next frame)."""
         h, w = gray.shape
-        lo = np.floor(corners.min(axis=0)).astype(int) - READ_MARGIN - origin
-        hi = np.ceil(corners.max(axis=0)).astype(int) + READ_MARGIN + 1 - origin
+        margin = read_margin(corners)
+        lo = np.floor(corners.min(axis=0)).astype(int) - margin - origin
+        hi = np.ceil(corners.max(axis=0)).astype(int) + margin + 1 - origin
         x0, y0 = max(int(lo[0]), 0), max(int(lo[1]), 0)
         patch = gray[y0 : min(int(hi[1]), h), x0 : min(int(hi[0]), w)].copy()
         at = (origin[0] + x0, origin[1] + y0)

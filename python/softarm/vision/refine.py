@@ -31,6 +31,12 @@ from softarm.vision.camera_model import CameraModel
 _STEP = 0.25  # px between profile samples across an edge
 _MAX_REACH = 4.0  # px: the widest half-profile across an edge
 _MAX_SHIFT = 2.0  # px: a refined corner further than this from the detection is refused
+#: ... unless the sides' lines put it up to this share of the shortest side away and a
+#: second pass from there agrees (refine_marker_corners: a corner the contour lost).
+_MAX_JUMP = 0.25
+#: The second pass drops edge points further than this many robust standard deviations
+#: from their side's line before fitting it again.
+_TRIM = 3.0
 #: Profile levels (DN) that only clipped pixels give: at or under CLIP_LOW the camera
 #: crushed the ink (its black level subtracted, then clipped at 0), at or over
 #: CLIP_HIGH the paper saturated. A marker without them keeps the centroid's corners.
@@ -39,10 +45,17 @@ CLIP_HIGH = 254.5
 #: The share of a marker's profile samples that must be clipped for the bias to be
 #: measured (a crushed ink or a saturated paper clips 1-30 % of them on the row).
 CLIPPED_SHARE = 0.002
-#: Pixels beyond the corners' bounding box that the refinement reads (the half-profile,
-#: one for the bilinear neighbour, one for rounding): a copy of this neighbourhood is
-#: enough to refine the marker later.
+#: Pixels beyond the corners' bounding box that one pass of the refinement reads (the
+#: half-profile, one for the bilinear neighbour, one for rounding).
 READ_MARGIN = int(_MAX_REACH) + 2
+
+
+def read_margin(corners: FloatArray) -> int:
+    """Pixels beyond the bounding box of a marker's detected ``corners`` (4, 2) that
+    :func:`refine_marker_corners` may read, its second pass included: a copy of this
+    neighbourhood is enough to refine the marker later."""
+    quad = np.asarray(corners, dtype=np.float64).reshape(4, 2)
+    return READ_MARGIN + int(np.ceil(_MAX_JUMP * _min_side(quad)))
 
 
 def refine_marker_corners(
@@ -56,14 +69,45 @@ def refine_marker_corners(
     bits + 2 border cells); returns ``corners`` unchanged if the edges cannot be measured.
 
     ``gray`` may be a window of the frame whose top-left pixel is frame pixel ``origin``
-    = (x0, y0); ``corners`` and the result are in frame pixels either way."""
+    = (x0, y0); ``corners`` and the result are in frame pixels either way.
+
+    A corner the detection's contour put far off (a dark berry or leaf over it joins the
+    border) is found by the sides' lines, fitted on the profiles clear of it, a few pixels
+    from the detection; the sides are then measured again from the corners found, and
+    those are kept only where the second pass lands within ``_MAX_SHIFT`` of the first."""
     quad = np.asarray(corners, dtype=np.float64).reshape(4, 2)
+    first = _refined(gray, quad, camera, cells, origin, _MAX_JUMP * _min_side(quad))
+    if first is None:
+        return quad
+    if np.max(np.linalg.norm(first - quad, axis=1)) <= _MAX_SHIFT:
+        return first
+    again = _refined(gray, first, camera, cells, origin, _MAX_SHIFT, robust=True)
+    return quad if again is None else again
+
+
+def _min_side(quad: FloatArray) -> float:
+    return float(np.min(np.linalg.norm(np.roll(quad, -1, axis=0) - quad, axis=1)))
+
+
+def _refined(
+    gray: npt.NDArray[np.uint8],
+    quad: FloatArray,
+    camera: CameraModel,
+    cells: int,
+    origin: tuple[int, int],
+    max_shift: float,
+    robust: bool = False,
+) -> FloatArray | None:
+    """One pass of :func:`refine_marker_corners` from the corners ``quad``: None when the
+    edges cannot be measured or a corner lands further than ``max_shift`` px from ``quad``;
+    ``robust``: the lines fitted again without the edge points far off them (what covers
+    a corner also bends the profiles beside it)."""
     h, w = gray.shape
     ox, oy = int(origin[0]), int(origin[1])
     sides = np.roll(quad, -1, axis=0) - quad  # side k runs from corner k to corner k + 1
     lengths = np.sqrt(np.einsum("ij,ij->i", sides, sides))
     if lengths.min() < 8:
-        return quad
+        return None
     # Half-width of the profile: well inside the black border cell, whatever the view;
     # a whole number of steps, so that the offsets are symmetric about 0.
     half = round(float(np.clip(0.4 * lengths.min() / cells, 1.0, _MAX_REACH)) / _STEP)
@@ -82,7 +126,7 @@ def refine_marker_corners(
     lo = np.floor(quad.min(axis=0) - reach - 1).astype(int)
     hi = np.ceil(quad.max(axis=0) + reach + 1).astype(int)
     if lo[0] < ox or lo[1] < oy or hi[0] > ox + w - 1 or hi[1] > oy + h - 1:
-        return quad
+        return None
     # Work on a float copy of the marker's neighbourhood only (a full-frame copy costs ~1 ms).
     crop = gray[lo[1] - oy : hi[1] + 1 - oy, lo[0] - ox : hi[0] + 1 - ox].astype(np.float32)
     # Profile sample positions (N, m, 2) in the neighbourhood's pixels.
@@ -102,13 +146,14 @@ def refine_marker_corners(
     shift = (grad.astype(np.float64) @ mid) / np.where(ok_edge, wsum, 1.0)
     good = ok_edge & (np.abs(shift) < reach)
     if np.any(np.bincount(side[good], minlength=4) < 4):
-        return quad
+        return None
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
-    centre, direction = _fit_lines(camera.normalize(edge), side)  # one call for all four
-    pix = _corners(centre, direction, camera, quad)
+    fit = _fit_lines_trimmed if robust else _fit_lines
+    centre, direction = fit(camera.normalize(edge), side)  # one call for all four
+    pix = _corners(centre, direction, camera, quad, max_shift)
     if pix is None:
-        return quad
+        return None
     clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
     if clipped < CLIPPED_SHARE * prof[good].size:
         return pix  # nothing clipped (a stray noisy pixel aside): the centroid is unbiased
@@ -117,7 +162,7 @@ def refine_marker_corners(
     if np.any(step == 0):
         return pix
     outward = normals * step[:, None]
-    return _unbiased(crop, lo, pix, cells, offsets, outward, centre, direction, camera)
+    return _unbiased(crop, lo, pix, cells, offsets, outward, centre, direction, camera, max_shift)
 
 
 def _unbiased(
@@ -130,6 +175,7 @@ def _unbiased(
     centre: FloatArray,
     direction: FloatArray,
     camera: CameraModel,
+    max_shift: float,
 ) -> FloatArray:
     """The corners ``pix`` with the sides' lines (normalised: ``centre``, ``direction``)
     moved back by the bias the marker's border measures
@@ -143,17 +189,21 @@ def _unbiased(
     # (the lens's local stretch changes it by a few percent at most; undistorting the
     # points again would cost as much as the first fit).
     focal = np.array([camera.matrix[0, 0], camera.matrix[1, 1]])
-    moved = _corners(centre - bias * outward / focal, direction, camera, pix)
+    moved = _corners(centre - bias * outward / focal, direction, camera, pix, max_shift)
     return pix if moved is None else moved
 
 
 def _corners(
-    centre: FloatArray, direction: FloatArray, camera: CameraModel, quad: FloatArray
+    centre: FloatArray,
+    direction: FloatArray,
+    camera: CameraModel,
+    quad: FloatArray,
+    max_shift: float,
 ) -> FloatArray | None:
     """The (4, 2) pixel corners where the sides' lines (normalised, where the sides are
     straight: a point ``centre`` and a ``direction`` each) meet, corner k joining side
     k - 1 and side k; None when two adjacent lines are parallel or a corner lands further
-    than _MAX_SHIFT from the detection's ``quad``."""
+    than ``max_shift`` px from ``quad``."""
     p1, d1 = np.roll(centre, 1, axis=0), np.roll(direction, 1, axis=0)  # side k - 1
     cross = d1[:, 0] * direction[:, 1] - d1[:, 1] * direction[:, 0]
     if np.min(np.abs(cross)) < 1e-9:
@@ -162,7 +212,7 @@ def _corners(
     s = (gap[:, 0] * direction[:, 1] - gap[:, 1] * direction[:, 0]) / cross
     lines = p1 + s[:, None] * d1
     pix = camera.project(np.column_stack([lines, np.ones(4)]))
-    if np.max(np.linalg.norm(pix - quad, axis=1)) > _MAX_SHIFT:
+    if np.max(np.linalg.norm(pix - quad, axis=1)) > max_shift:
         return None
     return pix
 
@@ -182,3 +232,19 @@ def _fit_lines(points: FloatArray, side: npt.NDArray[np.intp]) -> tuple[FloatArr
     angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
     direction = np.column_stack([np.cos(angle), np.sin(angle)])
     return centre, direction
+
+
+def _fit_lines_trimmed(
+    points: FloatArray, side: npt.NDArray[np.intp]
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`_fit_lines` again on the points within _TRIM robust standard deviations
+    (1.4826 MAD of the distances) of their side's first line; the first lines where a
+    side would keep fewer than 4 points."""
+    centre, direction = _fit_lines(points, side)
+    normal = np.column_stack([-direction[:, 1], direction[:, 0]])
+    distance = np.abs(np.einsum("ij,ij->i", points - centre[side], normal[side]))
+    sigma = np.array([1.4826 * np.median(distance[side == k]) for k in range(4)])
+    keep = distance <= _TRIM * sigma[side]
+    if np.any(np.bincount(side[keep], minlength=4) < 4):
+        return centre, direction
+    return _fit_lines(points[keep], side[keep])
