@@ -8,6 +8,7 @@ window) draws small, at the full map's texel pitch, about what it sees
 (:mod:`softarm.sim.render.shadow_map`). Geoms that cannot show in a render are left out
 of it (:mod:`softarm.sim.render.culling`), and a small colour render draws the row's
 bush canes as merged meshes of fewer triangles (:mod:`softarm.sim.render.cane_mesh`).
+The row's ground plane casts no shadow (it shades nothing: :meth:`BushRenderer._draw`).
 Lens distortion is applied afterwards (:mod:`softarm.sim.render.distortion`).
 """
 
@@ -69,6 +70,9 @@ SHADOW_STEPS = np.arange(SHADOW_STEP, SHADOW_REACH, 2 * SHADOW_STEP)
 #: pixels of open soil onto the next texel of its speckle (up to 4 levels), and the
 #: cane fit read them (7 canes instead of 8 on row 90140).
 SMALL_RENDER_GROUND_GRID = 4.0
+#: MuJoCo's ``mjCAT_DECOR`` scene category: a geom of it casts no shadow (``mjr_render``
+#: leaves it out of the light's depth pass), and is drawn as any other in the others.
+CATEGORY_DECOR = 4
 
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
@@ -156,10 +160,14 @@ class BushRenderer:
         self._merged, self._members = merged_and_members(self.model, self.labels)
         self._shadow_travel: FloatArray | None = None
         self._sun: SunShadows | None = None
+        #: Geoms left out of the sun's depth pass (:meth:`_draw`).
+        self._no_shadow: frozenset[int] = frozenset()
         if spec.row is not None and spec.shadows:
             sun = np.asarray(spec.look.light_direction, float)
             self._shadow_travel = sun / np.linalg.norm(sun)
             self._sun = SunShadows(self.model, mujoco)
+            if self._shadow_travel[2] < 0.0:  # the sun above the horizon
+                self._no_shadow = frozenset(int(g) for g in self._planes)
 
     def push_leaves(self, body: FloatArray, radius: FloatArray) -> None:
         """Move aside every leaf that the arm's body (spheres at ``body`` (N, 3) with
@@ -237,8 +245,7 @@ class BushRenderer:
         """Colour, and depth and geom ids if asked, of ``camera`` with renderer ``r``."""
         mj = self._mj
         r.update_scene(self.data, camera=camera, scene_option=option)
-        rgb = r.render()
-        colour = np.ascontiguousarray(rgb[..., ::-1])
+        colour = np.ascontiguousarray(self._draw(r)[..., ::-1])
         d = s = None
         if depth:
             r.enable_depth_rendering()
@@ -301,9 +308,30 @@ class BushRenderer:
             with self._culled(camera, (side, side), principal, merged=True) as local:
                 r = self._renderer(window, local)
                 r.update_scene(self.data, camera=camera)
-                return self._last.put(slot, state, np.ascontiguousarray(r.render()[..., ::-1]))
+                return self._last.put(slot, state, np.ascontiguousarray(self._draw(r)[..., ::-1]))
         finally:
             m.cam_resolution[cam], m.cam_sensorsize[cam], m.cam_intrinsic[cam] = saved
+
+    def _draw(self, r: Any) -> npt.NDArray[np.uint8]:
+        """The colour image of the scene renderer ``r`` was last given (``update_scene``),
+        the ground plane left out of the sun's depth pass (its shadow map): the ground
+        lies below everything drawn and the sun above the horizon, so it shades nothing,
+        and where it alone is in the map its own pixels are lit either way (a plane
+        does not shade itself; the map's empty texels read as lit). Every pixel is the
+        same (tests); the depth pass no longer fills the whole map with the ground
+        (BENCHMARKS.md, "The daylight row")."""
+        if self._no_shadow:
+            scene, left = r._scene, set(self._no_shadow)
+            geom = int(self._mj.mjtObj.mjOBJ_GEOM)
+            for i in range(scene.ngeom):  # the ground is among the first (its id is 0)
+                g = scene.geoms[i]
+                if g.objtype == geom and g.objid in left:
+                    g.category = CATEGORY_DECOR
+                    left.discard(g.objid)
+                    if not left:
+                        break
+        image: npt.NDArray[np.uint8] = r.render()
+        return image
 
     @contextmanager
     def _culled(
