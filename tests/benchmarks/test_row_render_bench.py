@@ -3,8 +3,9 @@ harvest's half scale) and a 184-pixel window of C1's left eye around the marker 
 the arm reaching for a berry, drawn with the small shadow map (the harvest's way) and
 with the full one, on the same world; with the small map on the same row whose
 small renders draw the ground on MuJoCo's finest grid (200 x 200 quads, as before
-renderer.SMALL_RENDER_GROUND_GRID); and with the small map on the same world drawing
-the bush's canes as their capsules (as before softarm.sim.render.cane_mesh)."""
+renderer.SMALL_RENDER_GROUND_GRID); with the small map on the same world drawing
+the bush's canes as their capsules (as before softarm.sim.render.cane_mesh); and with
+the ground plane in the sun's depth pass (as before renderer.BushRenderer._draw)."""
 
 from __future__ import annotations
 
@@ -123,4 +124,16 @@ def test_row_small_render_capsule_canes(benchmark, row: Any, view: str) -> None:
         image = _timed(benchmark, row, view)
     finally:
         renderer._merged, renderer._members = kept
+    assert image.ndim == 3
+
+
+@pytest.mark.parametrize("view", ["c2", "c1_window"])
+def test_row_small_render_ground_casting(benchmark, row: Any, view: str) -> None:  # type: ignore[no-untyped-def]
+    renderer = row.renderer
+    kept = renderer._no_shadow
+    renderer._no_shadow = frozenset()  # the ground drawn into the sun's depth map
+    try:
+        image = _timed(benchmark, row, view)
+    finally:
+        renderer._no_shadow = kept
     assert image.ndim == 3
