@@ -227,9 +227,6 @@ def test_the_way_homes_last_leg_leaves_the_rest_of_the_way_to_the_ramp_home() ->
     followed = [r for r in steps if r["goal"] is not None]  # the ramp has no goal
     assert len(followed) <= plan_steps + 1
     np.testing.assert_array_equal(q, home)
-    # The arm settles at home while the next berry begins (test_home_unsettled.py).
-    while not servo.link.arrived():
-        q = servo.link.hold(q)
     np.testing.assert_allclose(
         plant.pressures(), home / METRES_PER_PSI, atol=config.arrival_tolerance / METRES_PER_PSI
     )

@@ -144,9 +144,7 @@ class HarvestMachine:
         try:
             self.vision.select(berry)
             idle_deadline = self.clock.now() + self.config.idle_timeout
-            # Not settled: the plan is followed from where the lag model has the arm,
-            # each command's way checked from there (Transport.way_back).
-            servo.transport.ramp(watch, self.state, self.q, self.home, idle_deadline, settle=False)
+            servo.transport.ramp(watch, self.state, self.q, self.home, idle_deadline)
             servo.wait_visible(watch, self.state, self.q)
             self._transition(HarvestState.INITIAL_PLACEMENT, berry, "cube and berry in view")
             waypoints = self._reach(watch, berry)

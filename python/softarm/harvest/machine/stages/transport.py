@@ -311,14 +311,7 @@ class Transport:
         inside the resolver's step, the way to each command is checked): the model may be
         centimetres off the true arm (a rod sagging under gravity), and a ramp open loop
         through the model's waypoints would carry the true arm wherever that error puts
-        it. The loop ends on the exact home q, open loop from where it left the arm,
-        once home is commanded: the arm settles there while the next berry begins, its
-        plan followed from where the lag model has the arm and each command's way
-        checked from there (:meth:`clear_way`). Waiting for the arm at home took 0.75 s a
-        berry on the slow plant (diagnosis seeds 1530-1538), every channel crawling the
-        last of its way at the regulators' lag; a settle to within 1 cm of home's pose
-        instead was slower still (an actuator's millimetre bends a straight arm's tip by
-        about a centimetre). If
+        it. The loop ends on the exact home q, open loop from where it left the arm. If
         the cube is lost or the loop runs out of ``home_timeout``, the rest of the way is
         ramped open loop (the only way out: vented in the bush, the arm would relax
         through the canes)."""
@@ -343,5 +336,4 @@ class Transport:
             for q_way in legs[:-1]:
                 q = self.ramp(watch, stage, q, q_way, self.link.clock.now() + c.home_timeout)
         home = way[-1]
-        deadline = self.link.clock.now() + c.home_timeout
-        return self.ramp(watch, stage, q, home, deadline, settle=False)
+        return self.ramp(watch, stage, q, home, self.link.clock.now() + c.home_timeout)
