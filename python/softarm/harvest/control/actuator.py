@@ -24,7 +24,16 @@ from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.control.plant_model import MeasurementModel
 
-__all__ = ["SafeActuator", "lead_gain"]
+__all__ = ["SETTLE_LEAD_SHARE", "SafeActuator", "lead_gain"]
+
+#: The share of the overshoot-free bound ``a/(1 − a)`` (``a = e^{−T/τ}``) of the lead on
+#: a command held while the arm settles on it (:meth:`SafeActuator.send_settling`). The
+#: moves' lead is capped lower (``lead_cap``, 1.5): fine positioning starts from where a
+#: move left the regulators, and a larger one there made it slower (docs/harvest.md).
+#: A held command's approach is a step response: at a quarter (3.9 at τ = 0.8 s) a
+#: first-order regulator at the safety layer's 5 psi a period comes within 1 mm of 35
+#: psi from 65 psi in 0.85 s (1.15 s at 1.5), 0.2 psi past it; at the half bound 3 psi.
+SETTLE_LEAD_SHARE = 0.25
 
 
 class PressureMap(Protocol):
@@ -91,6 +100,10 @@ class SafeActuator:
         if np.any(np.asarray(play_m) != 0) and lag is None:
             raise ParameterError("play_m: needs the lag model (`lag`)")
         self._lead = float(lead)
+        self._settle_lead = self._lead
+        if self._lead > 0 and lag is not None and lag[0] > 0:
+            a = float(np.exp(-lag[1] / lag[0]))
+            self._settle_lead = min(20.0, max(self._lead, SETTLE_LEAD_SHARE * a / (1.0 - a)))
 
     @property
     def sent(self) -> FloatArray:
@@ -145,6 +158,22 @@ class SafeActuator:
         if self._model is not None:
             self._model.command(self._sent)
         return self.sent
+
+    @property
+    def settle_lead(self) -> float:
+        """The lead of :meth:`send_settling` (the moves' lead without a lag model)."""
+        return self._settle_lead
+
+    def send_settling(self, q: FloatArray) -> FloatArray:
+        """:meth:`send` for a command held while the arm settles on it (an open-loop
+        ramp's end, nothing closing a loop on the arm): the regulators led at
+        :attr:`settle_lead`, within the safety layer's rate limit and pressure range as
+        every command's boost is."""
+        lead, self._lead = self._lead, self._settle_lead
+        try:
+            return self.send(q)
+        finally:
+            self._lead = lead
 
     def _boost(self, wanted: FloatArray, boost: FloatArray) -> FloatArray:
         """``boost`` scaled as one vector, never clipped channel by channel, so that the
