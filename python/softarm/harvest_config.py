@@ -57,6 +57,11 @@ class HarvestConfig:
             the "confidence" rule's estimate is made from (an integer >= 2).
         fine_confidence: the probability, in (0, 1), with which the true mean error lies
             under the bound the "confidence" rule compares with ``fine_tolerance``.
+        fine_aim: with either rule, fine positioning ends only once the mean of the last
+            ``settle_steps`` measured offsets of the grasp point is within this (m) of
+            the berry as well, for up to ``end_rules.FINE_AIM_S`` (2 s) into the stage:
+            the arm servoed on to the measured berry rather than stopped on the
+            tolerance's edge; 0 (the default): the rule alone. In [0, fine_tolerance).
         marker_timeout: how long (s) the cube or the berry may stay unseen (beyond the
             locator's own hold of the last target) before MARKER_LOST.
         placement_timeout, fine_timeout, home_timeout: time budgets (s) of the stages.
@@ -112,6 +117,7 @@ class HarvestConfig:
     fine_end_rule: str = "steps"
     fine_window: int = 20
     fine_confidence: float = 0.95
+    fine_aim: float = 0.0
     marker_timeout: float = 1.0
     placement_timeout: float = 30.0
     fine_timeout: float = 20.0
@@ -139,7 +145,7 @@ class HarvestConfig:
             if not value > 0:
                 raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
         for name in ("grasp_offset", "stall_progress", "home_elongation", "transport_margin",
-                     "follow_blind_time", "lead_cap"):  # fmt: skip
+                     "follow_blind_time", "lead_cap", "fine_aim"):  # fmt: skip
             value = _real(self, name)
             if not value >= 0:
                 raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
@@ -164,7 +170,8 @@ class HarvestConfig:
         self._check_end_rule()
 
     def _check_end_rule(self) -> None:
-        """``fine_end_rule`` one of FINE_END_RULES, ``fine_confidence`` in (0, 1)."""
+        """``fine_end_rule`` one of FINE_END_RULES, ``fine_confidence`` in (0, 1),
+        ``fine_aim`` under ``fine_tolerance``."""
         if self.fine_end_rule not in FINE_END_RULES:
             raise ParameterError(
                 f"fine_end_rule must be one of {', '.join(FINE_END_RULES)}, "
@@ -173,6 +180,11 @@ class HarvestConfig:
         confidence = _real(self, "fine_confidence")
         if not 0.0 < confidence < 1.0:
             raise ParameterError(f"fine_confidence must be in (0, 1), got {confidence!r}")
+        if not self.fine_aim < self.fine_tolerance:  # both checked finite already
+            raise ParameterError(
+                f"fine_aim must be in [0, fine_tolerance {self.fine_tolerance!r}), "
+                f"got {self.fine_aim!r}"
+            )
 
     @property
     def approach_axis(self) -> np.ndarray:
