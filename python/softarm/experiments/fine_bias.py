@@ -250,10 +250,12 @@ def _mm(v: FloatArray) -> dict[str, Any]:
     }
 
 
-def run_seed(seed: int, berries: int, body: str, rule: str, label: str) -> dict[str, Any]:
-    """One traced harvest of the rendered bush under the fine end ``rule`` with the
-    marker ``body``: its report's figures and each grasp's decomposition, tagged
-    ``label`` (the code measured: before or after a change)."""
+def run_seed(
+    seed: int, berries: int, body: str, rule: str, label: str, fine_aim: float = 0.0
+) -> dict[str, Any]:
+    """One traced harvest of the rendered bush under the fine end ``rule`` (and
+    ``fine_aim``, m) with the marker ``body``: its report's figures and each grasp's
+    decomposition, tagged ``label`` (the code measured: before or after a change)."""
     from softarm.harvest.rigs.sim.options import SimRigOptions
     from softarm.harvest.rigs.sim.rig import build_sim_rig
     from softarm.harvest_config import HarvestConfig
@@ -261,7 +263,7 @@ def run_seed(seed: int, berries: int, body: str, rule: str, label: str) -> dict[
 
     options = SimRigOptions(
         n_berries=berries, seed=seed, world=WorldName.BUSH,
-        config=HarvestConfig(fine_end_rule=rule), marker_body=body,
+        config=HarvestConfig(fine_end_rule=rule, fine_aim=fine_aim), marker_body=body,
     )  # fmt: skip
     rig = build_sim_rig(options)
     trace = BiasTrace(rig)
@@ -409,6 +411,7 @@ def main() -> None:
     parser.add_argument("--berries", type=int, default=8)
     parser.add_argument("--marker-body", choices=("cube", "frustum"), default="cube")
     parser.add_argument("--rules", choices=("steps", "confidence"), nargs="+", default=["steps"])
+    parser.add_argument("--fine-aim", type=float, default=0.0, help="[harvest] fine_aim (m)")
     parser.add_argument("--label", default="now", help="the code measured (before, after)")
     parser.add_argument("--out", type=Path, default=Path("out/fine_bias.jsonl"))
     parser.add_argument("--summary", type=Path, nargs="+", help="summarise these")
@@ -429,7 +432,7 @@ def main() -> None:
     args.out.parent.mkdir(parents=True, exist_ok=True)
     for seed in args.seeds:
         for rule in args.rules:
-            row = run_seed(seed, args.berries, args.marker_body, rule, args.label)
+            row = run_seed(seed, args.berries, args.marker_body, rule, args.label, args.fine_aim)
             with args.out.open("a") as f:
                 f.write(json.dumps(row) + "\n")
             print(seed, rule, [round(e, 2) for e in row["true_mm"]], flush=True)
