@@ -1,8 +1,11 @@
-"""The row's ground plane is left out of the sun's depth pass
-(softarm.sim.render.renderer.BushRenderer._draw): it lies below everything drawn and the
-sun is above the horizon, so it shades nothing, and its own pixels are lit whether or
-not it is in the map. Every pixel of a C2 frame, a C1 window and a whole C1 frame is the
-same with it and without it, in the sun, against the light and at dusk."""
+"""In the small renders (C2's frames, C1's windows: the small shadow map) the row's ground
+plane is left out of the sun's depth pass (softarm.sim.render.renderer.BushRenderer._draw):
+it lies below everything drawn and the sun is above the horizon, so it shades nothing.
+Every pixel of a C2 frame and a C1 window is the same with it and without it, in the
+sun, against the light and at dusk (where the small map holds what the render sees:
+else the full map is drawn, the ground in it). Whole C1 frames keep it: there the polygon offset of
+its depth darkens what lies within millimetres of it (the mulch's top), which the cane
+fit reads."""
 
 from __future__ import annotations
 
@@ -56,10 +59,11 @@ def test_the_ground_casts_no_shadow_and_no_pixel_changes(row: Any) -> None:
     r = row.renderer
     ground = r.model.geom("bg_ground").id
     assert r._no_shadow == {ground}
-    categories = []
+    categories, local = [], []
     made = r._renderer
 
     def spy(*args: Any) -> Any:  # the scene's category of the ground as it is drawn
+        local.append(bool(args[1]) if len(args) > 1 else False)
         inner = made(*args)
         draw = inner.render
 
@@ -83,7 +87,9 @@ def test_the_ground_casts_no_shadow_and_no_pixel_changes(row: Any) -> None:
             r._renderer = made
             for ctx in r._renderers.values():
                 ctx.__dict__.pop("render", None)
-        assert categories[-1] == [mujoco.mjtCatBit.mjCAT_DECOR], name
+        decor = categories[-1] == [mujoco.mjtCatBit.mjCAT_DECOR]
+        assert decor == local[-1], name  # with the small shadow map only
+        assert not (name == "c1" and decor)  # whole C1 frames keep the ground in the map
         kept, r._no_shadow = r._no_shadow, frozenset()
         r._last.__init__()
         try:

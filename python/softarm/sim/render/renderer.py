@@ -8,7 +8,7 @@ window) draws small, at the full map's texel pitch, about what it sees
 (:mod:`softarm.sim.render.shadow_map`). Geoms that cannot show in a render are left out
 of it (:mod:`softarm.sim.render.culling`), and a small colour render draws the row's
 bush canes as merged meshes of fewer triangles (:mod:`softarm.sim.render.cane_mesh`).
-The row's ground plane casts no shadow (it shades nothing: :meth:`BushRenderer._draw`).
+In the small renders the row's ground plane casts no shadow (:meth:`BushRenderer._draw`).
 Lens distortion is applied afterwards (:mod:`softarm.sim.render.distortion`).
 """
 
@@ -237,15 +237,17 @@ class BushRenderer:
         merged = not (depth or geoms) and spec.size[0] * spec.size[1] <= LOCAL_MAX_PIXELS
         with self._culled(camera, spec.size, spec.principal, merged) as local:
             r = self._renderer(spec, local)
-            return self._last.put(slot, state, self._render_passes(r, camera, option, depth, geoms))
+            drawn = self._render_passes(r, camera, option, depth, geoms, local)
+            return self._last.put(slot, state, drawn)
 
     def _render_passes(
-        self, r: Any, camera: str, option: Any, depth: bool, geoms: bool
+        self, r: Any, camera: str, option: Any, depth: bool, geoms: bool, local: bool = False
     ) -> RenderedFrame:
-        """Colour, and depth and geom ids if asked, of ``camera`` with renderer ``r``."""
+        """Colour, and depth and geom ids if asked, of ``camera`` with renderer ``r``
+        (``local``: with the small shadow map, :meth:`_draw`)."""
         mj = self._mj
         r.update_scene(self.data, camera=camera, scene_option=option)
-        colour = np.ascontiguousarray(self._draw(r)[..., ::-1])
+        colour = np.ascontiguousarray(self._draw(r, local)[..., ::-1])
         d = s = None
         if depth:
             r.enable_depth_rendering()
@@ -308,19 +310,27 @@ class BushRenderer:
             with self._culled(camera, (side, side), principal, merged=True) as local:
                 r = self._renderer(window, local)
                 r.update_scene(self.data, camera=camera)
-                return self._last.put(slot, state, np.ascontiguousarray(self._draw(r)[..., ::-1]))
+                return self._last.put(
+                    slot, state, np.ascontiguousarray(self._draw(r, local)[..., ::-1])
+                )
         finally:
             m.cam_resolution[cam], m.cam_sensorsize[cam], m.cam_intrinsic[cam] = saved
 
-    def _draw(self, r: Any) -> npt.NDArray[np.uint8]:
-        """The colour image of the scene renderer ``r`` was last given (``update_scene``),
-        the ground plane left out of the sun's depth pass (its shadow map): the ground
-        lies below everything drawn and the sun above the horizon, so it shades nothing,
-        and where it alone is in the map its own pixels are lit either way (a plane
-        does not shade itself; the map's empty texels read as lit). Every pixel is the
-        same (tests); the depth pass no longer fills the whole map with the ground
-        (BENCHMARKS.md, "The daylight row")."""
-        if self._no_shadow:
+    def _draw(self, r: Any, local: bool) -> npt.NDArray[np.uint8]:
+        """The colour image of the scene renderer ``r`` was last given (``update_scene``);
+        with the small shadow map (``local``: C2's frames, C1's windows) the ground plane
+        left out of the sun's depth pass, which then no longer fills the whole map.
+
+        The ground lies below everything drawn and the sun is above the horizon, so it
+        casts no shadow on anything; where it alone is in the map its own pixels are lit
+        either way. But MuJoCo's polygon offset moves the ground's depth in the map a few
+        millimetres towards the sun, and that darkens sunlit surfaces within millimetres
+        of the ground (the mulch's top, the foot of a post or a stone): without it they
+        are lit. Whole C1 frames see the row's foot (on row 90270 in the sun 4,834 pixels
+        of C1's left eye differed, by up to 20 levels) and the cane fit reads them, so
+        they keep the ground in the map; in the small renders no pixel differed (tests,
+        BENCHMARKS.md "The daylight row")."""
+        if self._no_shadow and local:
             scene, left = r._scene, set(self._no_shadow)
             geom = int(self._mj.mjtObj.mjOBJ_GEOM)
             for i in range(scene.ngeom):  # the ground is among the first (its id is 0)
