@@ -49,7 +49,7 @@ class ArmLink:
         by the actuator's ``send_settling`` where it has one (a larger lead,
         :class:`~softarm.harvest.control.actuator.SafeActuator`)."""
         settle = getattr(self.actuator, "send_settling", None) if settling else None
-        sent = self.actuator.send(q) if settle is None else settle(q)
+        sent = self.actuator.send(q) if settle is None else settle(q, self.cfg.arrival_tolerance)
         rounding = float(np.max(np.abs(sent - q), initial=0.0)) <= SEND_ROUNDING
         return np.asarray(q, dtype=np.float64) if rounding else sent
 
