@@ -44,6 +44,8 @@ def _overshoots(
     ``wanted + boost`` (from the ``last`` drive, within ``rate`` psi of it) then back to
     ``wanted`` at ``rate`` psi a period, comes nearer than ``short`` to ``wanted`` (or
     passes it) on some channel (psi throughout)."""
+    # A channel already within ``short`` may come to ``wanted``, not past it.
+    short = np.where(np.abs(wanted - pressure) > short, short, 0.0)
     drive, p = np.clip(wanted + boost, last - rate, last + rate), pressure.copy()
     for _ in range(int(np.ceil(float(np.max(np.abs(drive - wanted), initial=0.0)) / rate)) + 1):
         p = drive + (p - drive) * a
@@ -118,6 +120,7 @@ class SafeActuator:
         self._settle_lead = self._lead
         self._braking = False
         self._settle_within = 0.0  # m: the settle's tolerance (send_settling's within)
+        self._lead_floor = 1.0  # the moves' lead as a share of the settling lead
         if self._lead > 0 and lag is not None and lag[0] > 0:
             a = float(np.exp(-lag[1] / lag[0]))
             self._settle_lead = min(20.0, max(self._lead, SETTLE_LEAD_SHARE * a / (1.0 - a)))
@@ -190,6 +193,7 @@ class SafeActuator:
         :attr:`settle_lead`, within the safety layer's rate limit and pressure range as
         every command's boost is."""
         lead, self._lead, self._braking = self._lead, self._settle_lead, True
+        self._lead_floor = lead / self._settle_lead if self._settle_lead > 0 else 1.0
         self._settle_within = float(within)
         try:
             return self.send(q)
@@ -213,7 +217,8 @@ class SafeActuator:
         last = self.bank.last_sent
         if not _overshoots(wanted, boost, pressure, a, rate, short, last):
             return 1.0
-        lo, hi = 0.0, 1.0  # lo does not overshoot, hi does: monotone in the share
+        # Never less than the moves' own lead: braking only trims what the settle adds.
+        lo, hi = self._lead_floor, 1.0  # hi overshoots; monotone in the share
         for _ in range(12):
             mid = 0.5 * (lo + hi)
             if _overshoots(wanted, mid * boost, pressure, a, rate, short, last):
