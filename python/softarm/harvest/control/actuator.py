@@ -192,6 +192,8 @@ class SafeActuator:
         ramp's end, nothing closing a loop on the arm): the regulators led at
         :attr:`settle_lead`, within the safety layer's rate limit and pressure range as
         every command's boost is."""
+        if self._settle_lead <= self._lead:  # a quick plant: its moves' lead, as before
+            return self.send(q)
         lead, self._lead, self._braking = self._lead, self._settle_lead, True
         self._lead_floor = lead / self._settle_lead if self._settle_lead > 0 else 1.0
         self._settle_within = float(within)
