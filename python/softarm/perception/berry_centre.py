@@ -14,9 +14,14 @@ an edge over about one pixel either side), so the fruit's share of it is
 (background - pixel) / (background - fruit). The fruit's brightness is the median of
 the mask's interior; the background's is taken in each of :data:`SECTORS` directions
 around the fruit from a ring just outside the blurred edge, since a fruit hangs in
-front of leaves on one side and sky or ground on another. Where fruit and background
-are of about the same brightness the edge carries no such information, and the mask's
-own pixels count.
+front of leaves on one side and sky or ground on another. The fruit's brightness too
+is taken in each direction, from its own pixels just inside the edge: a fruit is shaded,
+its side towards the light brighter (and its drupelets' highlights there), the other
+side darker, and one colour for the whole fruit read the lit edge's pixels as part
+background and the dark edge's as all fruit: the centre leaned away from the light, by
+0.2 px on C1's berries (52 of 58 on bushes 1500-1509; docs/harvest.md, "The lean of
+C1's centre"). Where fruit and background are of about the same brightness the edge
+carries no such information, and the mask's own pixels count.
 """
 
 from __future__ import annotations
@@ -29,12 +34,15 @@ import numpy.typing as npt
 
 _U8 = npt.NDArray[np.uint8]
 
-__all__ = ["EDGE", "SECTORS", "silhouette_centre"]
+__all__ = ["EDGE", "SECTORS", "SHADE", "silhouette_centre"]
 
 #: The blurred edge: this many pixels either side of the mask's boundary.
 EDGE = 1
 #: The background ring, this many pixels (from, to) outside the mask: past the edge.
 RING = (4, 7)
+#: The fruit's own colour near its edge: the interior pixels this many deep inside the
+#: edge (1: the layer next to it, where the shading is the edge's).
+SHADE = 1
 #: Directions around the fruit whose backgrounds are taken apart.
 SECTORS = 8
 #: Below this colour difference (BGR, 0-255) fruit and background are not told apart.
@@ -72,9 +80,15 @@ def silhouette_centre(
         return centre
     ox, oy = origin
     cx, cy = centre[0] - ox, centre[1] - oy
-    fruit = np.median(colour[iy, ix], axis=0).astype(np.float64)
     ey, ex = np.nonzero(edge)
-    background = _backgrounds(colour[ry, rx], _sector(rx - cx, ry - cy))[_sector(ex - cx, ey - cy)]
+    sector = _sector(ex - cx, ey - cy)
+    background = _medians(colour[ry, rx], _sector(rx - cx, ry - cy))[sector]
+    # The fruit's colour beside each edge pixel: its shading there (module docstring).
+    near = inner & ~(cv2.erode(m, _disk(EDGE + SHADE)) > 0)
+    ny, nx = np.nonzero(near)
+    if ny.size < MIN_PIXELS:
+        ny, nx = iy, ix
+    fruit = _medians(colour[ny, nx], _sector(nx - cx, ny - cy))[sector]
     # A pixel's colour is the mix p = s f + (1 - s) b of fruit f and background b in
     # its share s of fruit: s is the projection of b - p on b - f.
     line = background - fruit
@@ -95,11 +109,11 @@ def _sector(dx: npt.NDArray[np.floating], dy: npt.NDArray[np.floating]) -> npt.N
     return np.asarray(np.floor(turn * SECTORS).astype(np.intp) % SECTORS)
 
 
-def _backgrounds(
+def _medians(
     colour: npt.NDArray[np.uint8], sector: npt.NDArray[np.intp]
 ) -> npt.NDArray[np.float64]:
-    """Each sector's background colour (SECTORS, 3): the median of the ring pixels
-    ``colour`` (n, 3) in it, or of the whole ring where it holds too few of them."""
+    """Each sector's colour (SECTORS, 3): the median of the pixels ``colour`` (n, 3) in
+    it, or of all of them where it holds too few."""
     out = np.empty((SECTORS, colour.shape[1]))
     out[:] = np.median(colour, axis=0)
     counts = np.bincount(sector, minlength=SECTORS)
