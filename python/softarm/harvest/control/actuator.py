@@ -30,9 +30,14 @@ __all__ = ["SETTLE_LEAD_SHARE", "SafeActuator", "lead_gain"]
 #: a command held while the arm settles on it (:meth:`SafeActuator.send_settling`). The
 #: moves' lead is capped lower (``lead_cap``, 1.5): fine positioning starts from where a
 #: move left the regulators, and a larger one there made it slower (docs/harvest.md).
-#: A held command's approach is a step response: at a quarter (3.9 at τ = 0.8 s) a
-#: first-order regulator at the safety layer's 5 psi a period comes within 1 mm of 35
-#: psi from 65 psi in 0.85 s (1.15 s at 1.5), 0.2 psi past it; at the half bound 3 psi.
+#: A held command's approach is a step response: at a quarter (3.9 at τ = 0.8 s),
+#: braked (:meth:`SafeActuator._brake_scale`), regulators at the safety layer's 5 psi a
+#: period come within 1 mm of 35 psi from 65, 50 and 5 psi in 0.85 s (1.15 s at 1.5; by
+#: the lag model 1.0 s, with the drive back at 35 psi), none past it. On the arm the
+#: boost is one vector (``_boost``), so the channel nearest its limit or its command sets
+#: it for all: the settle at home shortened 0.82 -> 0.79 s a berry (diagnosis seeds 1530
+#: and 1533). Unbraked, the settle ended with the drive up to 20 psi past the command and
+#: the next placement set off from there (docs/harvest.md, "Where the slow plant waits").
 SETTLE_LEAD_SHARE = 0.25
 
 
@@ -188,10 +193,10 @@ class SafeActuator:
         return self._settle_lead
 
     def send_settling(self, q: FloatArray, within: float = 0.0) -> FloatArray:
-        """:meth:`send` for a command held while the arm settles on it (an open-loop
-        ramp's end, nothing closing a loop on the arm): the regulators led at
-        :attr:`settle_lead`, within the safety layer's rate limit and pressure range as
-        every command's boost is."""
+        """:meth:`send` for a command held while the arm settles on it to within
+        ``within`` (m; an open-loop ramp's end, nothing closing a loop on the arm): the
+        regulators led at :attr:`settle_lead`, braked (:meth:`_brake_scale`), within the
+        safety layer's rate limit and pressure range as every command's boost is."""
         if self._settle_lead <= self._lead:  # a quick plant: its moves' lead, as before
             return self.send(q)
         lead, self._lead, self._braking = self._lead, self._settle_lead, True
