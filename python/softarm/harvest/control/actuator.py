@@ -24,38 +24,7 @@ from softarm.hardware.pressure_map import ElongationMap
 from softarm.hardware.safety import SafePressureBank
 from softarm.harvest.control.plant_model import MeasurementModel
 
-__all__ = ["SETTLE_LEAD_SHARE", "SafeActuator", "lead_gain"]
-
-#: The share of the overshoot-free bound ``a/(1 − a)`` (``a = e^{−T/τ}``) of the lead on
-#: a command held while the arm settles on it (:meth:`SafeActuator.send_settling`). The
-#: moves' lead is capped lower (``lead_cap``, 1.5): fine positioning starts from where a
-#: move left the regulators, and a larger one there made it slower (docs/harvest.md).
-#: A held command's approach is a step response: at a quarter (3.9 at τ = 0.8 s),
-#: braked (:meth:`SafeActuator._brake_scale`), regulators at the safety layer's 5 psi a
-#: period come within 1 mm of 35 psi from 65, 50 and 5 psi in 0.85 s (1.15 s at 1.5; by
-#: the lag model 1.0 s, with the drive back at 35 psi), none past it. On the arm the
-#: boost is one vector (``_boost``), so the channel nearest its limit or its command sets
-#: it for all: the settle at home shortened 0.82 -> 0.79 s a berry (diagnosis seeds 1530
-#: and 1533). Unbraked, the settle ended with the drive up to 20 psi past the command and
-#: the next placement set off from there (docs/harvest.md, "Where the slow plant waits").
-SETTLE_LEAD_SHARE = 0.25
-
-
-def _overshoots(
-    wanted: FloatArray, boost: FloatArray, pressure: FloatArray, a: float, rate: float,
-    short: FloatArray, last: FloatArray,
-) -> bool:  # fmt: skip
-    """Whether a first-order regulator (``a = e^{-T/τ}``) at ``pressure``, driven at
-    ``wanted + boost`` (from the ``last`` drive, within ``rate`` psi of it) then back to
-    ``wanted`` at ``rate`` psi a period, comes nearer than ``short`` to ``wanted`` (or
-    passes it) on some channel (psi throughout)."""
-    # A channel already within ``short`` may come to ``wanted``, not past it.
-    short = np.where(np.abs(wanted - pressure) > short, short, 0.0)
-    drive, p = np.clip(wanted + boost, last - rate, last + rate), pressure.copy()
-    for _ in range(int(np.ceil(float(np.max(np.abs(drive - wanted), initial=0.0)) / rate)) + 1):
-        p = drive + (p - drive) * a
-        drive = drive + np.clip(wanted - drive, -rate, rate)
-    return bool(np.any(np.sign(boost) * (p - wanted) > -short))
+__all__ = ["SafeActuator", "lead_gain"]
 
 
 class PressureMap(Protocol):
@@ -122,13 +91,6 @@ class SafeActuator:
         if np.any(np.asarray(play_m) != 0) and lag is None:
             raise ParameterError("play_m: needs the lag model (`lag`)")
         self._lead = float(lead)
-        self._settle_lead = self._lead
-        self._braking = False
-        self._settle_within = 0.0  # m: the settle's tolerance (send_settling's within)
-        self._lead_floor = 1.0  # the moves' lead as a share of the settling lead
-        if self._lead > 0 and lag is not None and lag[0] > 0:
-            a = float(np.exp(-lag[1] / lag[0]))
-            self._settle_lead = min(20.0, max(self._lead, SETTLE_LEAD_SHARE * a / (1.0 - a)))
 
     @property
     def sent(self) -> FloatArray:
@@ -165,10 +127,9 @@ class SafeActuator:
         wanted = self.pressure_map.to_psi(q)
         boost = np.zeros_like(wanted)
         if self._lead > 0 and self._model is not None:
-            regulators = self.pressure_map.to_psi(self._model.regulators)
-            boost = self._boost(wanted, self._lead * (wanted - regulators))
-            if self._braking:
-                boost = boost * self._brake_scale(wanted, boost, regulators)
+            boost = self._boost(
+                wanted, self._lead * (wanted - self.pressure_map.to_psi(self._model.regulators))
+            )
         self.bank.set_pressures(np.clip(wanted + boost, 0.0, self.bank.max_pressure))
         drive = self.bank.last_sent
         self._drive = self.pressure_map.to_elongation(drive)
@@ -180,59 +141,10 @@ class SafeActuator:
             np.minimum(wanted, drive),
             np.where(boost < 0, np.maximum(wanted, drive), drive),
         )
-        if self._braking:  # a drive on its way back to a held command is not held short
-            target = np.clip(wanted, 0.0, self.bank.max_pressure)
         self._sent = self.pressure_map.to_elongation(target)
         if self._model is not None:
             self._model.command(self._sent)
         return self.sent
-
-    @property
-    def settle_lead(self) -> float:
-        """The lead of :meth:`send_settling` (the moves' lead without a lag model)."""
-        return self._settle_lead
-
-    def send_settling(self, q: FloatArray, within: float = 0.0) -> FloatArray:
-        """:meth:`send` for a command held while the arm settles on it to within
-        ``within`` (m; an open-loop ramp's end, nothing closing a loop on the arm): the
-        regulators led at :attr:`settle_lead`, braked (:meth:`_brake_scale`), within the
-        safety layer's rate limit and pressure range as every command's boost is."""
-        if self._settle_lead <= self._lead:  # a quick plant: its moves' lead, as before
-            return self.send(q)
-        lead, self._lead, self._braking = self._lead, self._settle_lead, True
-        self._lead_floor = lead / self._settle_lead if self._settle_lead > 0 else 1.0
-        self._settle_within = float(within)
-        try:
-            return self.send(q)
-        finally:
-            self._lead, self._braking = lead, False
-
-    def _brake_scale(self, wanted: FloatArray, boost: FloatArray, pressure: FloatArray) -> float:
-        """The largest share (0-1) of ``boost`` (psi past ``wanted``) from which the drive,
-        brought back to ``wanted`` at the safety layer's rate, leaves every regulator
-        (by the lag model, from its ``pressure`` now) at least the settle's tolerance
-        short of ``wanted``: the settle then ends with the drive back at the command.
-        Ended with the drive 20 psi past it, the next move waited for the drive to come
-        back at 5 psi a period (fresh slow-plant seed 1540: placement 0.6 s slower)."""
-        model = self._model
-        m = self.pressure_map
-        above = m.to_elongation(wanted, clamp=False) + self._settle_within
-        short = np.abs(m.to_psi(above, clamp=False) - wanted)  # the tolerance in psi
-        assert model is not None  # only with a lag model
-        a = float(np.exp(-model.period / model.tau)) if model.tau > 0 else 0.0
-        rate = self.bank.max_rate * model.period
-        last = self.bank.last_sent
-        if not _overshoots(wanted, boost, pressure, a, rate, short, last):
-            return 1.0
-        # Never less than the moves' own lead: braking only trims what the settle adds.
-        lo, hi = self._lead_floor, 1.0  # hi overshoots; monotone in the share
-        for _ in range(12):
-            mid = 0.5 * (lo + hi)
-            if _overshoots(wanted, mid * boost, pressure, a, rate, short, last):
-                hi = mid
-            else:
-                lo = mid
-        return lo
 
     def _boost(self, wanted: FloatArray, boost: FloatArray) -> FloatArray:
         """``boost`` scaled as one vector, never clipped channel by channel, so that the

@@ -101,7 +101,6 @@ class MeasurementModel:
                 raise ParameterError(f"{name} = {value!r}: must be finite and >= 0")
         widths = _widths(play_m, n)
         self.period = float(period_s)
-        self.tau = float(tau_s)  # the regulators' time constant (s)
         self._play = widths.copy()  # the band widths of softarm._core.play
         zeros = np.zeros(n)
         self._arm = zeros.copy()  # the play's output: where the actuators are

@@ -40,16 +40,13 @@ class ArmLink:
     cfg: HarvestConfig
     log: HarvestLog
 
-    def send(self, q: FloatArray, settling: bool = False) -> FloatArray:
+    def send(self, q: FloatArray) -> FloatArray:
         """Command ``q``; returns the q to go on from: what the safety layer let through,
         or ``q`` itself where that differs from it only by the rounding of the m -> psi
         -> m round trip (``SEND_ROUNDING``): holding a q it let through must not drift it.
         Every stage goes on from what was sent: the safety layer may have clamped or
-        rate-limited it. ``settling``: ``q`` is held while the arm settles on it, sent
-        by the actuator's ``send_settling`` where it has one (a larger lead,
-        :class:`~softarm.harvest.control.actuator.SafeActuator`)."""
-        settle = getattr(self.actuator, "send_settling", None) if settling else None
-        sent = self.actuator.send(q) if settle is None else settle(q, self.cfg.arrival_tolerance)
+        rate-limited it."""
+        sent = self.actuator.send(q)
         rounding = float(np.max(np.abs(sent - q), initial=0.0)) <= SEND_ROUNDING
         return np.asarray(q, dtype=np.float64) if rounding else sent
 

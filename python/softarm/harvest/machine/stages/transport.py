@@ -268,11 +268,7 @@ class Transport:
     ) -> FloatArray:
         """Move the elongations straight to ``goal`` at ``home_speed``, open loop; with
         ``observe`` the cameras are still read (and checked) at every step; with
-        ``settle`` (the default) return only once the lag model has the arm there, the
-        goal held with the actuator's settling lead (:meth:`ArmLink.send`'s
-        ``settling``): the settle at home was 0.76 s of each berry's 7.6 on the slow
-        plant (diagnosis seeds 1530-1538), the regulators mid-range at 35 psi, where a
-        lead drives them hardest.
+        ``settle`` (the default) return only once the lag model has the arm there.
 
         Every ramp is bounded in time: past ``deadline`` (clock time, finite) it is a
         TIMEOUT fault. A goal the arm never reaches (a lag model that never settles, a
@@ -296,7 +292,7 @@ class Transport:
         while settle and not self.link.arrived():
             if self.link.clock.now() > deadline:
                 raise Fault(FaultReason.TIMEOUT, f"{stage.value}: arm not settled in time")
-            q = self.link.send(q, settling=True)
+            q = self.link.send(q)
             seen = self.link.look(watch, q, need_fix=False) if observe else watch.blind()
             watch.log_step(stage, seen, q, None, None, False)
             self.link.clock.sleep(self.link.cfg.period)
