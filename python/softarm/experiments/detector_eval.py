@@ -31,7 +31,7 @@ from softarm.perception.detector.choice import DETECTORS, BerryDetector, detecto
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 from softarm.perception.detector.misses import fruit_cases, miss_table
-from softarm.perception.detector.network import STRIDE
+from softarm.perception.detector.network import STRIDE, heatmap_of
 
 __all__ = ["CANDIDATE", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
 
@@ -186,6 +186,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             "note": a.note,
             "folders": {k: str(v) for k, v in conditions.items()},
             "split_touching": a.split_touching,
+            # how the candidate's heatmap was trained decides how its peaks are read
+            "candidate_heatmap": None if a.weights is None else heatmap_of(a.weights),
             "results": results,
         }
         a.out.write_text(json.dumps(doc, indent=1) + "\n")
