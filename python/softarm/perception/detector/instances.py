@@ -50,8 +50,8 @@ PEAK_THRESHOLD = 0.6
 #: fruit and two peaks FOCAL_PEAK_SEPARATION apart are two (touching fruit at C1's half
 #: size lie 4-12 network px apart, inside PEAK_SEPARATION). Chosen on the validation
 #: renders (dataset seed 100300), not on the evaluation sets: thresholds 0.1-0.3 found
-#: more ripe fruit but split fruit into fragments (precision with both checks 0.67-0.93
-#: against 0.93-0.98 at 0.4); 0.5 split almost nothing; separations 1.5 and 4 the same.
+#: more ripe fruit but split fruit into fragments (precision with both checks 0.54-0.93
+#: against 0.95-0.98 at 0.4); 0.5 split nothing; separations 1.5 and 4 changed little.
 FOCAL_PEAK_THRESHOLD = 0.4
 FOCAL_PEAK_SEPARATION = 2.5
 #: Fewest network pixels an instance may have (two or three image pixels across at the
