@@ -5,17 +5,13 @@ run deterministic in its seed."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import os
-import subprocess
-import sys
-import textwrap
 from pathlib import Path
 
 import numpy as np
 import pytest
 from detector_scenes import H, W, disc, training_scenes, write_folder
+from jax_child import NEEDS_JAX, in_child
 
 from softarm.errors import VisionError
 from softarm.perception.berries import DetectorSettings
@@ -23,27 +19,10 @@ from softarm.perception.detector.instances import instances
 from softarm.perception.detector.network import CLASSES, NetworkOutput, heatmap_of
 from softarm.vision.camera_model import CameraModel
 
-HAS_JAX = all(importlib.util.find_spec(m) is not None for m in ("jax", "optax", "onnx"))
-#: JAX runs in a child process, as in test_detector_tools (its thread pools beside the
-#: suite's later forks).
-NEEDS_JAX = pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
-TESTS = Path(__file__).parent
-
-
-def _in_child(code: str, *args: str) -> subprocess.CompletedProcess[str]:
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")]),
-    }
-    return subprocess.run(
-        [sys.executable, "-c", textwrap.dedent(code), *args],
-        capture_output=True, text=True, env=env, timeout=600, check=False,
-    )  # fmt: skip
-
 
 @NEEDS_JAX
 def test_targets_of_two_touching_discs_have_one_positive_at_each_centre() -> None:
-    done = _in_child(
+    done = in_child(
         """
         import numpy as np
         from detector_scenes import disc
@@ -69,7 +48,7 @@ def test_targets_of_two_touching_discs_have_one_positive_at_each_centre() -> Non
 
 @NEEDS_JAX
 def test_the_focal_loss_has_centernets_value_on_known_inputs() -> None:
-    done = _in_child(
+    done = in_child(
         """
         import math
         import numpy as np
@@ -136,7 +115,7 @@ def test_focal_training_is_deterministic_in_its_seed_and_tells_the_detector(
 ) -> None:
     data = tmp_path / "data"
     write_folder(data, training_scenes(4, seed=2))
-    done = _in_child(
+    done = in_child(
         """
         import json, sys
         from pathlib import Path

@@ -6,25 +6,19 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import os
 import subprocess
-import sys
-import textwrap
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 from detector_scenes import H, W, disc, draw, training_scenes, write_folder
+from jax_child import NEEDS_JAX, in_child
 
 from softarm.cli import main
 from softarm.perception.detector.choice import detector
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.labels import _decode_counts, read_coco, stage_of
-
-HAS_JAX = (
-    importlib.util.find_spec("jax") is not None and importlib.util.find_spec("optax") is not None
-)
 
 
 def _known(tmp_path: Path, instances: bool = False) -> Path:
@@ -170,33 +164,13 @@ def test_train_without_the_extra_is_one_line_naming_it(
     assert not out.exists()
 
 
-#: JAX starts thread pools when imported: the tests that train run it in a child process,
-#: so that the suite's own later forks (Ray, subprocess) never happen beside them.
-NEEDS_JAX = pytest.mark.skipif(not HAS_JAX, reason="needs the train extra (jax, optax, onnx)")
-TESTS = Path(__file__).parent
-
-
-def _in_child(code: str, *args: str) -> subprocess.CompletedProcess[str]:
-    """Run ``code`` (with the tests' helpers importable) in a fresh interpreter."""
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")]),
-    }
-    return subprocess.run(
-        [sys.executable, "-c", textwrap.dedent(code), *args],
-        capture_output=True, text=True, env=env, timeout=600, check=False,
-    )  # fmt: skip
-
-
 def _softarm(*args: str) -> subprocess.CompletedProcess[str]:
-    return _in_child(
-        "import sys; from softarm.cli import main; sys.exit(main(sys.argv[1:]))", *args
-    )
+    return in_child("import sys; from softarm.cli import main; sys.exit(main(sys.argv[1:]))", *args)
 
 
 @NEEDS_JAX
 def test_onnx_export_round_trips_the_parameters(tmp_path: Path) -> None:
-    done = _in_child(
+    done = in_child(
         """
         import sys
         import numpy as np
@@ -219,7 +193,7 @@ def test_onnx_export_round_trips_the_parameters(tmp_path: Path) -> None:
 def test_a_network_of_other_widths_round_trips_and_bad_widths_are_refused(
     tmp_path: Path,
 ) -> None:
-    done = _in_child(
+    done = in_child(
         """
         import sys
         import numpy as np
@@ -264,7 +238,7 @@ def test_bad_widths_or_scale_are_one_usage_line(
 @NEEDS_JAX
 def test_crops_are_the_same_for_the_same_seed(tmp_path: Path) -> None:
     write_folder(tmp_path, training_scenes(3, seed=1))
-    done = _in_child(
+    done = in_child(
         """
         import sys
         from pathlib import Path
@@ -331,7 +305,7 @@ def test_train_from_a_file_that_is_no_network_is_one_line(tmp_path: Path) -> Non
 
 @NEEDS_JAX
 def test_a_stem_network_runs_in_opencv_as_in_jax_at_half_size(tmp_path: Path) -> None:
-    done = _in_child(
+    done = in_child(
         """
         import sys
         import cv2
