@@ -29,6 +29,7 @@ from softarm.checks import FloatArray
 from softarm.errors import MissingDependencyError
 from softarm.sim.render.cane_mesh import merged_and_members
 from softarm.sim.render.culling import in_frustum
+from softarm.sim.render.ground_shadow import ground_casters, leave_out_of_depth_pass
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.last_render import LastRender, scene_state
 from softarm.sim.render.mjcf import (
@@ -70,9 +71,6 @@ SHADOW_STEPS = np.arange(SHADOW_STEP, SHADOW_REACH, 2 * SHADOW_STEP)
 #: pixels of open soil onto the next texel of its speckle (up to 4 levels), and the
 #: cane fit read them (7 canes instead of 8 on row 90140).
 SMALL_RENDER_GROUND_GRID = 4.0
-#: MuJoCo's ``mjCAT_DECOR`` scene category: a geom of it casts no shadow (``mjr_render``
-#: leaves it out of the light's depth pass), and is drawn as any other in the others.
-CATEGORY_DECOR = 4
 
 __all__ = ["BushRenderer", "RenderUnavailableError", "RenderedFrame", "require_mujoco"]
 
@@ -160,14 +158,12 @@ class BushRenderer:
         self._merged, self._members = merged_and_members(self.model, self.labels)
         self._shadow_travel: FloatArray | None = None
         self._sun: SunShadows | None = None
-        #: Geoms left out of the sun's depth pass (:meth:`_draw`).
-        self._no_shadow: frozenset[int] = frozenset()
         if spec.row is not None and spec.shadows:
             sun = np.asarray(spec.look.light_direction, float)
             self._shadow_travel = sun / np.linalg.norm(sun)
             self._sun = SunShadows(self.model, mujoco)
-            if self._shadow_travel[2] < 0.0:  # the sun above the horizon
-                self._no_shadow = frozenset(int(g) for g in self._planes)
+        #: Geoms left out of the sun's depth pass in the small renders (:meth:`_draw`).
+        self._no_shadow = ground_casters(self._planes, self._shadow_travel)
 
     def push_leaves(self, body: FloatArray, radius: FloatArray) -> None:
         """Move aside every leaf that the arm's body (spheres at ``body`` (N, 3) with
@@ -245,22 +241,10 @@ class BushRenderer:
     ) -> RenderedFrame:
         """Colour, and depth and geom ids if asked, of ``camera`` with renderer ``r``
         (``local``: with the small shadow map, :meth:`_draw`)."""
-        mj = self._mj
         r.update_scene(self.data, camera=camera, scene_option=option)
         colour = np.ascontiguousarray(self._draw(r, local)[..., ::-1])
-        d = s = None
-        if depth:
-            r.enable_depth_rendering()
-            r.update_scene(self.data, camera=camera, scene_option=option)
-            d = r.render().astype(np.float32)
-            r.disable_depth_rendering()
-        if geoms:
-            r.enable_segmentation_rendering()
-            r.update_scene(self.data, camera=camera, scene_option=option)
-            seg = r.render()
-            r.disable_segmentation_rendering()
-            s = np.where(seg[..., 1] == int(mj.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
-            s = s.astype(np.int32)
+        d = _depth_pass(r, self.data, camera, option) if depth else None
+        s = _geom_pass(r, self.data, camera, option, self._mj) if geoms else None
         if d is not None and s is not None:
             d[s < 0] = np.nan
         return RenderedFrame(colour, d, s)
@@ -318,28 +302,10 @@ class BushRenderer:
 
     def _draw(self, r: Any, local: bool) -> npt.NDArray[np.uint8]:
         """The colour image of the scene renderer ``r`` was last given (``update_scene``);
-        with the small shadow map (``local``: C2's frames, C1's windows) the ground plane
-        left out of the sun's depth pass, which then no longer fills the whole map.
-
-        The ground lies below everything drawn and the sun is above the horizon, so it
-        casts no shadow on anything; where it alone is in the map its own pixels are lit
-        either way. But MuJoCo's polygon offset moves the ground's depth in the map a few
-        millimetres towards the sun, and that darkens sunlit surfaces within millimetres
-        of the ground (the mulch's top, the foot of a post or a stone): without it they
-        are lit. Whole C1 frames see the row's foot (on row 90270 in the sun 4,834 pixels
-        of C1's left eye differed, by up to 20 levels) and the cane fit reads them, so
-        they keep the ground in the map; in the small renders no pixel differed (tests,
-        BENCHMARKS.md "The daylight row")."""
+        with the small shadow map (``local``) the ground plane left out of the sun's
+        depth pass (:mod:`softarm.sim.render.ground_shadow`)."""
         if self._no_shadow and local:
-            scene, left = r._scene, set(self._no_shadow)
-            geom = int(self._mj.mjtObj.mjOBJ_GEOM)
-            for i in range(scene.ngeom):  # the ground is among the first (its id is 0)
-                g = scene.geoms[i]
-                if g.objtype == geom and g.objid in left:
-                    g.category = CATEGORY_DECOR
-                    left.discard(g.objid)
-                    if not left:
-                        break
+            leave_out_of_depth_pass(r._scene, self._no_shadow, self._mj)
         image: npt.NDArray[np.uint8] = r.render()
         return image
 
@@ -448,6 +414,25 @@ class BushRenderer:
         i = self._mocap[body]
         self.data.mocap_pos[i] = pos
         self.data.mocap_quat[i] = quat
+
+
+def _depth_pass(r: Any, data: Any, camera: str, option: Any) -> npt.NDArray[np.float32]:
+    """Depth (m) of ``camera`` drawn by MuJoCo renderer ``r``."""
+    r.enable_depth_rendering()
+    r.update_scene(data, camera=camera, scene_option=option)
+    depth: npt.NDArray[np.float32] = r.render().astype(np.float32)
+    r.disable_depth_rendering()
+    return depth
+
+
+def _geom_pass(r: Any, data: Any, camera: str, option: Any, mj: Any) -> npt.NDArray[np.int32]:
+    """The geom id of each pixel of ``camera`` drawn by ``r`` (-1: no geom)."""
+    r.enable_segmentation_rendering()
+    r.update_scene(data, camera=camera, scene_option=option)
+    seg = r.render()
+    r.disable_segmentation_rendering()
+    ids = np.where(seg[..., 1] == int(mj.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
+    return ids.astype(np.int32)
 
 
 def _bounds(model: Any, arm: npt.NDArray[np.intp]) -> FloatArray:

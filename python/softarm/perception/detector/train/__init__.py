@@ -75,25 +75,14 @@ def train(
         VisionError: ``start``'s training record is unreadable.
     """
     require_train_extra()
-    import jax
-
-    from softarm.perception.detector.network import MAX_SIDE, heatmap_of
+    from softarm.perception.detector.network import MAX_SIDE
     from softarm.perception.detector.train.augment import SCALE
-    from softarm.perception.detector.train.loop import HEATMAP_LOSSES, TrainSettings, fit
+    from softarm.perception.detector.train.loop import TrainSettings, fit
     from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
     from softarm.perception.detector.train.samples import describe, load_samples
     from softarm.perception.detector.train.unet import WIDTHS, layers, stem_of, widths_of
 
-    if start is not None and (widths is not None or stem):
-        raise InputError(
-            "widths, stem: a fine-tuned network keeps the widths and stem of its --from file"
-        )
-    if scale is not None and not 0 < scale[0] <= scale[1]:
-        raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
-    if heatmap is None:
-        heatmap = "logistic" if start is None else heatmap_of(Path(start))
-    if heatmap not in HEATMAP_LOSSES:
-        raise InputError(f"heatmap {heatmap!r}: one of {', '.join(HEATMAP_LOSSES)} expected")
+    heatmap = _checked(start, widths, stem, scale, heatmap)
     layers(WIDTHS if widths is None else widths)  # checks them before the data is read
     params = None if start is None else params_from_onnx(start)
     stem = stem_of(params) if params is not None else stem
@@ -106,25 +95,64 @@ def train(
     began = time.perf_counter()
     params = fit(samples, settings, params, on_epoch)
     export_onnx(params, out)
-    record = {
+    record = _record(out, notes, describe(samples), start, settings, began)
+    from softarm.files import write_text
+
+    write_text(Path(out).with_suffix(".json"), json.dumps(record, indent=1) + "\n", "record")
+    return record
+
+
+def _checked(
+    start: str | Path | None,
+    widths: tuple[int, ...] | None,
+    stem: bool,
+    scale: tuple[float, float] | None,
+    heatmap: str | None,
+) -> str:
+    """The heatmap loss :func:`train` uses, once its options are checked (an
+    :class:`InputError` naming the bad one)."""
+    from softarm.perception.detector.network import heatmap_of
+    from softarm.perception.detector.train.loop import HEATMAP_LOSSES
+
+    if start is not None and (widths is not None or stem):
+        raise InputError(
+            "widths, stem: a fine-tuned network keeps the widths and stem of its --from file"
+        )
+    if scale is not None and not 0 < scale[0] <= scale[1]:
+        raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
+    if heatmap is None:
+        heatmap = "logistic" if start is None else heatmap_of(Path(start))
+    if heatmap not in HEATMAP_LOSSES:
+        raise InputError(f"heatmap {heatmap!r}: one of {', '.join(HEATMAP_LOSSES)} expected")
+    return heatmap
+
+
+def _record(
+    out: str | Path,
+    notes: Any,
+    pixels: str,
+    start: str | Path | None,
+    settings: Any,
+    began: float,
+) -> dict[str, Any]:
+    """The training record written beside the weights ``out``."""
+    import jax
+
+    return {
         "weights": Path(out).name,
         "data": notes,
-        "pixels": json.loads(describe(samples)),
+        "pixels": json.loads(pixels),
         "from": None if start is None else str(start),
-        "epochs": epochs,
-        "seed": seed,
+        "epochs": settings.epochs,
+        "seed": settings.seed,
         "batch": settings.batch,
         "learning_rate": settings.learning_rate,
         "widths": list(settings.widths),
         "scale": list(settings.scale),
         "stem": settings.stem,
-        "heatmap": heatmap,
+        "heatmap": settings.heatmap,
         "losses": [round(v, 5) for v in settings.losses],
         "seconds": round(time.perf_counter() - began, 1),
         "device": str(jax.devices()[0].platform),
         "machine": platform.machine(),
     }
-    from softarm.files import write_text
-
-    write_text(Path(out).with_suffix(".json"), json.dumps(record, indent=1) + "\n", "record")
-    return record
