@@ -111,8 +111,7 @@ def _checked(
 ) -> str:
     """The heatmap loss :func:`train` uses, once its options are checked (an
     :class:`InputError` naming the bad one)."""
-    from softarm.perception.detector.network import heatmap_of
-    from softarm.perception.detector.train.loop import HEATMAP_LOSSES
+    from softarm.perception.detector.network import HEATMAPS, heatmap_of
 
     if start is not None and (widths is not None or stem):
         raise InputError(
@@ -122,8 +121,8 @@ def _checked(
         raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
     if heatmap is None:
         heatmap = "logistic" if start is None else heatmap_of(Path(start))
-    if heatmap not in HEATMAP_LOSSES:
-        raise InputError(f"heatmap {heatmap!r}: one of {', '.join(HEATMAP_LOSSES)} expected")
+    if heatmap not in HEATMAPS:
+        raise InputError(f"heatmap {heatmap!r}: one of {', '.join(HEATMAPS)} expected")
     return heatmap
 
 

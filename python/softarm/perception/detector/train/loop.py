@@ -19,29 +19,28 @@ import numpy as np
 import numpy.typing as npt
 import optax
 
-from softarm.perception.detector.network import CLASSES, HEATMAPS, normalise
+from softarm.perception.detector.network import CLASSES, normalise
 from softarm.perception.detector.train.augment import CROP, SCALE, crop_batch
 from softarm.perception.detector.train.focal import focal_loss, prior_bias, sharpened
 from softarm.perception.detector.train.samples import IGNORE, Sample
 from softarm.perception.detector.train.unet import WIDTHS, Params, apply, init_params
 
-__all__ = ["CLASS_WEIGHTS", "HEATMAP_LOSSES", "TrainSettings", "fit"]
+__all__ = ["CLASS_WEIGHTS", "TrainSettings", "fit"]
 
 #: Loss weight of each class's pixels (fruit and canes are few pixels of a frame).
 CLASS_WEIGHTS = (1.0, 2.5, 3.0, 2.5, 1.5)
 #: Weight of the centre heatmap's loss, and how much more a peak's pixels count.
 CENTRE_WEIGHT = 1.0
 CENTRE_POSITIVE = 20.0
-#: The centre heatmap's losses: the weighted logistic loss (the default) and CenterNet's
-#: penalty-reduced focal loss (:mod:`.focal`: sharp peaks, one per fruit).
-HEATMAP_LOSSES = HEATMAPS
 
 
 @dataclass(frozen=True)
 class TrainSettings:
     """Epochs (one crop of every image each), batch size, peak learning rate, seed, the
     network's channel widths, the augmentation's scale range, whether the network
-    has the stride-2 stem (``unet``) and the heatmap's loss (of HEATMAP_LOSSES)."""
+    has the stride-2 stem (``unet``) and the heatmap's loss (of ``network.HEATMAPS``:
+    the weighted logistic loss, the default, or CenterNet's penalty-reduced focal loss,
+    :mod:`.focal`, whose peaks are sharp, one per fruit)."""
 
     epochs: int = 150
     batch: int = 12
