@@ -25,7 +25,7 @@ class _Cane:
 
 def _row(y: float) -> int:
     """The image row of height ``y`` (m) on the cane (f = 900 px, centre row 240)."""
-    return int(round(240 + 900 * y / DEPTH))
+    return round(240 + 900 * y / DEPTH)
 
 
 def _views(stereo: StereoCamera) -> LossViews:
@@ -85,7 +85,7 @@ def test_a_cane_out_of_the_frames_or_the_depth_range_is_not_in_view(
 def test_the_summary_pools_metres_and_shares_over_scenes() -> None:
     rows = [
         {"condition": "sun", "source": "net", "settings": "default", "seed": s,
-         **{k: m * v for k, v in zip(STAGES, np.linspace(1.0, 0.2, len(STAGES)))},
+         **{k: m * v for k, v in zip(STAGES, np.linspace(1.0, 0.2, len(STAGES)), strict=True)},
          "coverage_all": 0.3}
         for s, m in ((1, 1.0), (2, 3.0))
     ]  # fmt: skip
