@@ -95,6 +95,12 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         "OUT tells the detector)",
     )  # fmt: skip
     t.add_argument(
+        "--boundary", action="store_true",
+        help="a fresh network with a boundary class (the pixels of a fruit against another "
+        "fruit), removed before the fruit pixels are split into parts, so that touching "
+        "fruit fall apart (the record beside OUT tells the detector)",
+    )  # fmt: skip
+    t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",
         help="start from these weights ('default': the shipped ones) instead of fresh ones",
     )  # fmt: skip
@@ -156,7 +162,7 @@ def run_train(args: argparse.Namespace) -> int:
 
     record = train(
         args.data, args.out, args.epochs, args.seed, start, on_epoch, args.widths, args.scale,
-        args.stem, args.zoom, args.heatmap,
+        args.stem, args.zoom, args.heatmap, args.boundary,
     )  # fmt: skip
     print(
         f"detector train: {args.epochs} epochs in {record['seconds']} s on "

@@ -23,6 +23,7 @@ from softarm.perception.berries import (
     Ripeness,
     _position,
 )
+from softarm.perception.detector.boundary import fruit_parts
 from softarm.perception.detector.depth_check import rejection
 from softarm.perception.detector.network import NetworkOutput
 from softarm.perception.detector.touching import disc_seeds, split_discs
@@ -144,7 +145,8 @@ def instance_masks(
     rule = PEAK_RULES[output.heatmap]
     binary = cast(_U8, (fruit > FRUIT_THRESHOLD).astype(np.uint8))
     binary = cast(_U8, cv2.morphologyEx(binary, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)))
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+    # A network with the boundary class cuts touching fruit apart first (.boundary).
+    n, labels, stats = fruit_parts(binary, output.boundary)
     out = []
     for k in range(1, n):
         x, y, w, h, area = (int(v) for v in stats[k])

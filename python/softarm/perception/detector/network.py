@@ -13,7 +13,10 @@ network at half its size) gives (1, N_OUTPUTS, H/2, W/2), H and W multiples of
 trained (:data:`HEATMAPS`: the broad logistic heatmap, or the focal loss's sharp peaks),
 which the decoding into fruit must know, is read from the training record beside the
 weights (the same name with ``.json``, as ``softarm detector train`` writes it); without
-one, the heatmap is the logistic one (the shipped weights').
+one, the heatmap is the logistic one (the shipped weights'). A record saying
+``"boundary": true`` (``softarm detector train --boundary``) adds one output after the
+heatmap: the logit that a fruit pixel lies against another fruit (:mod:`.boundary`); a
+record without the key is a network without it.
 Training images are shrunk so that their longer side is at most :data:`MAX_SIDE` pixels
 (the scale the training renders were drawn at: C1's 1280 × 720 eye at half size) times
 the output's stride; at run time images are shrunk to a network's own longest side, by
@@ -43,6 +46,7 @@ __all__ = [
     "STRIDE",
     "Network",
     "NetworkOutput",
+    "boundary_of",
     "normalise",
 ]
 
@@ -75,15 +79,24 @@ class NetworkOutput:
     """The network's output for one image, at the network's resolution: ``probabilities``
     (h, w, len(CLASSES)) float32 summing to 1 per pixel and ``centres`` (h, w) float32 in
     [0, 1]; ``size`` (W, H) is the image's, :meth:`upsample` brings a map to it;
-    ``heatmap`` is how the centres were trained (of HEATMAPS)."""
+    ``heatmap`` is how the centres were trained (of HEATMAPS); ``boundary`` the (h, w)
+    boundary probability of a network with the boundary class, else None."""
 
     def __init__(
-        self, probabilities: _F32, centres: _F32, size: tuple[int, int], heatmap: str = "logistic"
+        self,
+        probabilities: _F32,
+        centres: _F32,
+        size: tuple[int, int],
+        heatmap: str = "logistic",
+        boundary: _F32 | None = None,
     ) -> None:
         self.probabilities = probabilities
         self.centres = centres
         self.size = size
         self.heatmap = heatmap
+        #: (h, w) probability that a pixel is fruit against another fruit, for a network
+        #: trained with the boundary class; None for one without it.
+        self.boundary = boundary
 
     @property
     def scale(self) -> float:
@@ -131,13 +144,16 @@ class Network:
         if net.empty():
             raise VisionError(f"detector weights {self.path}: the ONNX network is empty")
         self._net = net
+        #: Whether the network gives the boundary class (its record says so).
+        self.boundary = boundary_of(self.path)
+        n = N_OUTPUTS + int(self.boundary)
         side = STRIDE * 4
         probe = self._forward(np.zeros((1, 3, side, side), np.float32))
-        shapes = {(1, N_OUTPUTS, side // k, side // k): k for k in (1, 2)}
+        shapes = {(1, n, side // k, side // k): k for k in (1, 2)}
         if probe.shape not in shapes:
             raise VisionError(
                 f"detector weights {self.path}: the network gives {probe.shape} for a "
-                f"{side} x {side} image, not (1, {N_OUTPUTS}, H, W) or (1, {N_OUTPUTS}, H/2, W/2)"
+                f"{side} x {side} image, not (1, {n}, H, W) or (1, {n}, H/2, W/2)"
             )
         #: Image pixels per output pixel of the network (2 for a network with the stem).
         self.stride = shapes[probe.shape]
@@ -168,10 +184,46 @@ class Network:
         e = np.exp(logits - logits.max(axis=0, keepdims=True))
         probs = (e / e.sum(axis=0, keepdims=True)).transpose(1, 2, 0)
         centres = 1.0 / (1.0 + np.exp(-out[len(CLASSES)]))
+        boundary = None
+        if self.boundary:
+            boundary = (1.0 / (1.0 + np.exp(-out[N_OUTPUTS]))).astype(np.float32)
         return NetworkOutput(
             np.ascontiguousarray(probs, np.float32), centres.astype(np.float32), (w, h),
-            self.heatmap,
+            self.heatmap, boundary,
         )  # fmt: skip
+
+
+def _record(weights: Path) -> object:
+    """The training record beside ``weights`` (parsed JSON), or {} where there is none.
+
+    Raises:
+        VisionError: the record is not readable JSON.
+    """
+    record = weights.with_suffix(".json")
+    if not record.is_file():
+        return {}
+    try:
+        return json.loads(record.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise VisionError(f"detector record {record}: not readable JSON ({exc})") from None
+
+
+def boundary_of(weights: Path) -> bool:
+    """Whether ``weights`` give the boundary class: their training record's "boundary"
+    (``weights`` with ``.json``); False where there is no record or it has no such key
+    (records written before the boundary class existed).
+
+    Raises:
+        VisionError: the record is unreadable, or its "boundary" is not true or false.
+    """
+    data = _record(weights)
+    flag = data.get("boundary", False) if isinstance(data, dict) else None
+    if not isinstance(flag, bool):
+        raise VisionError(
+            f"detector record {weights.with_suffix('.json')}: boundary {flag!r} is not true "
+            "or false"
+        )
+    return flag
 
 
 def heatmap_of(weights: Path) -> str:
@@ -183,12 +235,7 @@ def heatmap_of(weights: Path) -> str:
         VisionError: the record is not a JSON object, or names an unknown heatmap.
     """
     record = weights.with_suffix(".json")
-    if not record.is_file():
-        return "logistic"
-    try:
-        data = json.loads(record.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise VisionError(f"detector record {record}: not readable JSON ({exc})") from None
+    data = _record(weights)
     kind = data.get("heatmap", "logistic") if isinstance(data, dict) else None
     if kind not in HEATMAPS:
         raise VisionError(

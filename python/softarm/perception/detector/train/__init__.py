@@ -53,6 +53,7 @@ def train(
     stem: bool = False,
     zooms: list[float] | None = None,
     heatmap: str | None = None,
+    boundary: bool = False,
 ) -> dict[str, Any]:
     """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
     and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
@@ -65,12 +66,15 @@ def train(
     (default 1; 2 for renders drawn at half the size the network runs at); ``heatmap``:
     the centre heatmap's loss, "logistic" or "focal" (CenterNet's: sharp peaks, which
     the record tells the run-time decoding, :mod:`..network`; default: the ``start``
-    file's, from its record, else logistic). Returns the record.
+    file's, from its record, else logistic); ``boundary``: a fresh network with the
+    boundary class (the pixels of a fruit against another's, :mod:`..boundary`; a
+    fine-tuned one keeps its file's). Returns the record.
 
     Raises:
         TrainExtraMissing: the ``train`` extra is not installed.
         InputError: a data folder holds no labelled image, ``start`` is not a network
-            of this architecture, ``widths`` or ``stem`` are given with ``start``, or
+            of this architecture, ``widths``, ``stem`` or ``boundary`` are given with
+            ``start``, or
             ``widths``, ``scale``, ``zooms`` or ``heatmap`` are not valid.
         VisionError: ``start``'s training record is unreadable.
     """
@@ -80,17 +84,24 @@ def train(
     from softarm.perception.detector.train.loop import TrainSettings, fit
     from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
     from softarm.perception.detector.train.samples import describe, load_samples
-    from softarm.perception.detector.train.unet import WIDTHS, layers, stem_of, widths_of
+    from softarm.perception.detector.train.unet import (
+        WIDTHS,
+        has_boundary,
+        layers,
+        stem_of,
+        widths_of,
+    )
 
-    heatmap = _checked(start, widths, stem, scale, heatmap)
+    heatmap = _checked(start, widths, stem or boundary, scale, heatmap)
     layers(WIDTHS if widths is None else widths)  # checks them before the data is read
     params = None if start is None else params_from_onnx(start)
     stem = stem_of(params) if params is not None else stem
-    samples, notes = load_samples(list(data), MAX_SIDE * (2 if stem else 1), zooms)
+    boundary = has_boundary(params) if params is not None else boundary
+    samples, notes = load_samples(list(data), MAX_SIDE * (2 if stem else 1), zooms, boundary)
     settings = TrainSettings(
         epochs=epochs, seed=seed,
         widths=widths_of(params) if params is not None else widths or WIDTHS,
-        scale=SCALE if scale is None else scale, stem=stem, heatmap=heatmap,
+        scale=SCALE if scale is None else scale, stem=stem, heatmap=heatmap, boundary=boundary,
     )  # fmt: skip
     began = time.perf_counter()
     params = fit(samples, settings, params, on_epoch)
@@ -115,7 +126,8 @@ def _checked(
 
     if start is not None and (widths is not None or stem):
         raise InputError(
-            "widths, stem: a fine-tuned network keeps the widths and stem of its --from file"
+            "widths, stem, boundary: a fine-tuned network keeps the widths, stem and boundary "
+            "class of its --from file"
         )
     if scale is not None and not 0 < scale[0] <= scale[1]:
         raise InputError(f"scale {scale!r}: a range LOW <= HIGH of positive factors expected")
@@ -150,6 +162,7 @@ def _record(
         "scale": list(settings.scale),
         "stem": settings.stem,
         "heatmap": settings.heatmap,
+        "boundary": settings.boundary,
         "losses": [round(v, 5) for v in settings.losses],
         "seconds": round(time.perf_counter() - began, 1),
         "device": str(jax.devices()[0].platform),

@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from softarm.perception.detector.train.samples import IGNORE, Sample
+from softarm.perception.detector.train.samples import IGNORE, Sample, stages
 
 __all__ = ["CROP", "crop_batch"]
 
@@ -59,7 +59,8 @@ def _crop(
             _F32, cv2.copyMakeBorder(centres, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=0)
         )
         h, w = classes.shape
-    fruit = np.flatnonzero((classes >= 1) & (classes <= 3))
+    plain = stages(classes)  # a boundary pixel is fruit too
+    fruit = np.flatnonzero((plain >= 1) & (plain <= 3))
     if fruit.size and rng.uniform() < ON_FRUIT:
         cy, cx = divmod(int(fruit[rng.integers(fruit.size)]), w)
         y0 = int(np.clip(cy - crop // 2 + rng.integers(-crop // 4, crop // 4 + 1), 0, h - crop))

@@ -3,8 +3,10 @@ plus a weighted logistic loss on the centre heatmap (or CenterNet's focal loss:
 :mod:`.focal`), AdamW with a cosine schedule, on
 batches of augmented crops (twice the side for a network with the stride-2 stem, whose
 outputs are scored against the labels at half resolution); deterministic in the seed
-(the same crops, the same order, the same initial weights). JAX runs on a GPU where it
-sees one, else on the CPU."""
+(the same crops, the same order, the same initial weights). With the boundary class,
+its own output is trained by a logistic loss whose boundary pixels weigh BOUNDARY_WEIGHT
+(a fruit class's weight) and every other pixel 1. JAX runs on a GPU where it sees one,
+else on the CPU."""
 
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ import optax
 from softarm.perception.detector.network import CLASSES, normalise
 from softarm.perception.detector.train.augment import CROP, SCALE, crop_batch
 from softarm.perception.detector.train.focal import focal_loss, prior_bias, sharpened
-from softarm.perception.detector.train.samples import IGNORE, Sample
+from softarm.perception.detector.train.samples import BOUNDARY_FLAG, IGNORE, Sample
 from softarm.perception.detector.train.unet import WIDTHS, Params, apply, init_params
 
 __all__ = ["CLASS_WEIGHTS", "TrainSettings", "fit"]
@@ -32,6 +34,9 @@ CLASS_WEIGHTS = (1.0, 2.5, 3.0, 2.5, 1.5)
 #: Weight of the centre heatmap's loss, and how much more a peak's pixels count.
 CENTRE_WEIGHT = 1.0
 CENTRE_POSITIVE = 20.0
+#: Loss weight of a boundary pixel in the boundary class's loss (the ripe class's: the
+#: pixels it marks are fruit; every other pixel weighs 1).
+BOUNDARY_WEIGHT = 2.5
 
 
 @dataclass(frozen=True)
@@ -40,7 +45,8 @@ class TrainSettings:
     network's channel widths, the augmentation's scale range, whether the network
     has the stride-2 stem (``unet``) and the heatmap's loss (of ``network.HEATMAPS``:
     the weighted logistic loss, the default, or CenterNet's penalty-reduced focal loss,
-    :mod:`.focal`, whose peaks are sharp, one per fruit)."""
+    :mod:`.focal`, whose peaks are sharp, one per fruit) and whether the network has the
+    boundary class (``boundary``: the pixels of a fruit against another's)."""
 
     epochs: int = 150
     batch: int = 12
@@ -50,23 +56,36 @@ class TrainSettings:
     scale: tuple[float, float] = SCALE
     stem: bool = False
     heatmap: str = "logistic"
+    boundary: bool = False
     losses: list[float] = field(default_factory=list, compare=False)
 
 
-def _loss(params: Params, x: Any, classes: Any, centres: Any, focal: bool = False) -> Any:
+def _boundary_loss(logit: Any, classes: Any, valid: Any) -> Any:
+    """The boundary class's weighted logistic loss (its pixels carry BOUNDARY_FLAG)."""
+    target = valid & ((classes & BOUNDARY_FLAG) > 0)
+    bce = optax.sigmoid_binary_cross_entropy(logit, target.astype(jnp.float32))
+    w = jnp.where(target, BOUNDARY_WEIGHT, 1.0) * valid
+    return jnp.sum(bce * w) / jnp.maximum(jnp.sum(w), 1.0)
+
+
+def _loss(
+    params: Params, x: Any, classes: Any, centres: Any, focal: bool = False, edge: bool = False
+) -> Any:
     out = apply(params, x)
     logits, centre = out[..., : len(CLASSES)], out[..., len(CLASSES)]
     valid = classes != IGNORE
-    target = jnp.where(valid, classes, 0)
+    target = jnp.where(valid, classes & (BOUNDARY_FLAG - 1), 0)  # the stage, flag dropped
     ce = optax.softmax_cross_entropy_with_integer_labels(logits, target)
     w = jnp.asarray(CLASS_WEIGHTS)[target] * valid
-    class_loss = jnp.sum(ce * w) / jnp.maximum(jnp.sum(w), 1.0)
+    loss = jnp.sum(ce * w) / jnp.maximum(jnp.sum(w), 1.0)
+    if edge:
+        loss = loss + _boundary_loss(out[..., len(CLASSES) + 1], classes, valid)
     if focal:
-        return class_loss + CENTRE_WEIGHT * focal_loss(centre, centres)
+        return loss + CENTRE_WEIGHT * focal_loss(centre, centres)
     bce = optax.sigmoid_binary_cross_entropy(centre, centres)
     cw = 1.0 + CENTRE_POSITIVE * centres
     centre_loss = jnp.sum(bce * cw) / jnp.sum(cw)
-    return class_loss + CENTRE_WEIGHT * centre_loss
+    return loss + CENTRE_WEIGHT * centre_loss
 
 
 def _halved(
@@ -90,7 +109,7 @@ def fit(
     ``on_epoch(epoch, mean loss, seconds)`` after each epoch."""
     focal = settings.heatmap == "focal"
     if params is None:
-        params = init_params(settings.seed, settings.widths, settings.stem)
+        params = init_params(settings.seed, settings.widths, settings.stem, settings.boundary)
         if focal:  # the heatmap starts at PRIOR everywhere, as CenterNet's
             w, b = params["head"]
             params = {**params, "head": (w, b.at[len(CLASSES)].set(prior_bias()))}
@@ -105,7 +124,7 @@ def fit(
 
     @jax.jit
     def step(p: Params, s: Any, x: Any, c: Any, h: Any) -> tuple[Params, Any, Any]:
-        loss, grads = jax.value_and_grad(_loss)(p, x, c, h, focal)
+        loss, grads = jax.value_and_grad(_loss)(p, x, c, h, focal, settings.boundary)
         updates, s = optimiser.update(grads, s, p)
         return optax.apply_updates(p, updates), s, loss
 

@@ -91,12 +91,13 @@ def onnx_bytes(params: Params) -> bytes:
     d2 = g.conv(params, "dec2", g.up_cat(d3, s2))
     d1 = g.conv(params, "dec1", g.up_cat(d2, s1))
     head = g.conv(params, "head", d1, relu=False)
+    outputs = int(np.asarray(params["head"][1]).shape[0])  # N_OUTPUTS, +1 with the boundary
     g.nodes.append(helper.make_node("Identity", [head], ["scores"]))
     f32 = onnx.TensorProto.FLOAT
     graph = helper.make_graph(
         g.nodes, "softarm_berries",
         [helper.make_tensor_value_info("image", f32, [1, 3, "height", "width"])],
-        [helper.make_tensor_value_info("scores", f32, [1, N_OUTPUTS, "height", "width"])],
+        [helper.make_tensor_value_info("scores", f32, [1, outputs, "height", "width"])],
         g.inits,
     )  # fmt: skip
     model = helper.make_model(
@@ -141,8 +142,10 @@ def params_from_onnx(path: str | Path) -> Params:
         raise InputError(f"--from {path}: not a network of this architecture (no U-Net levels)")
     widths = tuple(int(w.shape[0]) for w in firsts if w is not None)
     stem = firsts[0] is not None and int(firsts[0].shape[-1]) == STEM_KERNEL
+    head = arrays.get("head.w")
+    boundary = head is not None and int(head.shape[0]) == N_OUTPUTS + 1
     params: Params = {}
-    for name, k, cin, cout in layers(widths, stem):
+    for name, k, cin, cout in layers(widths, stem, boundary):
         w, b = arrays.get(f"{name}.w"), arrays.get(f"{name}.b")
         if w is None or b is None or w.shape != (cout, cin, k, k) or b.shape != (cout,):
             raise InputError(f"--from {path}: not a network of this architecture (layer {name})")

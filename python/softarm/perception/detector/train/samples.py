@@ -2,7 +2,10 @@
 to MAX_SIDE, or twice it for a network with the stem), its class map (an index into
 CLASSES per pixel, IGNORE where a fruit has no known stage) and its centre heatmap (a
 Gaussian peak of height 1 at each fruit's centre, its width a third of the fruit's
-radius)."""
+radius). With the boundary class (``softarm detector train --boundary``), the pixels of a
+fruit within BOUNDARY_RADIUS of a different fruit's mask carry BOUNDARY_FLAG in the
+class map besides their stage: riding in the class map, the flag is scaled, cropped,
+mirrored and cut out with it by every augmentation."""
 
 from __future__ import annotations
 
@@ -19,10 +22,26 @@ from softarm.errors import InputError
 from softarm.perception.detector.labels import LabelledImage, read_coco
 from softarm.perception.detector.network import CLASSES, MAX_SIDE
 
-__all__ = ["IGNORE", "Sample", "find_labels", "load_samples"]
+__all__ = [
+    "BOUNDARY_FLAG",
+    "BOUNDARY_RADIUS",
+    "IGNORE",
+    "Sample",
+    "boundary_target",
+    "find_labels",
+    "load_samples",
+    "stages",
+]
 
 #: Class-map value of pixels the loss leaves out.
 IGNORE = 255
+#: Bit of the class map marking a boundary pixel (the classes are 0-4, IGNORE has every
+#: bit and stays IGNORE).
+BOUNDARY_FLAG = 16
+#: A fruit pixel within this distance (px at the training images' scale, the network's
+#: own) of another fruit's mask is a boundary pixel: a band of two pixels on each side
+#: of the contact, so that a fruit of 5 px radius keeps a core of its own.
+BOUNDARY_RADIUS = 2
 _U8 = npt.NDArray[np.uint8]
 _F32 = npt.NDArray[np.float32]
 
@@ -61,7 +80,33 @@ def find_labels(data: str | Path) -> Path:
     return found[0]
 
 
-def _sample(item: LabelledImage, max_side: int, zoom: float) -> Sample | None:
+def stages(classes: _U8) -> _U8:
+    """``classes`` without BOUNDARY_FLAG: each pixel's class index (or IGNORE)."""
+    return cast(_U8, np.where(classes == IGNORE, classes, classes & ~np.uint8(BOUNDARY_FLAG)))
+
+
+def boundary_target(
+    owner: npt.NDArray[np.int32], radius: int = BOUNDARY_RADIUS
+) -> npt.NDArray[np.bool_]:
+    """The boundary class of an instance map ``owner`` (0 off fruit, k > 0 on fruit k):
+    the fruit pixels within ``radius`` px (Euclidean) of a different fruit's pixel. A
+    lone fruit has none."""
+    out = np.zeros(owner.shape, bool)
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+    h, w = owner.shape
+    for k in np.unique(owner[owner > 0]).tolist():
+        rows, cols = np.nonzero(owner == k)
+        y0, y1 = max(0, rows.min() - radius), min(h, rows.max() + radius + 1)
+        x0, x1 = max(0, cols.min() - radius), min(w, cols.max() + radius + 1)
+        window = owner[y0:y1, x0:x1]
+        near = cv2.dilate((window == k).astype(np.uint8), kernel) > 0
+        out[y0:y1, x0:x1] |= near & (window > 0) & (window != k)
+    return out
+
+
+def _sample(
+    item: LabelledImage, max_side: int, zoom: float, boundary: bool = False
+) -> Sample | None:
     image = cast(_U8 | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
     if image is None or image.shape[:2] != (item.height, item.width):
         return None
@@ -72,16 +117,20 @@ def _sample(item: LabelledImage, max_side: int, zoom: float) -> Sample | None:
         image = cast(_U8, cv2.resize(image, size, interpolation=cv2.INTER_AREA))
     classes = np.zeros(image.shape[:2], np.uint8)
     centres = np.zeros(image.shape[:2], np.float32)
+    owner = np.zeros(image.shape[:2], np.int32)
     objects = sorted(item.objects(), key=lambda o: o.is_fruit)  # fruit painted over canes
-    for obj in objects:
+    for k, obj in enumerate(objects, start=1):
         mask = obj.mask
         if scale < 1.0:
             mask = cv2.resize(mask.astype(np.uint8), size, interpolation=cv2.INTER_NEAREST) > 0
         if not mask.any():
             continue
         classes[mask] = CLASSES.index(obj.stage) if obj.stage in CLASSES else IGNORE
+        owner[mask] = k if obj.is_fruit else 0
         if obj.is_fruit:
             _add_peak(centres, mask)
+    if boundary:
+        classes[boundary_target(owner) & (classes != IGNORE)] |= np.uint8(BOUNDARY_FLAG)
     return Sample(image, classes, centres, zoom)
 
 
@@ -98,11 +147,14 @@ def _add_peak(centres: _F32, mask: npt.NDArray[np.bool_]) -> None:
 
 
 def load_samples(
-    folders: list[str | Path], max_side: int = MAX_SIDE, zooms: list[float] | None = None
+    folders: list[str | Path],
+    max_side: int = MAX_SIDE,
+    zooms: list[float] | None = None,
+    boundary: bool = False,
 ) -> tuple[list[Sample], list[str]]:
     """The samples of every data folder (or COCO file), shrunk to ``max_side``, each
-    folder's with its zoom of ``zooms`` (default 1 each), and a line per folder saying
-    what it held.
+    folder's with its zoom of ``zooms`` (default 1 each), with the boundary class in
+    their class maps when ``boundary``, and a line per folder saying what it held.
 
     Raises:
         InputError: a folder has no COCO file, or none of its images could be read, or
@@ -118,7 +170,9 @@ def load_samples(
     for folder, zoom in zip(folders, zooms, strict=True):
         labels = find_labels(folder)
         items = read_coco(labels, labels.parent)
-        samples = [s for s in (_sample(i, max_side, zoom) for i in items) if s is not None]
+        samples = [
+            s for s in (_sample(i, max_side, zoom, boundary) for i in items) if s is not None
+        ]
         if not samples:
             raise InputError(f"--data {folder}: no readable labelled image in {labels}")
         zoomed = "" if zoom == 1 else f", zoom {zoom:g}"
@@ -128,9 +182,15 @@ def load_samples(
 
 
 def describe(samples: list[Sample]) -> str:
-    """Pixel counts per class, as one JSON line (the training record's)."""
+    """Pixel counts per class (and of the boundary class where the maps hold it), as one
+    JSON line (the training record's)."""
     counts = {name: 0 for name in CLASSES}
+    flagged = 0
     for s in samples:
+        plain = stages(s.classes)
         for k, name in enumerate(CLASSES):
-            counts[name] += int(np.count_nonzero(s.classes == k))
+            counts[name] += int(np.count_nonzero(plain == k))
+        flagged += int(np.count_nonzero((s.classes != IGNORE) & ((s.classes & BOUNDARY_FLAG) > 0)))
+    if flagged:
+        counts["boundary"] = flagged
     return json.dumps(counts)

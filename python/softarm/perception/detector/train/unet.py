@@ -9,6 +9,9 @@ followed by a 3×3 convolution, so that the rest of the network runs at half the
 resolution (today's cost) while its first layer sees every pixel of the full image
 (fruit of a few pixels keep their detail). Its outputs are at half the input's size.
 
+With ``boundary=True`` the head has one more output, after the heatmap: the boundary
+class's logit (:mod:`..boundary`).
+
 Parameters are a flat dict ``name -> (kernel (kh, kw, cin, cout), bias (cout,))`` of
 :data:`LAYERS`, images NHWC."""
 
@@ -28,6 +31,7 @@ __all__ = [
     "STEM_KERNEL",
     "WIDTHS",
     "apply",
+    "has_boundary",
     "init_params",
     "layers",
     "stem_of",
@@ -41,11 +45,11 @@ STEM_KERNEL = 6
 
 
 def layers(
-    widths: tuple[int, ...] = WIDTHS, stem: bool = False
+    widths: tuple[int, ...] = WIDTHS, stem: bool = False, boundary: bool = False
 ) -> tuple[tuple[str, int, int, int], ...]:
     """(name, kernel size, in channels, out channels) of a network of ``widths`` (four
     positive channel counts), in the order the graph runs them; with ``stem`` the first
-    layer is the stride-2 stem.
+    layer is the stride-2 stem, with ``boundary`` the head gives the boundary class too.
 
     Raises:
         InputError: ``widths`` is not four positive integers.
@@ -64,7 +68,7 @@ def layers(
         ("dec3", 3, c4 + c3, c3),
         ("dec2", 3, c3 + c2, c2),
         ("dec1", 3, c2 + c1, c1),
-        ("head", 1, c1, N_OUTPUTS),
+        ("head", 1, c1, N_OUTPUTS + int(boundary)),
     )
 
 
@@ -74,12 +78,14 @@ LAYERS = layers()
 Params = dict[str, tuple[Any, Any]]
 
 
-def init_params(seed: int, widths: tuple[int, ...] = WIDTHS, stem: bool = False) -> Params:
+def init_params(
+    seed: int, widths: tuple[int, ...] = WIDTHS, stem: bool = False, boundary: bool = False
+) -> Params:
     """He-initialised parameters of a network of ``widths`` (with the stride-2 stem when
-    ``stem``), deterministic in ``seed``."""
+    ``stem``, the boundary class when ``boundary``), deterministic in ``seed``."""
     rng = np.random.default_rng(seed)
     params: Params = {}
-    for name, k, cin, cout in layers(widths, stem):
+    for name, k, cin, cout in layers(widths, stem, boundary):
         std = np.sqrt(2.0 / (k * k * cin))
         w = rng.normal(0.0, std, (k, k, cin, cout)).astype(np.float32)
         params[name] = (jnp.asarray(w), jnp.zeros((cout,), jnp.float32))
@@ -90,6 +96,11 @@ def widths_of(params: Params) -> tuple[int, int, int, int]:
     """The four channel counts of ``params`` (their first layer of each level)."""
     c1, c2, c3, c4 = (int(params[n][0].shape[-1]) for n in ("enc1", "enc2a", "enc3a", "enc4a"))
     return c1, c2, c3, c4
+
+
+def has_boundary(params: Params) -> bool:
+    """Whether ``params`` give the boundary class (their head's output count says)."""
+    return int(params["head"][0].shape[-1]) == N_OUTPUTS + 1
 
 
 def stem_of(params: Params) -> bool:
