@@ -151,40 +151,106 @@ fn sweep<M: SectionModel + ?Sized>(
     upto: usize,
     jac: &mut DMatrix<f64>,
 ) -> Frame {
-    let mut f = Frame::identity();
     // Column-major 6×n: column j is the slice [6j, 6j + 6).
     let mut cols = jac.as_mut_slice().chunks_exact_mut(6);
-    for i in 0..upto {
-        let st = state(model, q, i);
-        let (tip, d_pos, d_rot) = st.arc.frame_with_derivatives(1.0);
-        let next = f.compose(&st.tip_then_tail(&tip));
-        let p_tip = f.pos + f.rot * tip.pos;
-        // The tip's derivatives along (L, ux, uy), rotated into the base frame once;
-        // ∂ω/∂L = 0, so the angular part has two columns.
-        let dp = f.rot * d_pos;
-        let (w_ux, w_uy) = (f.rot * d_rot.column(1), f.rot * d_rot.column(2));
-        // The velocity of the point at the base origin, v_tip + p_tip × w, per parameter.
-        let v = Mat3::from_columns(&[
-            dp.column(0).into_owned(),
-            dp.column(1) + p_tip.cross(&w_ux),
-            dp.column(2) + p_tip.cross(&w_uy),
-        ]);
-        // The tip's z axis: the twist after the arc turns about it.
-        let z = next.rot.column(2);
-        for (k, col) in cols.by_ref().take(3).enumerate() {
-            let a = st.d_arc.column(k);
-            let (mut vk, mut wk) = (v * a, w_ux * a[1] + w_uy * a[2]);
-            // A model's twist either varies with a coordinate or not; the test is decided
-            // at compile time for each model, and a constant twist costs nothing.
-            if st.d_twist[k] != 0.0 {
-                wk += z * st.d_twist[k];
-                vk += p_tip.cross(&z) * st.d_twist[k];
-            }
-            col.copy_from_slice(&[vk.x, vk.y, vk.z, wk.x, wk.y, wk.z]);
-        }
-        f = next;
+    if upto == 0 {
+        return Frame::identity();
+    }
+    // The first section's base is the chain's base: its twists need none of the
+    // rotations into a base frame (a third of the sweep's products for three sections).
+    let mut f = section_twists(&ChainBase, &state(model, q, 0), &mut cols);
+    for i in 1..upto {
+        f = section_twists(&f, &state(model, q, i), &mut cols);
     }
     f
+}
+
+/// The frame a section's twists are expressed from: the chain's base (the identity,
+/// [`ChainBase`]) or the frame after the sections before it.
+trait SectionBase {
+    fn rotate(&self, v: Vec3) -> Vec3;
+    fn rotate_all(&self, m: &Mat3) -> Mat3;
+    fn place(&self, p: &Vec3) -> Vec3;
+    fn then(&self, next: Frame) -> Frame;
+}
+
+/// The identity frame at the chain's base.
+struct ChainBase;
+
+impl SectionBase for ChainBase {
+    #[inline(always)]
+    fn rotate(&self, v: Vec3) -> Vec3 {
+        v
+    }
+    #[inline(always)]
+    fn rotate_all(&self, m: &Mat3) -> Mat3 {
+        *m
+    }
+    #[inline(always)]
+    fn place(&self, p: &Vec3) -> Vec3 {
+        *p
+    }
+    #[inline(always)]
+    fn then(&self, next: Frame) -> Frame {
+        next
+    }
+}
+
+impl SectionBase for Frame {
+    #[inline(always)]
+    fn rotate(&self, v: Vec3) -> Vec3 {
+        self.rot * v
+    }
+    #[inline(always)]
+    fn rotate_all(&self, m: &Mat3) -> Mat3 {
+        self.rot * m
+    }
+    #[inline(always)]
+    fn place(&self, p: &Vec3) -> Vec3 {
+        self.pos + self.rot * p
+    }
+    #[inline(always)]
+    fn then(&self, next: Frame) -> Frame {
+        self.compose(&next)
+    }
+}
+
+/// One section's three twist columns (see [`sweep`]) written into the next three of
+/// `cols`; returns the frame after the section.
+#[inline(always)]
+fn section_twists<B: SectionBase>(
+    base: &B,
+    st: &SectionState,
+    cols: &mut std::slice::ChunksExactMut<'_, f64>,
+) -> Frame {
+    let (tip, d_pos, d_rot) = st.arc.frame_with_derivatives(1.0);
+    let next = base.then(st.tip_then_tail(&tip));
+    let p_tip = base.place(&tip.pos);
+    // The tip's derivatives along (L, ux, uy), rotated into the base frame once;
+    // ∂ω/∂L = 0, so the angular part has two columns.
+    let dp = base.rotate_all(&d_pos);
+    let w_ux = base.rotate(d_rot.column(1).into_owned());
+    let w_uy = base.rotate(d_rot.column(2).into_owned());
+    // The velocity of the point at the base origin, v_tip + p_tip × w, per parameter.
+    let v = Mat3::from_columns(&[
+        dp.column(0).into_owned(),
+        dp.column(1) + p_tip.cross(&w_ux),
+        dp.column(2) + p_tip.cross(&w_uy),
+    ]);
+    // The tip's z axis: the twist after the arc turns about it.
+    let z = next.rot.column(2);
+    for (k, col) in cols.by_ref().take(3).enumerate() {
+        let a = st.d_arc.column(k);
+        let (mut vk, mut wk) = (v * a, w_ux * a[1] + w_uy * a[2]);
+        // A model's twist either varies with a coordinate or not; the test is decided
+        // at compile time for each model, and a constant twist costs nothing.
+        if st.d_twist[k] != 0.0 {
+            wk += z * st.d_twist[k];
+            vk += p_tip.cross(&z) * st.d_twist[k];
+        }
+        col.copy_from_slice(&[vk.x, vk.y, vk.z, wk.x, wk.y, wk.z]);
+    }
+    next
 }
 
 /// Forward kinematics and the 6×n Jacobian (rows vx, vy, vz, wx, wy, wz in the base
