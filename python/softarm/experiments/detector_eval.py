@@ -31,7 +31,7 @@ from softarm.perception.detector.choice import DETECTORS, BerryDetector, detecto
 from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 from softarm.perception.detector.misses import fruit_cases, miss_table
-from softarm.perception.detector.network import STRIDE, heatmap_of
+from softarm.perception.detector.network import STRIDE, boundary_of, heatmap_of
 
 __all__ = ["CANDIDATE", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
 
@@ -188,6 +188,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             "split_touching": a.split_touching,
             # how the candidate's heatmap was trained decides how its peaks are read
             "candidate_heatmap": None if a.weights is None else heatmap_of(a.weights),
+            # and whether it cuts touching fruit apart by its boundary class
+            "candidate_boundary": None if a.weights is None else boundary_of(a.weights),
             "results": results,
         }
         a.out.write_text(json.dumps(doc, indent=1) + "\n")
