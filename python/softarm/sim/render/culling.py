@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from softarm.checks import FloatArray
 
-__all__ = ["MARGIN_PX", "in_frustum"]
+__all__ = ["MARGIN_PX", "in_frustum", "swept_in_frustum"]
 
 #: Pixels added on every side of the picture before culling, so that a sphere grazing
 #: the border (and the rasteriser's half-pixel rules) is always drawn.
@@ -39,10 +39,44 @@ def in_frustum(
     ``principal`` (cx, cy) px. Conservative: a sphere that is kept may still cover no
     pixel, one that is left out covers none. A radius of 0 or less (MuJoCo's planes,
     unbounded) is always kept."""
-    x, y, depth = centres[:, 0], -centres[:, 1], -centres[:, 2]
-    r = radii
+    keep = np.ones(len(radii), bool)
+    for distance in _plane_distances(centres, size, focal, principal):
+        keep &= distance > -radii
+    result: npt.NDArray[np.bool_] = keep | (radii <= 0.0)
+    return result
+
+
+def swept_in_frustum(
+    starts: FloatArray,
+    ends: FloatArray,
+    radii: FloatArray,
+    size: tuple[int, int],
+    focal: float,
+    principal: tuple[float, float],
+) -> npt.NDArray[np.bool_]:
+    """Which spheres of ``radii`` (N,) swept from ``starts`` to ``ends`` (N, 3, MuJoCo's
+    camera frame) may reach the picture of :func:`in_frustum`. A point's distance to a
+    plane is linear along the sweep, so the sweep lies wholly outside a plane exactly
+    when both its ends do; conservative as :func:`in_frustum` (a sweep passing a corner
+    of the frustum may be kept)."""
+    keep = np.ones(len(radii), bool)
+    planes = zip(
+        _plane_distances(starts, size, focal, principal),
+        _plane_distances(ends, size, focal, principal),
+        strict=True,
+    )
+    for a, b in planes:
+        keep &= np.maximum(a, b) > -radii
+    return keep
+
+
+def _plane_distances(
+    points: FloatArray, size: tuple[int, int], focal: float, principal: tuple[float, float]
+) -> list[FloatArray]:
+    """Each of ``points``' (N, 3, camera frame) signed distances (m, inside positive)
+    to the picture's frustum's planes: the camera's own (depth), then its four sides."""
+    x, y, depth = points[:, 0], -points[:, 1], -points[:, 2]
     w, h = size
-    keep = depth > -r
     # Each side plane passes through the camera centre; its inward normal is
     # (±1, 0, ∓a) / sqrt(1 + a²) in (x, y-down, depth) for the bound x = a·depth.
     bounds = (
@@ -51,7 +85,4 @@ def in_frustum(
         (y, (-0.5 - MARGIN_PX - principal[1]) / focal, 1.0),
         (y, (h - 0.5 + MARGIN_PX - principal[1]) / focal, -1.0),
     )
-    for coord, a, side in bounds:
-        keep &= side * (coord - a * depth) / np.sqrt(1.0 + a * a) > -r
-    result: npt.NDArray[np.bool_] = keep | (radii <= 0.0)
-    return result
+    return [depth] + [side * (c - a * depth) / np.sqrt(1.0 + a * a) for c, a, side in bounds]

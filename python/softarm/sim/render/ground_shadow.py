@@ -21,11 +21,20 @@ import numpy as np
 
 from softarm.checks import FloatArray
 
-__all__ = ["CATEGORY_DECOR", "ground_casters", "leave_out_of_depth_pass"]
+__all__ = [
+    "CATEGORY_DECOR",
+    "GROUND_MIN_HALF",
+    "ground_casters",
+    "ground_height",
+    "leave_out_of_depth_pass",
+]
 
 #: MuJoCo's ``mjCAT_DECOR`` scene category: a geom of it casts no shadow (``mjr_render``
 #: leaves it out of the light's depth pass), and is drawn as any other in the others.
 CATEGORY_DECOR = 4
+#: A plane is the ground when it faces up from the world body and reaches at least this
+#: far (m) each way (0: MuJoCo's infinite plane): far beyond what a render culls.
+GROUND_MIN_HALF = 10.0
 
 
 def ground_casters(planes: np.ndarray, sun_travel: FloatArray | None) -> frozenset[int]:
@@ -35,6 +44,20 @@ def ground_casters(planes: np.ndarray, sun_travel: FloatArray | None) -> frozens
     if sun_travel is None or sun_travel[2] >= 0.0:
         return frozenset()
     return frozenset(int(g) for g in planes)
+
+
+def ground_height(model: Any, planes: np.ndarray) -> float | None:
+    """The height (m) of the lowest of ``model``'s ``planes`` that is the ground (see
+    GROUND_MIN_HALF); None without one. Seen from above it (the cameras are), nothing
+    below it shows."""
+    heights = [
+        float(model.geom_pos[g, 2])
+        for g in planes
+        if model.geom_bodyid[g] == 0
+        and np.allclose(model.geom_quat[g], (1.0, 0.0, 0.0, 0.0))
+        and all(h <= 0.0 or h >= GROUND_MIN_HALF for h in model.geom_size[g, :2])
+    ]
+    return min(heights) if heights else None
 
 
 def leave_out_of_depth_pass(scene: Any, geoms: frozenset[int], mj: Any) -> None:

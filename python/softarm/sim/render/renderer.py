@@ -29,7 +29,11 @@ from softarm.checks import FloatArray
 from softarm.errors import MissingDependencyError
 from softarm.sim.render.cane_mesh import merged_and_members
 from softarm.sim.render.culling import in_frustum
-from softarm.sim.render.ground_shadow import ground_casters, leave_out_of_depth_pass
+from softarm.sim.render.ground_shadow import (
+    ground_casters,
+    ground_height,
+    leave_out_of_depth_pass,
+)
 from softarm.sim.render.labels import KINDS, GeomLabels
 from softarm.sim.render.last_render import LastRender, scene_state
 from softarm.sim.render.mjcf import (
@@ -38,6 +42,7 @@ from softarm.sim.render.mjcf import (
     SceneSpec,
     scene_xml,
 )
+from softarm.sim.render.shadow_casters import shadow_casters
 from softarm.sim.render.shadow_map import (
     BACKDROP_RADIUS,
     LOCAL_MAX_PIXELS,
@@ -55,12 +60,6 @@ OCCLUDER_GROUP = 2
 #: The geom group a geom outside a render's frustum is moved to for that render: MuJoCo's
 #: default visualisation options, and those :meth:`BushRenderer.render` builds, hide it.
 CULLED_GROUP = 5
-#: Where the row's sun casts shadows, a geom is kept in a render when its bounding
-#: sphere, swept SHADOW_REACH m along the sunlight, meets the frustum: the sweep as
-#: spheres 2 * SHADOW_STEP apart, each grown by SHADOW_STEP (they cover it).
-SHADOW_REACH = 3.0
-SHADOW_STEP = 0.125
-SHADOW_STEPS = np.arange(SHADOW_STEP, SHADOW_REACH, 2 * SHADOW_STEP)
 #: The ground planes' grid pitch (m) in the small renders' context (C2, C1's windows,
 #: with the small shadow map). MuJoCo draws a plane as a grid of quads, made when the
 #: context is made, for the per-vertex light of spot and point lights; the row's lights
@@ -154,6 +153,7 @@ class BushRenderer:
         self._arm = np.flatnonzero(self.labels.kind == KINDS.index("arm"))
         self._backdrop = self.model.geom_rbound > BACKDROP_RADIUS
         self._planes = np.flatnonzero(self.model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
+        self._ground = ground_height(self.model, self._planes)
         self._backdrop[self._arm] = False
         self._merged, self._members = merged_and_members(self.model, self.labels)
         self._shadow_travel: FloatArray | None = None
@@ -338,10 +338,9 @@ class BushRenderer:
         if self._shadow_travel is not None:  # a caster out of the picture may shade it
             travel = self._shadow_travel @ d.cam_xmat[cam].reshape(3, 3)
             seen = shown.copy()
-            for t in SHADOW_STEPS:
-                shown |= in_frustum(
-                    centres + t * travel, radii + SHADOW_STEP, size, focal, principal
-                )
+            heights = d.geom_xpos[self._cullable, 2]
+            shown |= shadow_casters(centres, heights, radii, travel, self._shadow_travel[2],
+                                    self._ground, (size, focal, principal))  # fmt: skip
             if local and self._sun is not None:  # a caster kept for its shadow alone
                 # must reach into the small map
                 shown &= seen | self._sun.in_map(d, d.geom_xpos[self._cullable], radii)
