@@ -197,3 +197,21 @@ def test_roi_metering_of_a_render_at_part_of_the_light_is_for_the_scene() -> Non
 def test_roi_metering_refuses_a_scale_outside_0_1(scale: float) -> None:
     with pytest.raises(ParameterError, match="scale"):
         CameraEffects().roi_exposure_of(_flat(10), scale)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_read_out_is_its_formula_value_for_value(dtype: type) -> None:
+    """The read-out works in place; its values are the formula's written out in full,
+    with the same draws (OpenCV's generator seeded from ``rng``)."""
+    import cv2
+
+    effects = CameraEffects(gain=0.7, read_noise=2.5, black_level=3.0, full_well=240.0)
+    light: np.ndarray = np.random.default_rng(3).uniform(-20, 300, (50, 70, 3)).astype(dtype)
+    out = np.maximum(light, 0.0)
+    std = np.sqrt(0.7 * out + 2.5**2)
+    noise = np.empty(light.shape, np.float32)
+    cv2.setRNGSeed(int(np.random.default_rng(4).integers(2**31)))
+    cv2.randn(noise.reshape(50, -1), 0.0, 1.0)  # type: ignore[call-overload]
+    expected = ((np.clip(out + std * noise - 3.0, 0.0, 240.0)) + np.float32(0.5)).astype(np.uint8)
+    got = effects.sensor(light.copy(), np.random.default_rng(4))
+    np.testing.assert_array_equal(got, expected)

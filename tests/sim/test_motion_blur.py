@@ -229,3 +229,16 @@ def test_an_arm_drawn_with_another_body_is_no_step_for_c1() -> None:
 def test_a_sweep_far_outside_the_frame_paints_nothing() -> None:
     flow = swept_flow(SIZE, np.array([[1e12, 5.0]]), np.array([[1e9, 0.0]]), np.array([2.0]), 0.01)
     assert not flow.any()
+
+
+def test_a_windows_swept_flow_is_the_whole_frames_there() -> None:
+    """Parts whose sweep misses a window are skipped; what the window holds is the
+    whole frame's flow at its pixels, parts reaching in from outside included."""
+    rng = np.random.default_rng(7)
+    centres = rng.uniform(-40, 360, (40, 2))
+    velocities = rng.normal(0, 1500, (40, 2))
+    radii = rng.uniform(0.5, 12, 40)
+    whole = swept_flow((400, 400), centres + 20, velocities, radii, 0.01)
+    for x0, y0 in ((20, 20), (100, 60), (250, 200), (280, 290)):
+        window = swept_flow((64, 48), centres, velocities, radii, 0.01, (x0 - 20, y0 - 20))
+        np.testing.assert_array_equal(window, whole[y0 : y0 + 48, x0 : x0 + 64])

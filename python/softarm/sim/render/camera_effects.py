@@ -205,18 +205,26 @@ class CameraEffects:
         """The read-out of ``light`` (DN, float): shot and read noise, black level,
         clipping at 0 and ``full_well``, rounding to 8 bits."""
         out = np.maximum(light, 0.0)
+        dt = out.dtype.type  # the scalars as the arithmetic would cast them
         if self.gain or self.read_noise:
-            std = np.sqrt(self.gain * out + self.read_noise**2)
+            # In place, each step the same float32 operation as written out in full
+            # (std = sqrt(gain * out + read_noise**2); out += std * noise): the same
+            # values without four frame-sized temporaries.
+            std = np.multiply(out, dt(self.gain))
+            std += dt(self.read_noise**2)
+            np.sqrt(std, out=std)
             noise = np.empty(light.shape, np.float32)
             # OpenCV's generator is several times faster than numpy's on a full frame;
             # it is seeded from ``rng``, so the frame stays a function of the seed.
             cv2.setRNGSeed(int(rng.integers(2**31)))
             cv2.randn(noise.reshape(light.shape[0], -1), 0.0, 1.0)  # type: ignore[call-overload]
-            out += std * noise
+            std *= noise
+            out += std
         if self.black_level:
             out -= np.float32(self.black_level)
         np.clip(out, 0.0, self.full_well, out=out)
-        result: npt.NDArray[np.uint8] = (out + np.float32(0.5)).astype(np.uint8)
+        out += np.float32(0.5)
+        result: npt.NDArray[np.uint8] = out.astype(np.uint8)
         return result
 
 

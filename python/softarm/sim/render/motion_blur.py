@@ -136,16 +136,24 @@ def swept_flow(
     Later parts paint over earlier ones (list the fast end last)."""
     w, h = size
     flow = np.zeros((h, w, 2), np.float32)
-    for c, vel, r in zip(centres, velocities, radii, strict=True):
-        half = 0.5 * exposure_s * np.asarray(vel, float)
-        if not np.all(np.isfinite(np.append(c, half))) or float(np.hypot(*half)) < 0.5:
-            continue  # not drawn, or sweeping under a pixel
+    c = np.asarray(centres, float).reshape(-1, 2)
+    vel = np.asarray(velocities, float).reshape(-1, 2)
+    half = 0.5 * exposure_s * vel
+    ok = np.isfinite(c).all(axis=1) & np.isfinite(half).all(axis=1)
+    ok &= np.hypot(half[:, 0], half[:, 1]) >= 0.5  # else not drawn, or under a pixel
+    with np.errstate(invalid="ignore"):
         # Clipped far outside the frame: cv2.line takes 32-bit coordinates.
-        a = np.clip(np.round(c - half - origin), -1e6, 1e6).astype(int)
-        b = np.clip(np.round(c + half - origin), -1e6, 1e6).astype(int)
-        thick = max(1, round(2 * float(r)) + 1)
-        cv2.line(flow, (int(a[0]), int(a[1])), (int(b[0]), int(b[1])),
-                 (float(vel[0]), float(vel[1])), thick)  # fmt: skip
+        a = np.clip(np.round(c - half - origin), -1e6, 1e6)
+        b = np.clip(np.round(c + half - origin), -1e6, 1e6)
+    thick = np.maximum(1, np.round(2 * np.asarray(radii, float)) + 1)
+    # A band wholly off the frame paints nothing: skipped (a window sees few parts).
+    reach = thick / 2 + 2
+    ok &= np.isfinite(thick)
+    ok &= (np.minimum(a[:, 0], b[:, 0]) - reach < w) & (np.maximum(a[:, 0], b[:, 0]) + reach >= 0)
+    ok &= (np.minimum(a[:, 1], b[:, 1]) - reach < h) & (np.maximum(a[:, 1], b[:, 1]) + reach >= 0)
+    for i in np.flatnonzero(ok):
+        cv2.line(flow, (int(a[i, 0]), int(a[i, 1])), (int(b[i, 0]), int(b[i, 1])),
+                 (float(vel[i, 0]), float(vel[i, 1])), int(thick[i]))  # fmt: skip
     return flow
 
 
