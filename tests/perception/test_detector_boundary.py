@@ -90,7 +90,9 @@ def test_a_boundary_line_cuts_two_touching_fruit_apart() -> None:
     )
 
 
-def test_parts_give_the_boundary_back_and_keep_a_coreless_blob() -> None:
+def test_parts_give_the_boundary_back_and_keep_a_coreless_blob(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     binary = (disc(40, 50, 9) | disc(57, 50, 9) | disc(120, 50, 3)).astype(np.uint8)
     boundary = np.zeros((H, W), np.float32)
     boundary[:, 47:51] = 0.9
@@ -102,6 +104,12 @@ def test_parts_give_the_boundary_back_and_keep_a_coreless_blob() -> None:
         int(np.count_nonzero(labels == k)) for k in range(1, n)
     )
     assert len({int(v) for v in labels[50, 31:66]}) == 2
+    speck = boundary.copy()
+    speck[48:54, 30:47] = 0.9
+    speck[50:52, 35:37] = 0.0  # a piece of 2 x 2 px inside the band: no fruit of its own
+    assert fruit_parts(binary, speck)[0] == 4
+    monkeypatch.setattr("softarm.perception.detector.boundary.MIN_CORE", 1)
+    assert fruit_parts(binary, speck)[0] == 5
     plain = fruit_parts(binary, None)
     assert plain[0] == 3
     none_marked = fruit_parts(binary, np.zeros((H, W), np.float32))

@@ -6,8 +6,10 @@ about two of its pixels on each side of the contact). The fruit pixels it marks
 split into connected parts, so that a cluster the fruit mask draws as one blob falls
 apart at its contacts; each removed pixel is then given back to the nearest remaining
 part of its own blob, so that every fruit keeps its whole outline (its size and
-position). A blob that is boundary all through (a small fruit squeezed between others)
-stays one part, as without the class.
+position). A piece left between the marked pixels smaller than MIN_CORE is no fruit of
+its own (a speck the class's band did not quite cover) and is given back in the same
+way; a blob with no piece that large (a small fruit squeezed between others) stays one
+part, as without the class.
 """
 
 from __future__ import annotations
@@ -19,10 +21,13 @@ import numpy as np
 import numpy.typing as npt
 from scipy import ndimage
 
-__all__ = ["BOUNDARY_THRESHOLD", "fruit_parts"]
+__all__ = ["BOUNDARY_THRESHOLD", "MIN_CORE", "fruit_parts"]
 
 #: A fruit pixel is boundary where the network gives it more than this.
 BOUNDARY_THRESHOLD = 0.5
+#: Fewest pixels of a piece left between boundary pixels that is a fruit of its own (the
+#: detector's least instance, ``instances.MIN_PIXELS``).
+MIN_CORE = 6
 _U8 = npt.NDArray[np.uint8]
 _I32 = npt.NDArray[np.int32]
 Parts = tuple[int, _I32, _I32]
@@ -42,7 +47,12 @@ def fruit_parts(binary: _U8, boundary: npt.NDArray[np.float32] | None) -> Parts:
     if not removed.any():
         return n, cast(_I32, labels), cast(_I32, stats)
     core = cast(_U8, ((binary > 0) & ~removed).astype(np.uint8))
-    m, cores = cv2.connectedComponents(core, connectivity=8)
+    m, cores, core_stats, _ = cv2.connectedComponentsWithStats(core, connectivity=8)
+    specks = np.flatnonzero(core_stats[1:, 4] < MIN_CORE) + 1
+    if specks.size:  # given back as boundary pixels are
+        core[np.isin(cores, specks)] = 0
+        removed = (binary > 0) & (core == 0)
+        m, cores = cv2.connectedComponents(core, connectivity=8)
     # Blobs without any core pixel stay whole, with labels after the cores'.
     coreless = np.setdiff1d(np.unique(labels[removed]), np.unique(labels[core > 0]))
     parts = cores.astype(np.int32)
