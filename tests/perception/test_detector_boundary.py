@@ -105,7 +105,7 @@ def test_parts_give_the_boundary_back_and_keep_a_coreless_blob(
     )
     assert len({int(v) for v in labels[50, 31:66]}) == 2
     speck = boundary.copy()
-    speck[48:54, 30:47] = 0.9
+    speck[48:54, 33:39] = 0.9  # a ring of boundary inside the left fruit
     speck[50:52, 35:37] = 0.0  # a piece of 2 x 2 px inside the band: no fruit of its own
     assert fruit_parts(binary, speck)[0] == 4
     monkeypatch.setattr("softarm.perception.detector.boundary.MIN_CORE", 1)
