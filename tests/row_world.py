@@ -32,3 +32,15 @@ def sunlit_row_world() -> Any:
     q = np.asarray(bush.berries[0].q) * 0.9
     world.set_arm(arm_sections(arm, q), arm.forward(q))
     return world
+
+
+def stepped_casters(centres, heights, radii, travel, drop, ground, view):  # type: ignore[no-untyped-def]
+    """The shadow casters' sweep as it was before softarm.sim.render.shadow_casters:
+    spheres 0.25 m apart along 3 m of sunlight, each grown by 0.125 m, the ground not
+    counted (the reference its tests and benchmark compare with)."""
+    from softarm.sim.render.culling import in_frustum
+
+    kept = np.zeros(len(radii), bool)
+    for t in np.arange(0.125, 3.0, 0.25):
+        kept |= in_frustum(centres + t * travel, radii + 0.125, *view)
+    return kept

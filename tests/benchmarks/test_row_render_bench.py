@@ -137,3 +137,18 @@ def test_row_small_render_ground_casting(benchmark, row: Any, view: str) -> None
     finally:
         renderer._no_shadow = kept
     assert image.ndim == 3
+
+
+@pytest.mark.parametrize("view", ["c2", "c1_window"])
+def test_row_small_render_stepped_casters(benchmark, row: Any, view: str) -> None:  # type: ignore[no-untyped-def]
+    from row_world import stepped_casters
+    from softarm.sim.render import renderer
+
+    module: Any = renderer  # its shadow_casters swapped for the sweep as spheres
+    chosen = module.shadow_casters
+    module.shadow_casters = stepped_casters
+    try:
+        image = _timed(benchmark, row, view)
+    finally:
+        module.shadow_casters = chosen
+    assert image.ndim == 3

@@ -51,21 +51,11 @@ def test_a_geom_beside_the_picture_whose_shadow_goes_away_from_it_is_left_out() 
     assert not kept[0]
 
 
-def _stepped(centres, heights, radii, travel, drop, ground, view):  # type: ignore[no-untyped-def]
-    """The sweep as it was: spheres 0.25 m apart along 3 m, each grown by 0.125 m."""
-    from softarm.sim.render.culling import in_frustum
-
-    kept = np.zeros(len(radii), bool)
-    for t in np.arange(0.125, 3.0, 0.25):
-        kept |= in_frustum(centres + t * travel, radii + 0.125, *view)
-    return kept
-
-
 def test_the_row_renders_the_same_with_fewer_shadow_casters() -> None:
     """The sunlit row (seed 4, the arm reaching for a berry): C2's frame, two C1
     windows and C1's whole left eye are the same pixel for pixel as with every geom
     drawn, and fewer geoms are drawn than with the sweep as spheres."""
-    from row_world import sunlit_row_world
+    from row_world import stepped_casters, sunlit_row_world
     from softarm.sim.render import renderer
 
     module: Any = renderer  # its shadow_casters swapped for the reference sweeps
@@ -94,7 +84,7 @@ def test_the_row_renders_the_same_with_fewer_shadow_casters() -> None:
         r._renderer = spy
         swept, counts = draws(chosen)
         every, _ = draws(lambda centres, *rest: np.ones(len(centres), bool))
-        _, stepped = draws(_stepped)
+        _, stepped = draws(stepped_casters)
         for a, b in zip(swept, every, strict=True):
             np.testing.assert_array_equal(a, b)
         assert sum(counts[:3]) < 0.8 * sum(stepped[:3])  # the small renders
