@@ -3,6 +3,8 @@ together) split into connected parts; a part with two or more peaks of the centr
 heatmap (fruit that touch) is split between them, each pixel going to its nearest peak
 (the peaks found by the rule of the heatmap's kind, :data:`PEAK_RULES`; or, with
 ``DetectorSettings.split_touching``, at the necks of the part's shape: :mod:`.touching`);
+the pieces of one fruit that a heatmap's split leaves are joined again and small weak
+specks dropped, by the rule of the heatmap's kind (:mod:`.fragments`: the focal one's);
 each instance's stage is the stage most of its pixels' probability says. Everything
 runs at the network's resolution; each instance's mask is then resized to the image,
 and placed and sized as :mod:`softarm.perception.berries` places and sizes its blobs."""
@@ -25,6 +27,12 @@ from softarm.perception.berries import (
 )
 from softarm.perception.detector.boundary import fruit_parts
 from softarm.perception.detector.depth_check import rejection
+from softarm.perception.detector.fragments import (
+    FRAGMENT_RULES,
+    FragmentRule,
+    merge_fragments,
+    speck,
+)
 from softarm.perception.detector.network import NetworkOutput
 from softarm.perception.detector.touching import disc_seeds, split_discs
 from softarm.vision.camera_model import CameraModel
@@ -119,16 +127,22 @@ def _split(
 
 
 def _pieces(
-    part: npt.NDArray[np.bool_], centres: npt.NDArray[np.float32], split: bool, rule: PeakRule
+    part: npt.NDArray[np.bool_],
+    centres: npt.NDArray[np.float32],
+    split: bool,
+    rule: PeakRule,
+    fragments: FragmentRule | None = None,
 ) -> list[npt.NDArray[np.bool_]]:
     """``part`` as one mask per fruit: at the necks of its distance map (``split``,
-    :mod:`.touching`), else at its centre heatmap's peaks (of ``rule``)."""
+    :mod:`.touching`), else at its centre heatmap's peaks (of ``rule``), the pieces that
+    ``fragments`` calls one fruit joined again (:mod:`.fragments`)."""
     if split:
         # Too few pixels for two fruit of the least radius: one fruit, no distance map.
         if np.count_nonzero(part) < 2 * np.pi * SEED_RADIUS**2:
             return [part]
         return split_discs(part, disc_seeds(part, SEED_RADIUS))
-    return _split(part, _peaks(centres, part, rule))
+    peaks = _peaks(centres, part, rule)
+    return merge_fragments(_split(part, peaks), peaks, centres, fragments)
 
 
 #: An instance at the network's resolution: its mask over its window, and the window's
@@ -143,6 +157,7 @@ def instance_masks(
     that touch split at the necks of their part's distance map (``split``) or at the
     centre heatmap's peaks."""
     rule = PEAK_RULES[output.heatmap]
+    fragments = FRAGMENT_RULES.get(output.heatmap)
     binary = cast(_U8, (fruit > FRUIT_THRESHOLD).astype(np.uint8))
     binary = cast(_U8, cv2.morphologyEx(binary, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)))
     # A network with the boundary class cuts touching fruit apart first (.boundary).
@@ -153,8 +168,9 @@ def instance_masks(
         if area < MIN_PIXELS:
             continue
         part = labels[y : y + h, x : x + w] == k
-        for piece in _pieces(part, output.centres[y : y + h, x : x + w], split, rule):
-            if np.count_nonzero(piece) >= MIN_PIXELS:
+        centres = output.centres[y : y + h, x : x + w]
+        for piece in _pieces(part, centres, split, rule, fragments):
+            if np.count_nonzero(piece) >= MIN_PIXELS and not speck(piece, centres, fragments):
                 out.append((piece, x, y))
     return out
 
