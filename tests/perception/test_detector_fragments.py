@@ -5,18 +5,26 @@ heatmap's decoding is unchanged."""
 
 from __future__ import annotations
 
-import numpy as np
-from detector_scenes import H, W, disc
+import json
+import shutil
+from dataclasses import asdict
+from pathlib import Path
 
+import numpy as np
+import pytest
+from detector_scenes import H, W, disc, write_folder
+
+from softarm.experiments.detector_eval import main
 from softarm.perception.berries import DetectorSettings
 from softarm.perception.detector.fragments import (
     FRAGMENT_RULES,
     FragmentRule,
     merge_fragments,
     speck,
+    without_rules,
 )
 from softarm.perception.detector.instances import instances
-from softarm.perception.detector.network import CLASSES, NetworkOutput
+from softarm.perception.detector.network import CLASSES, DEFAULT_WEIGHTS, NetworkOutput
 from softarm.perception.detector.touching import split_discs
 from softarm.vision.camera_model import CameraModel
 
@@ -116,3 +124,27 @@ def test_a_rule_without_a_saddle_or_a_speck_size_changes_nothing() -> None:
     rule = FragmentRule(saddle=None)
     assert len(merge_fragments(pieces, peaks, centres, rule)) == 2
     assert not speck(disc(30, 30, 2), np.zeros((H, W), np.float32), rule)
+
+
+def test_without_rules_restores_the_rules_even_after_an_error() -> None:
+    before = dict(FRAGMENT_RULES)
+    with pytest.raises(RuntimeError), without_rules():
+        assert FRAGMENT_RULES == {}
+        raise RuntimeError("inside")
+    assert FRAGMENT_RULES == before
+
+
+def test_the_harness_scores_the_candidate_with_and_without_the_rule(tmp_path: Path) -> None:
+    weights = tmp_path / "focal.onnx"
+    shutil.copy(DEFAULT_WEIGHTS, weights)
+    weights.with_suffix(".json").write_text(json.dumps({"heatmap": "focal"}))
+    scene = [("ripe", disc(50, 60, 9), True), ("unripe", disc(110, 60, 9), True)]
+    folder = tmp_path / "scenes"
+    write_folder(folder, [scene])
+    out = tmp_path / "eval.json"
+    main([f"drawn={folder}", "--weights", str(weights), "--raw-candidate", "--out", str(out)])
+    doc = json.loads(out.read_text())
+    rows = doc["results"]["drawn"]
+    assert {"cand", "cand+colour+depth", "cand-raw", "cand-raw+colour+depth"} <= set(rows)
+    assert doc["candidate_fragment_rule"] == asdict(FRAGMENT_RULES["focal"])
+    assert FRAGMENT_RULES["focal"] == FOCAL  # the rule is back after the raw rows

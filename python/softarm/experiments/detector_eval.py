@@ -12,7 +12,10 @@ learned detector").
 Each NAME=FOLDER is one condition (a look of the row, held out or not, the bush); the
 time per image is the detector's alone (one OpenCV thread, median over the folder).
 ``--split-touching`` runs every detector with touching fruit split at the necks of their
-distance map (:data:`SPLIT`; docs/data/detector_eval_touching.json)."""
+distance map (:data:`SPLIT`; docs/data/detector_eval_touching.json). ``--raw-candidate``
+adds the candidate decoded without its heatmap's fragment rule
+(:mod:`softarm.perception.detector.fragments`) beside it
+(docs/data/detector_eval_fragments*.json)."""
 
 from __future__ import annotations
 
@@ -20,6 +23,7 @@ import argparse
 import json
 import time
 from collections.abc import Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -29,11 +33,12 @@ import numpy as np
 from softarm.perception.berries import DetectorSettings
 from softarm.perception.detector.choice import DETECTORS, BerryDetector, detector
 from softarm.perception.detector.evaluate import evaluate
+from softarm.perception.detector.fragments import FRAGMENT_RULES, without_rules
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 from softarm.perception.detector.misses import fruit_cases, miss_table
 from softarm.perception.detector.network import STRIDE, boundary_of, heatmap_of
 
-__all__ = ["CANDIDATE", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
+__all__ = ["CANDIDATE", "RAW", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
 
 _SHOWN = ("precision", "ripe_precision", "recall_ripe", "recall", "stage_right")
 
@@ -94,26 +99,47 @@ def candidates(
 SPLIT = DetectorSettings(split_touching=True, split_colour_blobs=True)
 
 
+#: The prefix of the candidate's rows decoded without its heatmap's fragment rule
+#: (``--raw-candidate``: :func:`softarm.perception.detector.fragments.without_rules`).
+RAW = "cand-raw"
+
+
+def _figures(
+    det: BerryDetector, folder: Path, with_depth: bool, settings: DetectorSettings | None
+) -> dict[str, Any]:
+    timed = _Timed(det, settings)
+    depth = folder / "depth" if with_depth else None
+    figures = evaluate(timed, folder / "annotations.json", folder, depth)
+    figures.pop("per_image")
+    figures["ms_per_image"] = round(1000.0 * float(np.median(timed.seconds)), 1)
+    return figures
+
+
 def run(
     conditions: dict[str, Path],
     weights: Path | None = None,
     max_side: int | None = None,
     settings: DetectorSettings | None = None,
+    raw: bool = False,
 ) -> dict[str, Any]:
     """{condition: {candidate: figures}} with ``ms_per_image``; a ``+depth`` candidate
     reads each folder's ``depth/``; every detector run with ``settings`` (None: the
-    default)."""
+    default); with ``raw`` and ``weights``, the candidate alone and with both checks
+    also without the fragment rule (rows :data:`RAW` and ``RAW+colour+depth``)."""
     cv2.setNumThreads(1)
     out: dict[str, Any] = {}
     for name, folder in conditions.items():
-        out[name] = {}
-        for cand, (det, with_depth) in candidates(weights, max_side).items():
-            timed = _Timed(det, settings)
-            depth = folder / "depth" if with_depth else None
-            figures = evaluate(timed, folder / "annotations.json", folder, depth)
-            figures.pop("per_image")
-            figures["ms_per_image"] = round(1000.0 * float(np.median(timed.seconds)), 1)
-            out[name][cand] = figures
+        dets = candidates(weights, max_side)
+        out[name] = {
+            cand: _figures(det, folder, with_depth, settings)
+            for cand, (det, with_depth) in dets.items()
+        }
+        if raw and weights is not None:
+            with without_rules():
+                for cand in (CANDIDATE, f"{CANDIDATE}+colour+depth"):
+                    det, with_depth = dets[cand]
+                    row = RAW + cand[len(CANDIDATE) :]
+                    out[name][row] = _figures(det, folder, with_depth, settings)
     return out
 
 
@@ -138,6 +164,11 @@ def table(results: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _rule(weights: Path) -> dict[str, Any] | None:
+    rule = FRAGMENT_RULES.get(heatmap_of(weights))
+    return None if rule is None else asdict(rule)
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     """python -m softarm.experiments.detector_eval NAME=FOLDER ... [--weights W
     [--max-side N]] [--out F | --misses]."""
@@ -155,6 +186,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         "--split-touching", action="store_true",
         help="split touching fruit at the necks of their distance map (the network's "
         "instances and the colour rule's ripe blobs), not the default",
+    )  # fmt: skip
+    p.add_argument(
+        "--raw-candidate", action="store_true",
+        help="also score the candidate (alone and with both checks) without its heatmap's "
+        f"fragment rule, as {RAW} rows",
     )  # fmt: skip
     p.add_argument("--note", default="", help="a line stored with the figures")
     p.add_argument("--out", type=Path, help="JSON file for the figures")
@@ -179,7 +215,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         cv2.setNumThreads(1)
         print(miss_table([c for f in conditions.values() for c in fruit_cases(net, f)]))
         return
-    results = run(conditions, a.weights, a.max_side, settings)
+    results = run(conditions, a.weights, a.max_side, settings, a.raw_candidate)
     print(table(results))
     if a.out is not None:
         doc = {
@@ -188,6 +224,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             "split_touching": a.split_touching,
             # how the candidate's heatmap was trained decides how its peaks are read
             "candidate_heatmap": None if a.weights is None else heatmap_of(a.weights),
+            # and the rule that tells its fragments from fruit (None: it has none)
+            "candidate_fragment_rule": None if a.weights is None else _rule(a.weights),
             # and whether it cuts touching fruit apart by its boundary class
             "candidate_boundary": None if a.weights is None else boundary_of(a.weights),
             "results": results,
