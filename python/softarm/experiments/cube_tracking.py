@@ -18,6 +18,8 @@ windows instead (the harvest's window before it was fitted to the cube), for
 comparison on the same poses. ``--look L`` measures it in the daylight row
 (``--world row``) with the look family L. ``--marker-body B`` tracks (and draws) the
 marker body B instead of the paper's cube (:mod:`softarm.vision.marker_body`);
+``--without noise jpeg blur`` (any of them) renders the row's windows with those
+parts of the camera model off, to tell which of them the error comes from;
 ``--by-angle`` prints the figures by approach angle as well (:data:`ANGLE_BINS`: the
 angle between C1's line of sight and the paper cube's best-facing tag, whichever body
 is drawn), ``--json FILE`` writes them all, ``--into FILE`` puts them into FILE with
@@ -45,7 +47,7 @@ from softarm.experiments.cube_tracking_table import merge_into
 from softarm.sim.render.row_look import LOOKS
 from softarm.vision.marker_body import MARKER_BODIES
 
-__all__ = ["ANGLE_BINS", "by_angle", "track_cubes"]
+__all__ = ["ANGLE_BINS", "CAMERA_PARTS", "by_angle", "track_cubes", "without_parts"]
 
 #: The cube is in full view when this share of its faces' pixels is not hidden.
 UNHIDDEN = 0.99
@@ -53,6 +55,13 @@ UNHIDDEN = 0.99
 #: the normal of the paper cube's best-facing side tag at the true pose (the same for
 #: every body: it says where the arm is, not what it carries).
 ANGLE_BINS = (0.0, 40.0, 50.0, 60.0, 70.0, 90.0)
+#: Parts of the row's camera model ``--without`` turns off, as the settings of C1's
+#: :class:`~softarm.sim.render.camera_effects.CameraEffects` that make them.
+CAMERA_PARTS: dict[str, dict[str, Any]] = {
+    "noise": {"gain": 0.0, "read_noise": 0.0},
+    "jpeg": {"jpeg_quality": None},
+    "blur": {"exposure_s": 0.0},
+}
 
 
 @dataclass(frozen=True)
@@ -73,13 +82,15 @@ def track_cubes(
     side: int | None = None,
     look: str | None = None,
     body: str = "cube",
+    without: tuple[str, ...] = (),
 ) -> dict[str, Any]:
     """Position errors (mm) of the marker body ``body`` tracked in C1 over ``poses`` arm
     poses per seed, the share of poses where it was found, the mean time (ms) to render
     a window (its renderer made; the harvest makes one per size once) and its mean side
     (px); ``look``: in the daylight row with that look family (``--world row``), drawn
-    from each seed. ``"by_angle"`` holds the same by approach angle (:func:`by_angle`)."""
-    found, seconds, sides = _tracked(seeds, poses, side, look, body)
+    from each seed, with the camera model's parts ``without`` (:data:`CAMERA_PARTS`) off.
+    ``"by_angle"`` holds the same by approach angle (:func:`by_angle`)."""
+    found, seconds, sides = _tracked(seeds, poses, side, look, body, without)
     errors = [p.error for p in found if p.error is not None]
     unhidden = [p.error for p in found if p.error is not None and p.share >= UNHIDDEN]
     hidden = [p.error for p in found if p.error is not None and p.share < UNHIDDEN]
@@ -120,8 +131,36 @@ def by_angle(found: list[Pose]) -> list[dict[str, Any]]:
     return out
 
 
+def without_parts(look: Any, parts: Iterable[str]) -> Any:
+    """The row look ``look`` (:class:`~softarm.sim.render.row_look.RowLook`) with C1's
+    camera model's ``parts`` (names of :data:`CAMERA_PARTS`) off; the same look for none.
+
+    Raises:
+        ParameterError: a part that is not one of CAMERA_PARTS.
+    """
+    from dataclasses import replace
+
+    from softarm.errors import ParameterError
+
+    settings: dict[str, Any] = {}
+    for part in parts:
+        if part not in CAMERA_PARTS:
+            raise ParameterError(f"without: {part!r} is none of {', '.join(CAMERA_PARTS)}")
+        settings.update(CAMERA_PARTS[part])
+    if not settings:
+        return look
+    stereo = replace(look.stereo, left=replace(look.stereo.left, **settings))
+    blur = 0.0 if "blur" in parts else look.blur_px_s
+    return replace(look, stereo=stereo, blur_px_s=blur)
+
+
 def _tracked(
-    seeds: Iterable[int], poses: int, side: int | None, look: str | None, body: str
+    seeds: Iterable[int],
+    poses: int,
+    side: int | None,
+    look: str | None,
+    body: str,
+    without: tuple[str, ...] = (),
 ) -> tuple[list[Pose], float, list[int]]:
     """Every pose tracked, the seconds spent rendering windows and the windows' sides."""
     import softarm
@@ -146,7 +185,7 @@ def _tracked(
     seconds = 0.0
     for seed in seeds:
         bush = Bush.generate(arm, 8, seed, view_point=cams.T_base_c1[:3, 3])
-        row = None if look is None else RowLook.named(look, seed)
+        row = None if look is None else without_parts(RowLook.named(look, seed), without)
         world = world_for(bush, cams, BASE_TAG_ID, look=row)
         faces = [g for g in range(world.renderer.model.ngeom) if _is_cube_face(world, g)]
         rng = np.random.default_rng(seed)
@@ -208,10 +247,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--look", choices=LOOKS, help="in the daylight row with this look")
     p.add_argument("--marker-body", choices=MARKER_BODIES, default="cube", help="the body tracked")
     p.add_argument("--by-angle", action="store_true", help="also by approach angle")
+    p.add_argument(
+        "--without", nargs="+", choices=tuple(CAMERA_PARTS), default=(),
+        help="the row's camera model without these parts",
+    )  # fmt: skip
     p.add_argument("--json", metavar="FILE", help="write the figures as JSON to FILE")
     p.add_argument("--into", metavar="FILE", help="put the figures into the JSON file FILE")
     args = p.parse_args(argv)
-    result = track_cubes(args.seeds, args.poses, args.side, args.look, args.marker_body)
+    without = tuple(args.without)
+    result = track_cubes(args.seeds, args.poses, args.side, args.look, args.marker_body, without)
+    if without:
+        result["without"] = list(without)
     if args.into:
         merge_into(Path(args.into), {"seeds": args.seeds, "look": args.look, **result})
     print(_line({k: v for k, v in result.items() if k != "by_angle"}))
