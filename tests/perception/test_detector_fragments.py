@@ -1,7 +1,7 @@
 """Fragments after the focal heatmap's split (softarm.perception.detector.fragments): one
 fruit with two peaks joined by the heatmap is merged back, two touching fruit whose
-heatmap falls between them stay two, a small weak speck is dropped, and the logistic
-heatmap's decoding is unchanged."""
+heatmap falls between them stay two, a small weak speck is dropped, a small core grows
+into the rim the network half saw, and the logistic heatmap's decoding is unchanged."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ from softarm.perception.berries import DetectorSettings
 from softarm.perception.detector.fragments import (
     FRAGMENT_RULES,
     FragmentRule,
+    grown,
     merge_fragments,
     speck,
     without_rules,
@@ -148,3 +149,29 @@ def test_the_harness_scores_the_candidate_with_and_without_the_rule(tmp_path: Pa
     assert {"cand", "cand+colour+depth", "cand-raw", "cand-raw+colour+depth"} <= set(rows)
     assert doc["candidate_fragment_rule"] == asdict(FRAGMENT_RULES["focal"])
     assert FRAGMENT_RULES["focal"] == FOCAL  # the rule is back after the raw rows
+
+
+def test_a_small_core_grows_into_the_fruit_rim_the_network_half_saw() -> None:
+    core, whole = disc(30, 30, 2), disc(30, 30, 4)  # 13 px over 0.5; the rim at 0.4
+    assert int(core.sum()) < FOCAL.grow_pixels and FOCAL.grow_low <= 0.4
+    fruit = np.where(core, 0.9, np.where(whole, 0.4, 0.0)).astype(np.float32)
+    taken = fruit > 0.5
+    piece, x, y = grown(core[26:35, 26:35], 26, 26, fruit, taken, FOCAL)
+    full = np.zeros((H, W), bool)
+    full[y : y + piece.shape[0], x : x + piece.shape[1]] = piece
+    assert np.array_equal(full, whole)  # the rim is 2 px: all of it, nothing beyond
+    # no rule, or a piece of the growth size or more: unchanged
+    assert grown(core[26:35, 26:35], 26, 26, fruit, taken, None)[0].sum() == core.sum()
+    big = disc(30, 30, 4)[24:37, 24:37]
+    assert int(big.sum()) >= FOCAL.grow_pixels
+    assert grown(big, 24, 24, fruit, taken, FOCAL)[0] is big
+
+
+def test_a_small_core_does_not_grow_into_another_fruit() -> None:
+    core, rim = disc(30, 30, 2), disc(30, 30, 4)
+    other = disc(36, 30, 3)  # another part's pixels, over the threshold, in the rim's way
+    fruit = np.where(core | other, 0.9, np.where(rim, 0.4, 0.0)).astype(np.float32)
+    piece, x, y = grown(core[26:35, 26:35], 26, 26, fruit, fruit > 0.5, FOCAL)
+    full = np.zeros((H, W), bool)
+    full[y : y + piece.shape[0], x : x + piece.shape[1]] = piece
+    assert not (full & other).any() and (full & rim & ~core).any()

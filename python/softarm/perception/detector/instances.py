@@ -30,6 +30,7 @@ from softarm.perception.detector.depth_check import rejection
 from softarm.perception.detector.fragments import (
     FRAGMENT_RULES,
     FragmentRule,
+    grown,
     merge_fragments,
     speck,
 )
@@ -160,6 +161,7 @@ def instance_masks(
     fragments = FRAGMENT_RULES.get(output.heatmap)
     binary = cast(_U8, (fruit > FRUIT_THRESHOLD).astype(np.uint8))
     binary = cast(_U8, cv2.morphologyEx(binary, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8)))
+    taken = binary > 0  # what a small piece may not grow into (.fragments.grown)
     # A network with the boundary class cuts touching fruit apart first (.boundary).
     n, labels, stats = fruit_parts(binary, output.boundary)
     out = []
@@ -171,7 +173,7 @@ def instance_masks(
         centres = output.centres[y : y + h, x : x + w]
         for piece in _pieces(part, centres, split, rule, fragments):
             if np.count_nonzero(piece) >= MIN_PIXELS and not speck(piece, centres, fragments):
-                out.append((piece, x, y))
+                out.append(grown(piece, x, y, fruit, taken, fragments))
     return out
 
 
