@@ -77,6 +77,31 @@ def test_the_crossing_from_the_baseline_middle_is_the_harvests() -> None:
     assert left is not None and np.linalg.norm(left - harvest) > 1e-4
 
 
+def test_the_weighed_crossing_is_the_harvests() -> None:
+    # With the rays' spreads the harvest's fix lies between them (RayCrossing.spreads).
+    camera = CameraModel.ideal(150.0, 320, 240)
+    T_base_c1 = _look_at(np.array([0.7, -0.45, 0.55]), np.array([0.0, 0.25, 0.3]))
+    origin = (T_base_c1 @ np.array([0.06, 0.0, 0.0, 1.0]))[:3]
+    mapped = np.array([0.02, 0.3, 0.32])
+    T_base_c2 = _look_at(np.array([0.05, 0.22, 0.3]), np.array([0.021, 0.301, 0.318]))
+    det = BerryDetection((163.2, 117.9), 20.0, (0, 0, 1, 1), np.ones((1, 1), bool), 1.0,
+                         "ripe", 1.0)  # fmt: skip
+    spreads = (1.5e-4, 0.35)
+    harvest = RayCrossing(origin, mapped, 0.01, spreads=spreads).fix(det, T_base_c2, camera)
+    T_c1_base = np.linalg.inv(T_base_c1)
+    o1 = np.array([0.06, 0.0, 0.0])
+    c1_dir = T_c1_base[:3, :3] @ mapped + T_c1_base[:3, 3] - o1
+    x, y = camera.normalize(np.array([det.center]))[0]
+    ray = np.array([x, y, 1.0]) / np.linalg.norm([x, y, 1.0])
+    T_c1_c2 = T_c1_base @ T_base_c2
+    rad = (spreads[0], spreads[1] / camera.focal)
+    mine = cross_rays(c1_dir / np.linalg.norm(c1_dir), ray, T_c1_c2, o1, rad)
+    plain = cross_rays(c1_dir / np.linalg.norm(c1_dir), ray, T_c1_c2, o1)
+    assert harvest is not None and mine is not None and plain is not None
+    np.testing.assert_allclose(mine, harvest, atol=1e-12)
+    assert np.linalg.norm(mine - plain) > 1e-5  # off C2's ray
+
+
 def test_parallel_rays_give_no_crossing() -> None:
     assert cross_rays(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]), np.eye(4)) is None
 

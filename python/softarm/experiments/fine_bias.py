@@ -51,18 +51,30 @@ FINE_BUDGET_S = 12.0
 
 
 def cross_rays(
-    c1_dir: FloatArray, c2_ray: FloatArray, T_c1_c2: FloatArray, c1_origin: FloatArray | None = None
+    c1_dir: FloatArray,
+    c2_ray: FloatArray,
+    T_c1_c2: FloatArray,
+    c1_origin: FloatArray | None = None,
+    spreads: tuple[float, float] | None = None,
 ) -> FloatArray | None:
     """The point on C2's ray (unit ``c2_ray`` in C2's frame) nearest C1's ray (unit
     ``c1_dir`` from ``c1_origin``, C1's origin when None, C1's frame), in C2's frame;
-    None when the two are parallel. :meth:`RayCrossing.fix` in C1's frame."""
+    with ``spreads`` (each ray's, rad) moved towards C1's ray's nearest point by the
+    share the two spreads give it; None when the two are parallel.
+    :meth:`RayCrossing.fix` in C1's frame."""
     ray = T_c1_c2[:3, :3] @ c2_ray
-    origin = T_c1_c2[:3, 3] - (np.zeros(3) if c1_origin is None else c1_origin)
+    start = np.zeros(3) if c1_origin is None else c1_origin
+    origin = T_c1_c2[:3, 3] - start
     b = float(c1_dir @ ray)
     if 1.0 - b * b < 1e-9:
         return None
     t = (b * float(c1_dir @ origin) - float(ray @ origin)) / (1.0 - b * b)
     result: FloatArray = c2_ray * t
+    if spreads is not None:
+        s = (float(c1_dir @ origin) - b * float(ray @ origin)) / (1.0 - b * b)
+        on_c1 = T_c1_c2[:3, :3].T @ (start + s * c1_dir - T_c1_c2[:3, 3])
+        var1, var2 = (spreads[0] * s) ** 2, (spreads[1] * t) ** 2
+        result = result + var2 / (var1 + var2) * (on_c1 - result)
     return result
 
 
@@ -167,16 +179,24 @@ class BiasTrace:
             "true": _unit(berry_c1 - o1),
         }
         projected = vision.model2.project(true_c2[None, :])[0]
+        # The harvest's weighing of the two rays (RayCrossing.spreads), C2's in rad.
+        w = (
+            None
+            if track.spreads is None
+            else (track.spreads[0], track.spreads[1] / vision.model2.focal)
+        )
         by: dict[str, FloatArray] = {}
         for k in range(len(SOURCES) + 1):
             for subset in itertools.combinations(SOURCES, k):
                 pick = {s: "true" if s in subset else "measured" for s in SOURCES}
-                p = cross_rays(c1[pick["c1_ray"]], rays[pick["c2_centre"]], poses[pick["cube"]], o1)
+                p = cross_rays(
+                    c1[pick["c1_ray"]], rays[pick["c2_centre"]], poses[pick["cube"]], o1, w
+                )
                 if p is None:
                     return
                 by["+".join(subset)] = _apply(T_ee_c2, p)
         for part, mixed in _cube_parts(poses, T_ee_c2).items():  # the cube's two errors
-            p = cross_rays(c1["measured"], rays["measured"], mixed, o1)
+            p = cross_rays(c1["measured"], rays["measured"], mixed, o1, w)
             if p is None:
                 return
             by[part] = _apply(T_ee_c2, p)

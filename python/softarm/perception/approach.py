@@ -24,7 +24,14 @@ from softarm.perception.berries import BerryDetection
 from softarm.perception.two_lines import closest_params
 from softarm.vision.camera_model import CameraModel
 
-__all__ = ["DISPARITY_SPREAD_PX", "RayCrossing", "along_spread", "distance_from_size"]
+__all__ = [
+    "C1_RAY_PX",
+    "C2_CENTRE_PX",
+    "DISPARITY_SPREAD_PX",
+    "RayCrossing",
+    "along_spread",
+    "distance_from_size",
+]
 
 #: A detection is this berry when its size is within this ratio of the expected one...
 SIZE_RANGE = (0.6, 1.6)
@@ -35,6 +42,13 @@ MIN_GATE_PX = 8.0
 #: disparity error on the diagnosis rows 90120-90125 is 0.49 px median, 1.35 px p95;
 #: twice the p95 keeps the tail that a wrong cue's match leaves.
 DISPARITY_SPREAD_PX = 3.0
+#: The spread (px, one image axis) of C1's ray through a berry it placed (its rectified
+#: image) and of C2's ray through the fruit it detects at fine positioning (its image):
+#: measured on the diagnosis bushes 1500-1509, frustum (c1_lean: 0.167 px median error
+#: of C1's ray; c2_lean: 0.41 px of C2's centre at its fixes); a round 2-D error of
+#: spread s per axis has a median norm of 1.18 s.
+C1_RAY_PX = 0.14
+C2_CENTRE_PX = 0.35
 
 
 def along_spread(depth: float, focal: float, baseline: float) -> float:
@@ -78,14 +92,23 @@ class RayCrossing:
             and poorly along it, so C2's gate (:meth:`consistent`) is centred on the
             point of C1's ray within ``along`` of ``position`` nearest C2's ray through
             the detection. 0: centred on ``position``.
+        spreads: the spread (rad, one axis) of C1's ray and of C2's ray through a
+            detection's centre (px: divided by C2's focal length at each fix), weighing
+            the fix between the two rays (:meth:`fix`); None: the fix on C2's ray.
 
     Raises:
         InputError: a point that is not a finite (3,) array, the two the same, a radius
-            that is not a finite number > 0, or ``along`` not a finite number >= 0.
+            that is not a finite number > 0, ``along`` not a finite number >= 0, or a
+            spread not a finite number > 0.
     """
 
     def __init__(
-        self, c1_centre: FloatArray, position: FloatArray, radius: float, along: float = 0.0
+        self,
+        c1_centre: FloatArray,
+        position: FloatArray,
+        radius: float,
+        along: float = 0.0,
+        spreads: tuple[float, float] | None = None,
     ) -> None:
         self.c1_centre = as_array(c1_centre, (3,), "c1_centre")
         self.position = as_array(position, (3,), "position")
@@ -96,12 +119,18 @@ class RayCrossing:
         self.c1_ray = ray / length
         self.radius = positive(radius, "radius")
         self.along = 0.0 if along == 0.0 else positive(along, "along")
+        self.spreads = None if spreads is None else (
+            positive(spreads[0], "spreads[0]"), positive(spreads[1], "spreads[1]")
+        )  # fmt: skip
 
     def fix(
         self, det: BerryDetection, T_base_camera: FloatArray, camera: CameraModel
     ) -> FloatArray | None:
         """The berry's centre in the camera's frame, on the ray through ``det`` where it
-        passes nearest C1's ray; None when the two rays are too near parallel.
+        passes nearest C1's ray, or with ``spreads`` between that point and C1's ray's
+        nearest, weighted by the inverse variance of each ray's spread there (the
+        weighted least-squares point of the two lines); None when the two rays are too
+        near parallel.
 
         Raises:
             InputError: ``T_base_camera`` is not a finite rigid 4x4 pose (PoseError),
@@ -115,6 +144,10 @@ class RayCrossing:
         if params is None:
             return None
         result: FloatArray = local * params[1]
+        if self.spreads is not None:
+            on_c1 = self.c1_centre + params[0] * self.c1_ray
+            towards = T_base_camera[:3, :3].T @ (on_c1 - origin) - result
+            result = result + _c1_share(params, self.spreads, camera.focal) * towards
         return result
 
     def consistent(
@@ -150,6 +183,15 @@ class RayCrossing:
         s = float(np.clip(params[0], -self.along, self.along))
         out: FloatArray = self.position + s * self.c1_ray
         return out
+
+
+def _c1_share(params: tuple[float, float], spreads: tuple[float, float], focal: float) -> float:
+    """How far (0-1) from C2's ray towards C1's the fix lies: C2's variance over both
+    rays' at the distances ``params`` (m along C1's ray, C2's) of their nearest points,
+    ``spreads`` (C1's rad, C2's px at ``focal``)."""
+    var1 = (spreads[0] * params[0]) ** 2
+    var2 = (spreads[1] / focal * params[1]) ** 2
+    return var2 / (var1 + var2) if var1 + var2 > 0.0 else 0.0
 
 
 def _checked(det: object, T_base_camera: object, camera: object) -> FloatArray:
