@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from softarm.checks import FloatArray
-from softarm.perception.approach import C1_RAY_PX, C2_CENTRE_PX, RayCrossing, along_spread
+from softarm.perception.approach import RayCrossing, along_spread
 from softarm.perception.berries import BerryDetection, DetectorSettings
 from softarm.perception.bush_map import BushMap
 from softarm.perception.detector.choice import detect_berries  # the chosen detector
@@ -63,7 +63,7 @@ class BushVision(CameraVision):
         origin = self.bush_map.ray_origin
         self._track = None if entry is None else RayCrossing(
             self.T_base_c1[:3, 3] if origin is None else origin, entry.position, entry.radius,
-            self._along(origin, entry.position), (C1_RAY_PX / self.model1.focal, C2_CENTRE_PX),
+            self._along(origin, entry.position),
         )  # fmt: skip
 
     def _along(self, origin: FloatArray | None, position: FloatArray) -> float:
