@@ -40,12 +40,17 @@ def test_the_side_by_side_table_gives_each_figure_before_and_after() -> None:
 
 
 def test_the_reach_budget_keeps_the_count_support_the_length_budget_the_defaults() -> None:
+    from dataclasses import replace
+
     from softarm.experiments.cane_sources import BUDGETS
     from softarm.perception.canes import CaneSettings
 
     assert BUDGETS["reach"].max_points == 4000 and BUDGETS["reach"].search.min_support == 70
     assert BUDGETS["reach"].search.support_length == 0.0
     assert BUDGETS["view"].reach is None and BUDGETS["reach"] == CaneSettings()
+    # ``before``: the default before the specks were counted among all points
+    old = replace(CaneSettings().search, speck_points=5, specks_among_all=False)
+    assert BUDGETS["before"] == replace(CaneSettings(), search=old)
     assert BUDGETS["length"].search.support_length == 0.08
 
 

@@ -66,11 +66,14 @@ __all__ = [
 CONDITIONS = ("sun", "overcast", "dusk", "backlight", "bush")
 #: The candidates, in the order of the table.
 SOURCES = ("colour", "net", "net+colour", "net|colour")
-#: Support counted in points, the default.
-_COUNTED = CurveSearch(min_support=70, support_length=0.0)
+#: Support counted in points, with the rule against specks before it counted among all
+#: points (the budgets measured with it keep it, so that they run as they were measured).
+_COUNTED = CurveSearch(min_support=70, support_length=0.0, speck_points=5, specks_among_all=False)
 #: The point budgets and supports: ``view``, 4,000 points over the whole view, a cane 70
-#: of them (as before the reach); ``reach``, 4,000 points within the reach, a cane 70 of
-#: them (the default); ``length``, 8,000 points within the reach, a cane 8 cm of cane
+#: of them (as before the reach); ``before``, 4,000 points within the reach, a cane 70 of
+#: them, a speck under 5 of its cane's points within 1 cm (the default before);
+#: ``reach``, the default (a speck under 4 points of any kind within 1 cm); ``length``,
+#: 8,000 points within the reach, a cane 8 cm of cane
 #: covered and at least 20 points (``CurveSearch.support_length``; measured, not adopted);
 #: ``evidence``, the ``length`` budget's fits kept only where they show a cane's evidence
 #: (:class:`~softarm.perception.cane_evidence.CaneEvidence`); ``far``, the same budget
@@ -82,12 +85,14 @@ _COUNTED = CurveSearch(min_support=70, support_length=0.0)
 #: 1.5 mm (the mask's half width, the largest distance to its edge less half a pixel,
 #: reads a cane an even number of pixels wide half a pixel thin: the renderer's thinnest
 #: canes, 2.5 mm, read 1.7 mm at 1.1 m).
-_LENGTH = CurveSearch(min_support=20, support_length=0.08)
+_LENGTH = CurveSearch(min_support=20, support_length=0.08, speck_points=5, specks_among_all=False)
 BUDGETS: dict[str, CaneSettings] = {
     "view": CaneSettings(
         reach=None, max_points=4000, search=_COUNTED, evidence=None, match_far=None
     ),
-    "reach": CaneSettings(max_points=4000, search=_COUNTED, evidence=None, match_far=None),
+    # ``before``: the default before the specks were counted among all points
+    "before": CaneSettings(max_points=4000, search=_COUNTED, evidence=None, match_far=None),
+    "reach": CaneSettings(),
     "length": CaneSettings(max_points=8000, search=_LENGTH, evidence=None, match_far=None),
     "evidence": CaneSettings(
         max_points=8000, search=_LENGTH, evidence=CaneEvidence(), match_far=None

@@ -41,11 +41,20 @@ class CurveSearch:
         it removed the two phantoms that made the planner refuse two berries);
         min_length: its shortest extent.
     max_gap: the longest hole (a leaf in front) a cane is followed across.
-    speck_radius, speck_points: a point with fewer than ``speck_points`` points of its
-        cane (itself included) within ``speck_radius`` is a speck, a stray match, and no
-        cane is grown across a hole to it: a cubic bent out to a few specks 5–12 cm
-        away runs through open air, where the planner then sees a cane and may refuse
-        a berry.
+    speck_radius, speck_points: a point with fewer than ``speck_points`` points
+        (itself included, any point, not only its cane's) within ``speck_radius`` is a
+        speck, a stray match, and no cane is grown across a hole to it: a cubic bent
+        out to a few specks 5–12 cm away runs through open air, where the planner then
+        sees a cane and may refuse a berry. Counted among all points with 4, not among
+        the cane's with 5: C1's budget leaves a cane at 1 m about 300–500 points a
+        metre, 6–10 within 1 cm, and the stereo scatters them across the cane, out of
+        the curve's band; the old rule dropped so many true points that pieces of cane
+        between leaves fell under ``min_support`` (on tuning renders 311000–311005 of
+        the row the fit lost 0.2 of the cane length its points reached; this rule
+        covered 0.03–0.06 more at the same precision there and in the bush,
+        docs/perception.md "Where the row's canes are lost").
+    specks_among_all: count a point's neighbours among all points (True, the default)
+        or among its cane's alone (False, with 5 points: the rule before).
     proposals: random lines tried for each cane; seed: their generator's seed.
     join_gap, join_angle: two canes whose ends face each other across at most
         ``join_gap`` (m), each end's outward direction within ``join_angle`` (degrees)
@@ -66,7 +75,8 @@ class CurveSearch:
     min_length: float = 0.04
     max_gap: float = 0.10
     speck_radius: float = 0.010
-    speck_points: int = 5
+    speck_points: int = 4
+    specks_among_all: bool = True
     proposals: int = 150
     seed: int = 0
     join_gap: float = 0.15
@@ -194,12 +204,14 @@ def _grow(points: FloatArray, line: IndexArray, search: CurveSearch) -> IndexArr
     """The cane grown from the inliers ``line`` of a proposed line: alternately fit the
     cubic and take the points near it, in one run without long holes; None when it is
     too short or has too few points."""
-    members = _longest_run(points, _without_specks(points, line, search), search.max_gap)
+    tree = cKDTree(points) if search.specks_among_all else None
+    members = _longest_run(points, _without_specks(points, tree, line, search), search.max_gap)
     for _ in range(3):
         if len(members) < search.min_support:
             return None
         coeffs = arc_length_cubic(points[members])
-        members = _without_specks(points, _near_curve(points, coeffs, search), search)
+        near = _near_curve(points, coeffs, search)
+        members = _without_specks(points, tree, near, search)
         members = _longest_run(points, members, search.max_gap)
     if len(members) < search.min_support or _extent(points[members]) < search.min_length:
         return None
@@ -249,12 +261,18 @@ def _near_curve(points: FloatArray, coeffs: FloatArray, search: CurveSearch) -> 
     return np.flatnonzero(distance < search.curve_tolerance)
 
 
-def _without_specks(points: FloatArray, members: IndexArray, search: CurveSearch) -> IndexArray:
-    """The ``members`` that are not specks (see ``CurveSearch.speck_points``)."""
+def _without_specks(
+    points: FloatArray, tree: cKDTree | None, members: IndexArray, search: CurveSearch
+) -> IndexArray:
+    """The ``members`` that are not specks (see ``CurveSearch.speck_points``): their
+    neighbours counted among all the points (``tree``, of ``points``), since the stereo
+    scatters a sparse cane's points out of the curve's band (a stray match in open air
+    has none either way); with ``tree`` None among the members alone."""
     if len(members) == 0:
         return members
     chosen = points[members]
-    neighbours = cKDTree(chosen).query_ball_point(chosen, search.speck_radius, return_length=True)
+    among = cKDTree(chosen) if tree is None else tree
+    neighbours = among.query_ball_point(chosen, search.speck_radius, return_length=True)
     return members[np.asarray(neighbours) >= search.speck_points]
 
 
