@@ -50,9 +50,10 @@ class CurveSearch:
         metre, 6–10 within 1 cm, and the stereo scatters them across the cane, out of
         the curve's band; the old rule dropped so many true points that pieces of cane
         between leaves fell under ``min_support`` (on tuning renders 311000–311005 of
-        the row the fit lost 0.2 of the cane length its points reached; this rule
-        covered 0.03–0.06 more at the same precision there and in the bush,
-        docs/perception.md "Where the row's canes are lost").
+        the row in sun and overcast the fit lost 0.14–0.21 of the cane length its
+        points reached; this rule covered 0.03–0.09 more of it at the same precision
+        with either mask, the bush 0.03 more at 0.02 less: docs/perception.md "Where
+        the row's canes are lost", with the fresh figures).
     specks_among_all: count a point's neighbours among all points (True, the default)
         or among its cane's alone (False, with 5 points: the rule before).
     proposals: random lines tried for each cane; seed: their generator's seed.
