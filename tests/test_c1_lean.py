@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from softarm.experiments.c1_lean import _seeds, summary
+from softarm.experiments.c1_lean import seed_range, summary
 
 
 def _row(left: list[float], sun: list[float]) -> dict[str, Any]:
@@ -38,5 +38,5 @@ def test_no_berries_summarise_to_a_count() -> None:
 
 
 def test_seed_ranges_include_both_ends() -> None:
-    assert _seeds("1500-1502") == [1500, 1501, 1502]
-    assert _seeds("7") == [7]
+    assert seed_range("1500-1502") == [1500, 1501, 1502]
+    assert seed_range("7") == [7]

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from softarm.experiments.c2_lean import _seeds, outline_centre_offset, summary
+from softarm.experiments.c2_lean import outline_centre_offset, summary
 
 
 def test_a_sphere_on_the_axis_has_its_outline_centred_on_it() -> None:
@@ -41,7 +41,3 @@ def test_summary_signs_the_shares() -> None:
     assert s["centre"]["along_sun_median_px"] == pytest.approx(0.2)  # towards the sun
     assert s["centre"]["outward_median_px"] == pytest.approx(-0.2)  # towards the axis
     assert summary([]) == {"fixes": 0, "berries": 0}
-
-
-def test_seed_ranges_include_both_ends() -> None:
-    assert _seeds("1500-1502") == [1500, 1501, 1502]

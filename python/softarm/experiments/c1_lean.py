@@ -128,14 +128,14 @@ def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def _seeds(text: str) -> list[int]:
+def seed_range(text: str) -> list[int]:
     lo, _, hi = text.partition("-")
     return list(range(int(lo), int(hi or lo) + 1))
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=_seeds, required=True, help="A-B, both included")
+    parser.add_argument("--seeds", type=seed_range, required=True, help="A-B, both included")
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--label", default="")
     args = parser.parse_args()

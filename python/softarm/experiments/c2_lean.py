@@ -35,6 +35,7 @@ import cv2
 import numpy as np
 
 from softarm.checks import FloatArray
+from softarm.experiments.c1_lean import seed_range
 
 __all__ = ["C2Trace", "outline_centre_offset", "summary"]
 
@@ -213,14 +214,9 @@ def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def _seeds(text: str) -> list[int]:
-    lo, _, hi = text.partition("-")
-    return list(range(int(lo), int(hi or lo) + 1))
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=_seeds, required=True, help="A-B, both included")
+    parser.add_argument("--seeds", type=seed_range, required=True, help="A-B, both included")
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--crops", type=Path, help="keep each fix's window here")
     parser.add_argument("--label", default="")

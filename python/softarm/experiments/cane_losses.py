@@ -239,24 +239,10 @@ def _render(condition: str, seed: int) -> tuple[Any, Any, StereoCamera, list[Any
     """C1's rectified pair of ``seed``'s bush (8 berries, as ``cane_sources`` draws it)
     in ``condition``, its stereo, every cane drawn and the cane index each pixel of the
     left and right frames shows."""
-    import softarm
-    from softarm.harvest.rigs.sim.options import default_cameras
-    from softarm.sim.bush import Bush
-    from softarm.sim.render import RenderedBush
+    from softarm.experiments.cane_sources import rendered_bush
     from softarm.sim.render.labels import KINDS
-    from softarm.sim.render.row_look import RowLook
-    from softarm.sim.rig_cameras import BASE_TAG_ID
 
-    cams = default_cameras()
-    bush = Bush.generate(
-        softarm.SoftArm.blackberry(), 8, seed,
-        view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4,
-    )  # fmt: skip
-    look = None if condition == "bush" else RowLook.named(condition, seed)
-    world = RenderedBush(
-        bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2,
-        cams.T_ee_cube, cams.T_base_tag, BASE_TAG_ID, cams.base_tag, look=look,
-    )  # fmt: skip
+    world = rendered_bush(condition, seed, 8)
     try:
         frames = world.c1(truth=True)
         canes = world.canes()

@@ -57,6 +57,7 @@ __all__ = [
     "CONDITIONS",
     "SOURCES",
     "fitted_length",
+    "rendered_bush",
     "scene_rows",
     "side_by_side",
     "summarise",
@@ -180,9 +181,10 @@ def scene_rows(
     return rows
 
 
-def _render(condition: str, seed: int, n_berries: int) -> tuple[Any, Any, Any, Any]:
-    """C1's rectified pair of ``seed``'s bush in ``condition``, its stereo and every
-    cane drawn."""
+def rendered_bush(condition: str, seed: int, n_berries: int) -> Any:
+    """``seed``'s bush of ``n_berries`` berries (40 % unripe) as the simulated rig's
+    cameras see it (a :class:`~softarm.sim.render.RenderedBush`; the caller closes it),
+    in ``condition``: a look of the row, or ``"bush"``."""
     import softarm
     from softarm.harvest.rigs.sim.options import default_cameras
     from softarm.sim.bush import Bush
@@ -196,10 +198,16 @@ def _render(condition: str, seed: int, n_berries: int) -> tuple[Any, Any, Any, A
         view_point=cams.T_base_c1[:3, 3], unripe_fraction=0.4,
     )  # fmt: skip
     look = None if condition == "bush" else RowLook.named(condition, seed)
-    world = RenderedBush(
+    return RenderedBush(
         bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2,
         cams.T_ee_cube, cams.T_base_tag, BASE_TAG_ID, cams.base_tag, look=look,
     )  # fmt: skip
+
+
+def _render(condition: str, seed: int, n_berries: int) -> tuple[Any, Any, Any, Any]:
+    """C1's rectified pair of ``seed``'s bush in ``condition``, its stereo and every
+    cane drawn."""
+    world = rendered_bush(condition, seed, n_berries)
     try:
         left, right = world.c1()
         truth = world.canes()
