@@ -49,12 +49,12 @@ from softarm.sim.render.shadow_map import (
     LOCAL_SIZE,
     SunShadows,
 )
+from softarm.sim.render.window_camera import geom_bounds as _bounds
+from softarm.sim.render.window_camera import window_camera
 from softarm.uninterrupted import uninterrupted
 
 #: Where what is out of the picture is put.
 FAR_AWAY = np.array([0.0, -50.0, 0.0])
-#: The sensor pixel pitch (m) the scene's cameras are declared with (mjcf._camera).
-PIXEL = 1e-6
 #: The geom group of everything that can hide a berry (leaves, canes, clutter, the arm).
 OCCLUDER_GROUP = 2
 #: The geom group a geom outside a render's frustum is moved to for that render: MuJoCo's
@@ -274,31 +274,14 @@ class BushRenderer:
         kept: np.ndarray | None = self._last.get(slot, state)
         if kept is not None:  # nothing moved since this was drawn
             return kept
-        mj, m = self._mj, self.model
         spec = self.cameras[camera]
-        cam = mj.mj_name2id(m, mj.mjtObj.mjOBJ_CAMERA, camera)
-        saved = (m.cam_resolution[cam].copy(), m.cam_sensorsize[cam].copy(),
-                 m.cam_intrinsic[cam].copy())  # fmt: skip
-        centre = (side - 1) / 2
-        # MuJoCo takes the principal point as an offset of the image centre from it.
-        px = centre - (spec.principal[0] - origin[0])
-        py = centre - (spec.principal[1] - origin[1])
-        m.cam_resolution[cam] = (side, side)
-        m.cam_sensorsize[cam] = (side * PIXEL, side * PIXEL)
-        m.cam_intrinsic[cam] = (spec.focal * PIXEL, spec.focal * PIXEL, px * PIXEL, py * PIXEL)
-        try:
-            mj.mj_kinematics(m, self.data)
-            mj.mj_camlight(m, self.data)
-            window = CameraSpec(camera, spec.T_parent_camera, (side, side), spec.focal, (0, 0))
-            principal = (spec.principal[0] - origin[0], spec.principal[1] - origin[1])
-            with self._culled(camera, (side, side), principal, merged=True) as local:
+        with window_camera(self._mj, self.model, self.data, spec, origin, side) as (window, pp):
+            with self._culled(camera, (side, side), pp, merged=True) as local:
                 r = self._renderer(window, local)
                 r.update_scene(self.data, camera=camera)
                 return self._last.put(
                     slot, state, np.ascontiguousarray(self._draw(r, local)[..., ::-1])
                 )
-        finally:
-            m.cam_resolution[cam], m.cam_sensorsize[cam], m.cam_intrinsic[cam] = saved
 
     def _draw(self, r: Any, local: bool) -> npt.NDArray[np.uint8]:
         """The colour image of the scene renderer ``r`` was last given (``update_scene``);
@@ -432,16 +415,6 @@ def _geom_pass(r: Any, data: Any, camera: str, option: Any, mj: Any) -> npt.NDAr
     r.disable_segmentation_rendering()
     ids = np.where(seg[..., 1] == int(mj.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
     return ids.astype(np.int32)
-
-
-def _bounds(model: Any, arm: npt.NDArray[np.intp]) -> FloatArray:
-    """Every geom's bounding radius (m) about its centre: MuJoCo's, but for the
-    ``arm``'s geoms, which change size as it bends (MuJoCo's radius is the built
-    size's), the larger of it and the sum of their sizes (a capsule's radius and
-    half-length, a box's half-sides: a sphere about the centre holding the geom)."""
-    radii: FloatArray = model.geom_rbound.copy()
-    radii[arm] = np.maximum(radii[arm], model.geom_size[arm].sum(axis=1))
-    return radii
 
 
 def _sized(r: Any, mj: Any, w: int, h: int) -> Any:

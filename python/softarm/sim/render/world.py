@@ -35,6 +35,7 @@ from softarm.sim.render.rig_motion import RigMotion
 from softarm.sim.render.row import ROW_Y, Row
 from softarm.sim.render.row_camera import RowCameras
 from softarm.sim.render.row_look import RowLook
+from softarm.sim.render.window_composite import CompositedWindows, quantised_share
 from softarm.vision.camera_model import CameraModel
 from softarm.vision.crop import ImageCrop
 from softarm.vision.marker_body import SIMULATED_BODY, panel_corners
@@ -100,6 +101,9 @@ class RenderedBush:
         shadows: in the row, the sun casts shadows (a shadow map; off: cheaper).
         marker_body: the body carrying the tags C1 tracks
             (:data:`~softarm.vision.marker_body.MARKER_BODIES`).
+        composited_windows: in the row, C1's marker windows are the arm drawn over
+            the row kept from an earlier render
+            (:mod:`softarm.sim.render.window_composite`; off: each drawn whole).
     """
 
     def __init__(
@@ -119,6 +123,7 @@ class RenderedBush:
         n_sections: int = 3,
         shadows: bool = True,
         marker_body: str = SIMULATED_BODY,
+        composited_windows: bool = True,
     ) -> None:
         self.bush = bush
         self.look = look or BushLook.random(bush.seed)
@@ -158,6 +163,10 @@ class RenderedBush:
             shadows=shadows,
         )
         self.renderer = BushRenderer(spec)
+        self.windows = (
+            CompositedWindows(self.renderer) if self.row is not None and composited_windows
+            else None
+        )  # fmt: skip
         self._distort = {"c1": Distorter(c1), "c2": Distorter(c2)}
         self.renderer.hide_arm()
 
@@ -220,6 +229,8 @@ class RenderedBush:
         if self.effects is not None:
             normals = self._tag_normals @ T_base_cube[:3, :3].T
             share = window_share(self.renderer.model, normals)
+            if self.windows is not None:  # the kept row serves nearby shares
+                share = quantised_share(share)
         return self.c1_left_window(centre, min(side, w, h), share)
 
     def c1_left_window(
@@ -228,7 +239,8 @@ class RenderedBush:
         """The ``side``-pixel square of C1's left eye around ``centre`` (px, clamped into
         the frame), with lens distortion, as an :class:`ImageCrop` that detectors read in
         full-frame coordinates. Only the pinhole pixels the window needs are rendered
-        (:meth:`BushRenderer.render_window`); they equal the full frame's. ``share``:
+        (:meth:`BushRenderer.render_window`; in the row the arm over the row kept,
+        :mod:`softarm.sim.render.window_composite`); they equal the full frame's. ``share``:
         the lights' strength it is drawn with, its camera's exposure scaled back
         (:mod:`softarm.sim.render.headroom`)."""
         w, h = self.stereo.left.image_size or (0, 0)
@@ -244,7 +256,9 @@ class RenderedBush:
                 self.c1_left().colour[y0 : y0 + side, x0 : x0 + side], (x0, y0), (w, h)
             )
         with dimmed(self.renderer.model, share):
-            pin = self.renderer.render_window("c1_left", (px0, py0), span)
+            pin = None if self.windows is None else self.windows.render((px0, py0), span)
+            if pin is None:  # no compositing, or the window reaches past the frame
+                pin = self.renderer.render_window("c1_left", (px0, py0), span)
         colour = cv2.remap(
             pin, mx - px0, my - py0, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
         )
