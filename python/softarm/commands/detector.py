@@ -101,6 +101,12 @@ def _add_train(actions: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         "fruit fall apart (the record beside OUT tells the detector)",
     )  # fmt: skip
     t.add_argument(
+        "--distance", action="store_true",
+        help="the network also learns each fruit pixel's distance to its fruit's edge over "
+        "the fruit's largest, and touching fruit are split by a watershed of it (with "
+        "--from, added to that file's network; the record beside OUT tells the detector)",
+    )  # fmt: skip
+    t.add_argument(
         "--from", dest="start", metavar="WEIGHTS",
         help="start from these weights ('default': the shipped ones) instead of fresh ones",
     )  # fmt: skip
@@ -162,7 +168,7 @@ def run_train(args: argparse.Namespace) -> int:
 
     record = train(
         args.data, args.out, args.epochs, args.seed, start, on_epoch, args.widths, args.scale,
-        args.stem, args.zoom, args.heatmap, args.boundary,
+        args.stem, args.zoom, args.heatmap, args.boundary, args.distance,
     )  # fmt: skip
     print(
         f"detector train: {args.epochs} epochs in {record['seconds']} s on "

@@ -36,7 +36,7 @@ from softarm.perception.detector.evaluate import evaluate
 from softarm.perception.detector.fragments import FRAGMENT_RULES, without_rules
 from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetector
 from softarm.perception.detector.misses import fruit_cases, miss_table
-from softarm.perception.detector.network import STRIDE, boundary_of, heatmap_of
+from softarm.perception.detector.network import STRIDE, boundary_of, distance_of, heatmap_of
 
 __all__ = ["CANDIDATE", "RAW", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
 
@@ -228,6 +228,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             "candidate_fragment_rule": None if a.weights is None else _rule(a.weights),
             # and whether it cuts touching fruit apart by its boundary class
             "candidate_boundary": None if a.weights is None else boundary_of(a.weights),
+            # and whether it splits them by a watershed of its distance to the fruit's edge
+            "candidate_distance": None if a.weights is None else distance_of(a.weights),
             "results": results,
         }
         a.out.write_text(json.dumps(doc, indent=1) + "\n")

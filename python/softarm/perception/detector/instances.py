@@ -27,6 +27,7 @@ from softarm.perception.berries import (
 )
 from softarm.perception.detector.boundary import fruit_parts
 from softarm.perception.detector.depth_check import rejection
+from softarm.perception.detector.distance import distance_pieces
 from softarm.perception.detector.fragments import (
     FRAGMENT_RULES,
     FragmentRule,
@@ -133,15 +134,20 @@ def _pieces(
     split: bool,
     rule: PeakRule,
     fragments: FragmentRule | None = None,
+    distance: npt.NDArray[np.float32] | None = None,
 ) -> list[npt.NDArray[np.bool_]]:
     """``part`` as one mask per fruit: at the necks of its distance map (``split``,
-    :mod:`.touching`), else at its centre heatmap's peaks (of ``rule``), the pieces that
-    ``fragments`` calls one fruit joined again (:mod:`.fragments`)."""
+    :mod:`.touching`), else by the watershed of the network's normalised distance to the
+    fruit's edge where it gives one (``distance``, the part's window: :mod:`.distance`),
+    else at its centre heatmap's peaks (of ``rule``), the pieces that ``fragments`` calls
+    one fruit joined again (:mod:`.fragments`)."""
     if split:
         # Too few pixels for two fruit of the least radius: one fruit, no distance map.
         if np.count_nonzero(part) < 2 * np.pi * SEED_RADIUS**2:
             return [part]
         return split_discs(part, disc_seeds(part, SEED_RADIUS))
+    if distance is not None:
+        return distance_pieces(part, distance)
     peaks = _peaks(centres, part, rule)
     return merge_fragments(_split(part, peaks), peaks, centres, fragments)
 
@@ -171,7 +177,8 @@ def instance_masks(
             continue
         part = labels[y : y + h, x : x + w] == k
         centres = output.centres[y : y + h, x : x + w]
-        for piece in _pieces(part, centres, split, rule, fragments):
+        distance = None if output.distance is None else output.distance[y : y + h, x : x + w]
+        for piece in _pieces(part, centres, split, rule, fragments, distance):
             if np.count_nonzero(piece) >= MIN_PIXELS and not speck(piece, centres, fragments):
                 out.append(grown(piece, x, y, fruit, taken, fragments))
     return out

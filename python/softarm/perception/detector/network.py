@@ -16,7 +16,10 @@ weights (the same name with ``.json``, as ``softarm detector train`` writes it);
 one, the heatmap is the logistic one (the shipped weights'). A record saying
 ``"boundary": true`` (``softarm detector train --boundary``) adds one output after the
 heatmap: the logit that a fruit pixel lies against another fruit (:mod:`.boundary`); a
-record without the key is a network without it.
+record without the key is a network without it. A record saying ``"distance": true``
+(``softarm detector train --distance``) adds one output after those: the logit of each
+fruit pixel's distance to its own fruit's edge, divided by that fruit's largest
+(:mod:`.distance`).
 Training images are shrunk so that their longer side is at most :data:`MAX_SIDE` pixels
 (the scale the training renders were drawn at: C1's 1280 × 720 eye at half size) times
 the output's stride; at run time images are shrunk to a network's own longest side, by
@@ -47,6 +50,7 @@ __all__ = [
     "Network",
     "NetworkOutput",
     "boundary_of",
+    "distance_of",
     "normalise",
 ]
 
@@ -80,7 +84,9 @@ class NetworkOutput:
     (h, w, len(CLASSES)) float32 summing to 1 per pixel and ``centres`` (h, w) float32 in
     [0, 1]; ``size`` (W, H) is the image's, :meth:`upsample` brings a map to it;
     ``heatmap`` is how the centres were trained (of HEATMAPS); ``boundary`` the (h, w)
-    boundary probability of a network with the boundary class, else None."""
+    boundary probability of a network with the boundary class, else None; ``distance``
+    the (h, w) normalised distance to the fruit's edge of a network trained with it
+    (``--distance``), else None."""
 
     def __init__(
         self,
@@ -89,6 +95,7 @@ class NetworkOutput:
         size: tuple[int, int],
         heatmap: str = "logistic",
         boundary: _F32 | None = None,
+        distance: _F32 | None = None,
     ) -> None:
         self.probabilities = probabilities
         self.centres = centres
@@ -97,6 +104,10 @@ class NetworkOutput:
         #: (h, w) probability that a pixel is fruit against another fruit, for a network
         #: trained with the boundary class; None for one without it.
         self.boundary = boundary
+        #: (h, w) predicted distance of a fruit pixel to its own fruit's edge over that
+        #: fruit's largest (1 at its centre, near 0 at its edge), for a network trained
+        #: with it; None for one without it.
+        self.distance = distance
 
     @property
     def scale(self) -> float:
@@ -146,7 +157,9 @@ class Network:
         self._net = net
         #: Whether the network gives the boundary class (its record says so).
         self.boundary = boundary_of(self.path)
-        n = N_OUTPUTS + int(self.boundary)
+        #: Whether the network gives the normalised distance to the fruit's edge.
+        self.distance = distance_of(self.path)
+        n = N_OUTPUTS + int(self.boundary) + int(self.distance)
         side = STRIDE * 4
         probe = self._forward(np.zeros((1, 3, side, side), np.float32))
         shapes = {(1, n, side // k, side // k): k for k in (1, 2)}
@@ -184,12 +197,14 @@ class Network:
         e = np.exp(logits - logits.max(axis=0, keepdims=True))
         probs = (e / e.sum(axis=0, keepdims=True)).transpose(1, 2, 0)
         centres = 1.0 / (1.0 + np.exp(-out[len(CLASSES)]))
-        boundary = None
+        boundary = distance = None
         if self.boundary:
             boundary = (1.0 / (1.0 + np.exp(-out[N_OUTPUTS]))).astype(np.float32)
+        if self.distance:  # the last output, after the boundary class where there is one
+            distance = (1.0 / (1.0 + np.exp(-out[-1]))).astype(np.float32)
         return NetworkOutput(
             np.ascontiguousarray(probs, np.float32), centres.astype(np.float32), (w, h),
-            self.heatmap, boundary,
+            self.heatmap, boundary, distance,
         )  # fmt: skip
 
 
@@ -208,22 +223,40 @@ def _record(weights: Path) -> object:
         raise VisionError(f"detector record {record}: not readable JSON ({exc})") from None
 
 
+def _flag(weights: Path, key: str) -> bool:
+    """The true-or-false ``key`` of the training record of ``weights``; False where there
+    is no record or it has no such key (records written before the option existed).
+
+    Raises:
+        VisionError: the record is unreadable, or its ``key`` is not true or false.
+    """
+    data = _record(weights)
+    flag = data.get(key, False) if isinstance(data, dict) else None
+    if not isinstance(flag, bool):
+        raise VisionError(
+            f"detector record {weights.with_suffix('.json')}: {key} {flag!r} is not true or false"
+        )
+    return flag
+
+
 def boundary_of(weights: Path) -> bool:
     """Whether ``weights`` give the boundary class: their training record's "boundary"
-    (``weights`` with ``.json``); False where there is no record or it has no such key
-    (records written before the boundary class existed).
+    (``weights`` with ``.json``); False where there is no record or it has no such key.
 
     Raises:
         VisionError: the record is unreadable, or its "boundary" is not true or false.
     """
-    data = _record(weights)
-    flag = data.get("boundary", False) if isinstance(data, dict) else None
-    if not isinstance(flag, bool):
-        raise VisionError(
-            f"detector record {weights.with_suffix('.json')}: boundary {flag!r} is not true "
-            "or false"
-        )
-    return flag
+    return _flag(weights, "boundary")
+
+
+def distance_of(weights: Path) -> bool:
+    """Whether ``weights`` give the normalised distance to the fruit's edge: their
+    training record's "distance"; False where there is no record or it has no such key.
+
+    Raises:
+        VisionError: the record is unreadable, or its "distance" is not true or false.
+    """
+    return _flag(weights, "distance")
 
 
 def heatmap_of(weights: Path) -> str:

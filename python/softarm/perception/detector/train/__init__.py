@@ -54,6 +54,7 @@ def train(
     zooms: list[float] | None = None,
     heatmap: str | None = None,
     boundary: bool = False,
+    distance: bool = False,
 ) -> dict[str, Any]:
     """Train on the COCO data folders ``data`` and write the network to ``out`` (ONNX)
     and its record to ``out`` with ``.json`` for a suffix; ``start`` is an ONNX file of
@@ -68,7 +69,10 @@ def train(
     the record tells the run-time decoding, :mod:`..network`; default: the ``start``
     file's, from its record, else logistic); ``boundary``: a fresh network with the
     boundary class (the pixels of a fruit against another's, :mod:`..boundary`; a
-    fine-tuned one keeps its file's). Returns the record.
+    fine-tuned one keeps its file's); ``distance``: the network learns each fruit pixel's
+    distance to its fruit's edge over the fruit's largest (:mod:`..distance`), a fresh
+    network with that output or, with ``start``, the file's network with it added when
+    it has none (a fine-tuned network that has it keeps it). Returns the record.
 
     Raises:
         TrainExtraMissing: the ``train`` extra is not installed.
@@ -82,26 +86,23 @@ def train(
     from softarm.perception.detector.network import MAX_SIDE
     from softarm.perception.detector.train.augment import SCALE
     from softarm.perception.detector.train.loop import TrainSettings, fit
-    from softarm.perception.detector.train.onnx_export import export_onnx, params_from_onnx
+    from softarm.perception.detector.train.onnx_export import export_onnx
     from softarm.perception.detector.train.samples import describe, load_samples
-    from softarm.perception.detector.train.unet import (
-        WIDTHS,
-        has_boundary,
-        layers,
-        stem_of,
-        widths_of,
-    )
+    from softarm.perception.detector.train.unet import WIDTHS, layers, widths_of
 
     heatmap = _checked(start, widths, stem or boundary, scale, heatmap)
     layers(WIDTHS if widths is None else widths)  # checks them before the data is read
-    params = None if start is None else params_from_onnx(start)
-    stem = stem_of(params) if params is not None else stem
-    boundary = has_boundary(params) if params is not None else boundary
-    samples, notes = load_samples(list(data), MAX_SIDE * (2 if stem else 1), zooms, boundary)
+    params = None
+    if start is not None:
+        params, stem, boundary, distance = _started(Path(start), distance, seed)
+    samples, notes = load_samples(
+        list(data), MAX_SIDE * (2 if stem else 1), zooms, boundary, distance
+    )
     settings = TrainSettings(
         epochs=epochs, seed=seed,
         widths=widths_of(params) if params is not None else widths or WIDTHS,
         scale=SCALE if scale is None else scale, stem=stem, heatmap=heatmap, boundary=boundary,
+        distance=distance,
     )  # fmt: skip
     began = time.perf_counter()
     params = fit(samples, settings, params, on_epoch)
@@ -111,6 +112,22 @@ def train(
 
     write_text(Path(out).with_suffix(".json"), json.dumps(record, indent=1) + "\n", "record")
     return record
+
+
+def _started(start: Path, distance: bool, seed: int) -> tuple[Any, bool, bool, bool]:
+    """The parameters of the network ``start`` to fine-tune, whether it has the stem, the
+    boundary class and (once added where ``distance`` asks for it and it has none, a
+    fresh column of its head drawn from ``seed``) the distance output."""
+    from softarm.perception.detector.network import distance_of
+    from softarm.perception.detector.train.onnx_export import params_from_onnx
+    from softarm.perception.detector.train.unet import has_boundary, stem_of, with_distance
+
+    params = params_from_onnx(start)
+    had = distance_of(start)
+    boundary = has_boundary(params, had)
+    if distance and not had:  # a fresh output on the trained network
+        params = with_distance(params, seed)
+    return params, stem_of(params), boundary, distance or had
 
 
 def _checked(
@@ -163,6 +180,7 @@ def _record(
         "stem": settings.stem,
         "heatmap": settings.heatmap,
         "boundary": settings.boundary,
+        "distance": settings.distance,
         "losses": [round(v, 5) for v in settings.losses],
         "seconds": round(time.perf_counter() - began, 1),
         "device": str(jax.devices()[0].platform),

@@ -6,7 +6,7 @@ what is under it, which the labels then call background)."""
 
 from __future__ import annotations
 
-from typing import cast
+from typing import Any, cast
 
 import cv2
 import numpy as np
@@ -29,9 +29,11 @@ _U8 = npt.NDArray[np.uint8]
 _F32 = npt.NDArray[np.float32]
 
 
-def _scaled(
-    s: Sample, rng: np.random.Generator, scale: tuple[float, float]
-) -> tuple[_U8, _U8, _F32]:
+#: A crop: image, classes, centre heatmap and the distance target (None without it).
+Crop = tuple[_U8, _U8, _F32, _F32 | None]
+
+
+def _scaled(s: Sample, rng: np.random.Generator, scale: tuple[float, float]) -> Crop:
     f = float(np.exp(rng.uniform(np.log(scale[0]), np.log(scale[1])))) * s.zoom
     h, w = s.classes.shape
     size = (max(CROP // 4, round(w * f)), max(CROP // 4, round(h * f)))
@@ -39,25 +41,28 @@ def _scaled(
     image = cast(_U8, cv2.resize(s.image, size, interpolation=mode))
     classes = cast(_U8, cv2.resize(s.classes, size, interpolation=cv2.INTER_NEAREST))
     centres = cast(_F32, cv2.resize(s.centres, size, interpolation=cv2.INTER_LINEAR))
-    return image, classes, centres
+    distance = None
+    if s.distance is not None:
+        distance = cast(_F32, cv2.resize(s.distance, size, interpolation=cv2.INTER_LINEAR))
+    return image, classes, centres, distance
 
 
-def _crop(
-    s: Sample, rng: np.random.Generator, scale: tuple[float, float], crop: int
-) -> tuple[_U8, _U8, _F32]:
-    image, classes, centres = _scaled(s, rng, scale)
+def _padded(values: npt.NDArray[Any], pad_y: int, pad_x: int, fill: int) -> npt.NDArray[Any]:
+    return cast(
+        npt.NDArray[Any],
+        cv2.copyMakeBorder(values, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=fill),
+    )
+
+
+def _crop(s: Sample, rng: np.random.Generator, scale: tuple[float, float], crop: int) -> Crop:
+    image, classes, centres, distance = _scaled(s, rng, scale)
     h, w = classes.shape
     pad_y, pad_x = max(0, crop - h), max(0, crop - w)
     if pad_y or pad_x:
-        image = cast(
-            _U8, cv2.copyMakeBorder(image, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=0)
-        )
-        classes = cast(
-            _U8, cv2.copyMakeBorder(classes, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=IGNORE)
-        )
-        centres = cast(
-            _F32, cv2.copyMakeBorder(centres, 0, pad_y, 0, pad_x, cv2.BORDER_CONSTANT, value=0)
-        )
+        image = _padded(image, pad_y, pad_x, 0)
+        classes = _padded(classes, pad_y, pad_x, IGNORE)
+        centres = _padded(centres, pad_y, pad_x, 0)
+        distance = None if distance is None else _padded(distance, pad_y, pad_x, 0)
         h, w = classes.shape
     plain = stages(classes)  # a boundary pixel is fruit too
     fruit = np.flatnonzero((plain >= 1) & (plain <= 3))
@@ -68,10 +73,13 @@ def _crop(
     else:
         y0, x0 = int(rng.integers(h - crop + 1)), int(rng.integers(w - crop + 1))
     window = np.s_[y0 : y0 + crop, x0 : x0 + crop]
-    image, classes, centres = image[window], classes[window], centres[window]
-    if rng.uniform() < 0.5:
-        image, classes, centres = image[:, ::-1], classes[:, ::-1], centres[:, ::-1]
-    return np.ascontiguousarray(image), np.ascontiguousarray(classes), np.ascontiguousarray(centres)
+    mirror = rng.uniform() < 0.5
+    step = -1 if mirror else 1
+
+    def cut(values: npt.NDArray[Any]) -> npt.NDArray[Any]:
+        return np.ascontiguousarray(values[window][:, ::step])
+
+    return cut(image), cut(classes), cut(centres), None if distance is None else cut(distance)
 
 
 def _colour(image: _U8, rng: np.random.Generator) -> _U8:
@@ -112,7 +120,9 @@ def _sensor(image: _U8, rng: np.random.Generator) -> _U8:
     return out
 
 
-def _cut_outs(image: _U8, classes: _U8, centres: _F32, rng: np.random.Generator) -> None:
+def _cut_outs(
+    image: _U8, classes: _U8, centres: _F32, distance: _F32 | None, rng: np.random.Generator
+) -> None:
     if rng.uniform() >= 0.4:
         return
     crop = classes.shape[0]
@@ -122,18 +132,22 @@ def _cut_outs(image: _U8, classes: _U8, centres: _F32, rng: np.random.Generator)
         image[y : y + hh, x : x + ww] = rng.integers(0, 256, 3).astype(np.uint8)
         classes[y : y + hh, x : x + ww] = 0
         centres[y : y + hh, x : x + ww] = 0.0
+        if distance is not None:
+            distance[y : y + hh, x : x + ww] = 0.0
 
 
 def augmented(
     s: Sample, rng: np.random.Generator, scale: tuple[float, float] = SCALE, crop: int = CROP
-) -> tuple[_U8, _U8, _F32]:
-    """One augmented ``crop`` × ``crop`` (image, classes, centres) of ``s``, scaled by a
-    factor drawn log-uniformly from ``scale`` times the sample's ``zoom``."""
-    image, classes, centres = _crop(s, rng, scale, crop)
+) -> Crop:
+    """One augmented ``crop`` × ``crop`` (image, classes, centres, distance target or None)
+    of ``s``, scaled by a factor drawn log-uniformly from ``scale`` times the sample's
+    ``zoom``."""
+    image, classes, centres, distance = _crop(s, rng, scale, crop)
     image = _sensor(_blur(_colour(image, rng), rng), rng)
     image, classes, centres = image.copy(), classes.copy(), centres.copy()
-    _cut_outs(image, classes, centres, rng)
-    return image, classes, centres
+    distance = None if distance is None else distance.copy()
+    _cut_outs(image, classes, centres, distance, rng)
+    return image, classes, centres, distance
 
 
 def crop_batch(
@@ -143,14 +157,17 @@ def crop_batch(
     step: int,
     scale: tuple[float, float] = SCALE,
     crop: int = CROP,
-) -> tuple[_U8, _U8, _F32]:
+) -> tuple[_U8, _U8, _F32, _F32]:
     """A batch of augmented crops of ``samples[indices]``, the same for the same
     ``seed``, ``step``, ``scale`` and ``crop``: (N, crop, crop, 3), (N, crop, crop),
-    (N, crop, crop)."""
+    (N, crop, crop) and the distance targets (N, crop, crop), zero for a sample without
+    one."""
     out = [
         augmented(samples[int(i)], np.random.default_rng([seed, step, k]), scale, crop)
         for k, i in enumerate(indices)
     ]
+    distance = [np.zeros_like(o[2]) if o[3] is None else o[3] for o in out]
     return (
-        np.stack([o[0] for o in out]), np.stack([o[1] for o in out]), np.stack([o[2] for o in out])
+        np.stack([o[0] for o in out]), np.stack([o[1] for o in out]),
+        np.stack([o[2] for o in out]), np.stack(distance),
     )  # fmt: skip

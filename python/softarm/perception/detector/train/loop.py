@@ -5,8 +5,11 @@ batches of augmented crops (twice the side for a network with the stride-2 stem,
 outputs are scored against the labels at half resolution); deterministic in the seed
 (the same crops, the same order, the same initial weights). With the boundary class,
 its own output is trained by a logistic loss whose boundary pixels weigh BOUNDARY_WEIGHT
-(a fruit class's weight) and every other pixel 1. JAX runs on a GPU where it sees one,
-else on the CPU."""
+(a fruit class's weight) and every other pixel 1. With the distance target (each fruit
+pixel's distance to its own fruit's edge over that fruit's largest: ``distance_target``),
+its output (the last) is trained by a logistic loss against that soft target over the
+fruit pixels alone (off fruit the decoding never reads it). JAX runs on a GPU where it
+sees one, else on the CPU."""
 
 from __future__ import annotations
 
@@ -40,6 +43,9 @@ CENTRE_POSITIVE = 20.0
 #: validation renders (dataset seed 100300), so that nothing was ever cut; at 10 a pixel
 #: is called boundary once about one in eleven such pixels is.
 BOUNDARY_WEIGHT = 10.0
+#: Weight of the distance target's loss (a mean over fruit pixels, as the class loss is
+#: a weighted mean over all).
+DISTANCE_WEIGHT = 1.0
 
 
 @dataclass(frozen=True)
@@ -49,7 +55,8 @@ class TrainSettings:
     has the stride-2 stem (``unet``) and the heatmap's loss (of ``network.HEATMAPS``:
     the weighted logistic loss, the default, or CenterNet's penalty-reduced focal loss,
     :mod:`.focal`, whose peaks are sharp, one per fruit) and whether the network has the
-    boundary class (``boundary``: the pixels of a fruit against another's)."""
+    boundary class (``boundary``: the pixels of a fruit against another's) and the
+    normalised distance to each fruit's edge (``distance``)."""
 
     epochs: int = 150
     batch: int = 12
@@ -60,6 +67,7 @@ class TrainSettings:
     stem: bool = False
     heatmap: str = "logistic"
     boundary: bool = False
+    distance: bool = False
     losses: list[float] = field(default_factory=list, compare=False)
 
 
@@ -71,9 +79,24 @@ def _boundary_loss(logit: Any, classes: Any, valid: Any) -> Any:
     return jnp.sum(bce * w) / jnp.maximum(jnp.sum(w), 1.0)
 
 
+def _distance_loss(logit: Any, target: Any, stage: Any, valid: Any) -> Any:
+    """The distance output's logistic loss against its soft target, over fruit pixels."""
+    fruit = (valid & (stage >= 1) & (stage <= 3)).astype(jnp.float32)
+    bce = optax.sigmoid_binary_cross_entropy(logit, target)
+    return jnp.sum(bce * fruit) / jnp.maximum(jnp.sum(fruit), 1.0)
+
+
 def _loss(
-    params: Params, x: Any, classes: Any, centres: Any, focal: bool = False, edge: bool = False
+    params: Params,
+    x: Any,
+    classes: Any,
+    centres: Any,
+    distance: Any,
+    flags: tuple[bool, bool, bool] = (False, False, False),
 ) -> Any:
+    """The training loss of a batch; ``flags``: (focal heatmap, boundary class, distance
+    target)."""
+    focal, edge, dist = flags
     out = apply(params, x)
     logits, centre = out[..., : len(CLASSES)], out[..., len(CLASSES)]
     valid = classes != IGNORE
@@ -83,6 +106,8 @@ def _loss(
     loss = jnp.sum(ce * w) / jnp.maximum(jnp.sum(w), 1.0)
     if edge:
         loss = loss + _boundary_loss(out[..., len(CLASSES) + 1], classes, valid)
+    if dist:
+        loss = loss + DISTANCE_WEIGHT * _distance_loss(out[..., -1], distance, target, valid)
     if focal:
         return loss + CENTRE_WEIGHT * focal_loss(centre, centres)
     bce = optax.sigmoid_binary_cross_entropy(centre, centres)
@@ -92,14 +117,19 @@ def _loss(
 
 
 def _halved(
-    classes: npt.NDArray[np.uint8], centres: npt.NDArray[np.float32]
-) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
+    classes: npt.NDArray[np.uint8],
+    centres: npt.NDArray[np.float32],
+    distance: npt.NDArray[np.float32],
+) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """The labels of a batch at a stem network's output resolution: each 2×2 block's
-    top-left class (the output pixel's, as the image shrinks for a plain network) and the
-    block's mean heatmap."""
+    top-left class and distance (the output pixel's, as the image shrinks for a plain
+    network) and the block's mean heatmap."""
     n, h, w = centres.shape
     mean = centres.reshape(n, h // 2, 2, w // 2, 2).mean(axis=(2, 4))
-    return np.ascontiguousarray(classes[:, ::2, ::2]), mean.astype(np.float32)
+    return (
+        np.ascontiguousarray(classes[:, ::2, ::2]), mean.astype(np.float32),
+        np.ascontiguousarray(distance[:, ::2, ::2]),
+    )  # fmt: skip
 
 
 def fit(
@@ -112,7 +142,9 @@ def fit(
     ``on_epoch(epoch, mean loss, seconds)`` after each epoch."""
     focal = settings.heatmap == "focal"
     if params is None:
-        params = init_params(settings.seed, settings.widths, settings.stem, settings.boundary)
+        params = init_params(
+            settings.seed, settings.widths, settings.stem, settings.boundary, settings.distance
+        )
         if focal:  # the heatmap starts at PRIOR everywhere, as CenterNet's
             w, b = params["head"]
             params = {**params, "head": (w, b.at[len(CLASSES)].set(prior_bias()))}
@@ -126,8 +158,9 @@ def fit(
     state = optimiser.init(params)
 
     @jax.jit
-    def step(p: Params, s: Any, x: Any, c: Any, h: Any) -> tuple[Params, Any, Any]:
-        loss, grads = jax.value_and_grad(_loss)(p, x, c, h, focal, settings.boundary)
+    def step(p: Params, s: Any, x: Any, c: Any, h: Any, d: Any) -> tuple[Params, Any, Any]:
+        flags = (focal, settings.boundary, settings.distance)
+        loss, grads = jax.value_and_grad(_loss)(p, x, c, h, d, flags)
         updates, s = optimiser.update(grads, s, p)
         return optax.apply_updates(p, updates), s, loss
 
@@ -141,16 +174,16 @@ def fit(
             idx = order[b * settings.batch : (b + 1) * settings.batch]
             if idx.size < settings.batch:  # a full batch keeps one compiled shape
                 idx = np.concatenate([idx, order[: settings.batch - idx.size]])
-            images, classes, centres = crop_batch(
+            images, classes, centres, distance = crop_batch(
                 samples, idx, settings.seed, n, settings.scale, crop
             )
             if settings.stem:
-                classes, centres = _halved(classes, centres)
+                classes, centres, distance = _halved(classes, centres, distance)
             if focal:
                 centres = sharpened(centres)
             params, state, loss = step(
                 params, state, jnp.asarray(normalise(images)), jnp.asarray(classes),
-                jnp.asarray(centres),
+                jnp.asarray(centres), jnp.asarray(distance),
             )  # fmt: skip
             losses.append(float(loss))
             n += 1

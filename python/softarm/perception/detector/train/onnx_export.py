@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from softarm.perception.detector.network import N_OUTPUTS
+from softarm.perception.detector.network import N_OUTPUTS, distance_of
 from softarm.perception.detector.train.unet import STEM_KERNEL, Params, layers
 
 __all__ = ["export_onnx", "onnx_bytes", "params_from_onnx"]
@@ -122,6 +122,8 @@ def params_from_onnx(path: str | Path) -> Params:
 
     Raises:
         InputError: the file is missing, unreadable, or not this architecture.
+        VisionError: its training record (which says whether a seventh output is the
+            boundary class or the distance) is unreadable.
     """
     import jax.numpy as jnp
     import onnx
@@ -143,9 +145,11 @@ def params_from_onnx(path: str | Path) -> Params:
     widths = tuple(int(w.shape[0]) for w in firsts if w is not None)
     stem = firsts[0] is not None and int(firsts[0].shape[-1]) == STEM_KERNEL
     head = arrays.get("head.w")
-    boundary = head is not None and int(head.shape[0]) == N_OUTPUTS + 1
+    # A seventh output is the boundary class's or the distance's: the record says which.
+    distance = distance_of(Path(path))
+    boundary = head is not None and int(head.shape[0]) - int(distance) == N_OUTPUTS + 1
     params: Params = {}
-    for name, k, cin, cout in layers(widths, stem, boundary):
+    for name, k, cin, cout in layers(widths, stem, boundary, distance):
         w, b = arrays.get(f"{name}.w"), arrays.get(f"{name}.b")
         if w is None or b is None or w.shape != (cout, cin, k, k) or b.shape != (cout,):
             raise InputError(f"--from {path}: not a network of this architecture (layer {name})")

@@ -5,7 +5,9 @@ Gaussian peak of height 1 at each fruit's centre, its width a third of the fruit
 radius). With the boundary class (``softarm detector train --boundary``), the pixels of a
 fruit within BOUNDARY_RADIUS of a different fruit's mask carry BOUNDARY_FLAG in the
 class map besides their stage: riding in the class map, the flag is scaled, cropped,
-mirrored and cut out with it by every augmentation."""
+mirrored and cut out with it by every augmentation. With the distance target
+(``--distance``), a sample carries each fruit pixel's normalised distance to its own
+fruit's edge (:mod:`.distance_target`) as a map of its own, moved as the heatmap is."""
 
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ import numpy.typing as npt
 from softarm.errors import InputError
 from softarm.perception.detector.labels import LabelledImage, read_coco
 from softarm.perception.detector.network import CLASSES, MAX_SIDE
+from softarm.perception.detector.train.distance_target import distance_target
 
 __all__ = [
     "BOUNDARY_FLAG",
@@ -50,12 +53,14 @@ _F32 = npt.NDArray[np.float32]
 class Sample:
     """One training image: ``image`` (H, W, 3) BGR uint8, ``classes`` (H, W) uint8 and
     ``centres`` (H, W) float32; ``zoom`` multiplies the augmentation's scale (2 for a
-    render drawn at half the camera's size, trained for a network run at full size)."""
+    render drawn at half the camera's size, trained for a network run at full size);
+    ``distance`` (H, W) float32 the normalised distance target, where it was asked for."""
 
     image: _U8
     classes: _U8
     centres: _F32
     zoom: float = 1.0
+    distance: _F32 | None = None
 
 
 def find_labels(data: str | Path) -> Path:
@@ -105,7 +110,7 @@ def boundary_target(
 
 
 def _sample(
-    item: LabelledImage, max_side: int, zoom: float, boundary: bool = False
+    item: LabelledImage, max_side: int, zoom: float, boundary: bool = False, distance: bool = False
 ) -> Sample | None:
     image = cast(_U8 | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
     if image is None or image.shape[:2] != (item.height, item.width):
@@ -131,7 +136,7 @@ def _sample(
             _add_peak(centres, mask)
     if boundary:
         classes[boundary_target(owner) & (classes != IGNORE)] |= np.uint8(BOUNDARY_FLAG)
-    return Sample(image, classes, centres, zoom)
+    return Sample(image, classes, centres, zoom, distance_target(owner) if distance else None)
 
 
 def _add_peak(centres: _F32, mask: npt.NDArray[np.bool_]) -> None:
@@ -151,10 +156,12 @@ def load_samples(
     max_side: int = MAX_SIDE,
     zooms: list[float] | None = None,
     boundary: bool = False,
+    distance: bool = False,
 ) -> tuple[list[Sample], list[str]]:
     """The samples of every data folder (or COCO file), shrunk to ``max_side``, each
     folder's with its zoom of ``zooms`` (default 1 each), with the boundary class in
-    their class maps when ``boundary``, and a line per folder saying what it held.
+    their class maps when ``boundary`` and the distance target when ``distance``, and a
+    line per folder saying what it held.
 
     Raises:
         InputError: a folder has no COCO file, or none of its images could be read, or
@@ -171,7 +178,9 @@ def load_samples(
         labels = find_labels(folder)
         items = read_coco(labels, labels.parent)
         samples = [
-            s for s in (_sample(i, max_side, zoom, boundary) for i in items) if s is not None
+            s
+            for s in (_sample(i, max_side, zoom, boundary, distance) for i in items)
+            if s is not None
         ]
         if not samples:
             raise InputError(f"--data {folder}: no readable labelled image in {labels}")

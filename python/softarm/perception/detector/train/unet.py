@@ -10,7 +10,9 @@ resolution (today's cost) while its first layer sees every pixel of the full ima
 (fruit of a few pixels keep their detail). Its outputs are at half the input's size.
 
 With ``boundary=True`` the head has one more output, after the heatmap: the boundary
-class's logit (:mod:`..boundary`).
+class's logit (:mod:`..boundary`); with ``distance=True`` one more, last: the logit of
+the normalised distance to the fruit's edge (:mod:`..distance`), which
+:func:`with_distance` adds to a trained network (a fresh column of the head).
 
 Parameters are a flat dict ``name -> (kernel (kh, kw, cin, cout), bias (cout,))`` of
 :data:`LAYERS`, images NHWC."""
@@ -36,6 +38,7 @@ __all__ = [
     "layers",
     "stem_of",
     "widths_of",
+    "with_distance",
 ]
 
 #: Channels of the four levels (full, 1/2, 1/4, 1/8 resolution) by default.
@@ -45,11 +48,15 @@ STEM_KERNEL = 6
 
 
 def layers(
-    widths: tuple[int, ...] = WIDTHS, stem: bool = False, boundary: bool = False
+    widths: tuple[int, ...] = WIDTHS,
+    stem: bool = False,
+    boundary: bool = False,
+    distance: bool = False,
 ) -> tuple[tuple[str, int, int, int], ...]:
     """(name, kernel size, in channels, out channels) of a network of ``widths`` (four
     positive channel counts), in the order the graph runs them; with ``stem`` the first
-    layer is the stride-2 stem, with ``boundary`` the head gives the boundary class too.
+    layer is the stride-2 stem, with ``boundary`` the head gives the boundary class too,
+    with ``distance`` the normalised distance too.
 
     Raises:
         InputError: ``widths`` is not four positive integers.
@@ -68,7 +75,7 @@ def layers(
         ("dec3", 3, c4 + c3, c3),
         ("dec2", 3, c3 + c2, c2),
         ("dec1", 3, c2 + c1, c1),
-        ("head", 1, c1, N_OUTPUTS + int(boundary)),
+        ("head", 1, c1, N_OUTPUTS + int(boundary) + int(distance)),
     )
 
 
@@ -79,17 +86,35 @@ Params = dict[str, tuple[Any, Any]]
 
 
 def init_params(
-    seed: int, widths: tuple[int, ...] = WIDTHS, stem: bool = False, boundary: bool = False
+    seed: int,
+    widths: tuple[int, ...] = WIDTHS,
+    stem: bool = False,
+    boundary: bool = False,
+    distance: bool = False,
 ) -> Params:
     """He-initialised parameters of a network of ``widths`` (with the stride-2 stem when
-    ``stem``, the boundary class when ``boundary``), deterministic in ``seed``."""
+    ``stem``, the boundary class when ``boundary``, the distance when ``distance``),
+    deterministic in ``seed``."""
     rng = np.random.default_rng(seed)
     params: Params = {}
-    for name, k, cin, cout in layers(widths, stem, boundary):
+    for name, k, cin, cout in layers(widths, stem, boundary, distance):
         std = np.sqrt(2.0 / (k * k * cin))
         w = rng.normal(0.0, std, (k, k, cin, cout)).astype(np.float32)
         params[name] = (jnp.asarray(w), jnp.zeros((cout,), jnp.float32))
     return params
+
+
+def with_distance(params: Params, seed: int) -> Params:
+    """``params`` with one more output of the head, last: the distance's, He-initialised
+    from ``seed`` as a fresh head's column is (the rest of the network as trained)."""
+    w, b = params["head"]
+    cin = int(w.shape[2])
+    column = np.random.default_rng([seed, 2]).normal(0.0, np.sqrt(2.0 / cin), (1, 1, cin, 1))
+    head = (
+        jnp.concatenate([w, jnp.asarray(column.astype(np.float32))], axis=-1),
+        jnp.concatenate([b, jnp.zeros((1,), jnp.float32)]),
+    )
+    return {**params, "head": head}
 
 
 def widths_of(params: Params) -> tuple[int, int, int, int]:
@@ -98,9 +123,10 @@ def widths_of(params: Params) -> tuple[int, int, int, int]:
     return c1, c2, c3, c4
 
 
-def has_boundary(params: Params) -> bool:
-    """Whether ``params`` give the boundary class (their head's output count says)."""
-    return int(params["head"][0].shape[-1]) == N_OUTPUTS + 1
+def has_boundary(params: Params, distance: bool = False) -> bool:
+    """Whether ``params`` give the boundary class (their head's output count says, less
+    the distance's output where they have it: ``distance``, which their record says)."""
+    return int(params["head"][0].shape[-1]) - int(distance) == N_OUTPUTS + 1
 
 
 def stem_of(params: Params) -> bool:
