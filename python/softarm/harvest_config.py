@@ -102,6 +102,12 @@ class HarvestConfig:
         lead_cap: the most pre-compensation gain ``k`` of the regulators' lag (the
             regulators are told ``q + k (q - ŷ)``, within the safety layer's rate limit
             and pressure range; ``softarm._core.lead_gain``, docs/control.md §6); 0: no lead.
+        plan_band: the placement planner moves each configuration it solves along its
+            pose's null space to raise the least room of any actuator to its limits, up to
+            this fraction of the range (``softarm.harvest.control.mid_band``; 0.5: as far
+            as the pose allows; 0: as the resolver leaves it): a regulator driven towards
+            0 or 70 psi cannot be driven harder, and one channel near a limit sets the
+            time of a whole move on a slow plant (docs/harvest.md).
     """
 
     period: float = 0.05
@@ -135,6 +141,7 @@ class HarvestConfig:
     handover_tolerance: float = 0.001
     lead_cap: float = 1.5
     transport_margin: float = 0.01
+    plan_band: float = 0.5
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
@@ -149,6 +156,9 @@ class HarvestConfig:
             value = _real(self, name)
             if not value >= 0:
                 raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
+        band = _real(self, "plan_band")
+        if not 0.0 <= band <= 0.5:
+            raise ParameterError(f"plan_band must be in [0, 0.5], got {band!r}")
         if self.lead_cap > 20.0:  # the actuator's bound on its lead
             raise ParameterError(f"lead_cap must be in [0, 20], got {self.lead_cap!r}")
         _real(self, "ripeness_threshold")

@@ -11,6 +11,11 @@ The machine ramps the actuators to that solution, then servos on the cameras (eq
 With known canes (curve obstacles, as in the planning paper) a solution is kept only if
 the model arm clears them by ``margin`` all along the straight actuator-space ramp to it,
 along the final approach to the berry and at the grasp.
+
+Each solution is first moved along its pose's null space so that the actuator nearest a
+limit has as much room as the pose allows (``band``, :mod:`.mid_band`): a regulator driven
+towards 0 or 70 psi cannot be driven harder, and on a slow plant that one channel sets
+the time of the whole move (docs/harvest.md, "Where the slow plant waits").
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from softarm._core import Resolver, SoftArm
 from softarm.checks import FloatArray
 from softarm.geometry import cone_axes
 from softarm.harvest.control.clearance import Clearance
+from softarm.harvest.control.mid_band import toward_mid
 from softarm.harvest.machine.targets import approach_pose
 from softarm.harvest_config import HarvestConfig
 
@@ -71,6 +77,10 @@ class ModelIK:
         limit_room: smallest distance (m) of the grasp solution to the joint limits, so
             that the true arm (gains and geometry a few % off the model) can still reach
             the berry within a millimetre in closed loop.
+        band: each solution is moved in its task's null space towards the middle of
+            every actuator's range, out of this fraction of it at either end
+            (:func:`~softarm.harvest.control.mid_band.toward_mid`), the unmoved solutions
+            kept as a fallback; 0: solutions as the resolver leaves them.
     """
 
     def __init__(
@@ -85,6 +95,7 @@ class ModelIK:
         ramp_margin: float = 0.025,
         via: float = 0.1,
         limit_room: float = 0.001,
+        band: float = 0.0,
     ) -> None:
         self.resolver = resolver
         self.arm = resolver.arm
@@ -94,6 +105,7 @@ class ModelIK:
         self.clearance, self.margin, self.via = clearance, margin, via
         self.ramp_margin = ramp_margin
         self.limit_room = limit_room
+        self.band = band
         #: The canes to plan around where no plan clears ``clearance``'s: the ones C1
         #: saw itself, once C2's survey has added its own (ControlStack.know_canes).
         self.fallback: Clearance | None = None
@@ -253,7 +265,10 @@ class ModelIK:
 
     def solve(self, q: FloatArray, target: FloatArray, sample: bool = True) -> list[FloatArray]:
         """Elongations reaching ``target`` (4, 4) on the model from each start that
-        converges, nearest to ``q`` first; [] when none does."""
+        converges, nearest to ``q`` first; [] when none does. With a ``band``, each moved
+        towards mid-range in its pose's null space comes first (those it could move), then
+        the solutions as the resolver left them: a moved one whose ramp or approach comes
+        nearer a cane than the pass allows leaves the unmoved one to try."""
         starts = [q]
         if sample:
             lo, hi = self.arm.lower, self.arm.upper
@@ -271,4 +286,9 @@ class ModelIK:
             )  # fmt: skip
             if sol.converged:
                 found.append(np.asarray(sol.q, dtype=np.float64))
-        return sorted(found, key=lambda x: float(np.linalg.norm(x - q)))
+        found.sort(key=lambda x: float(np.linalg.norm(x - q)))
+        if self.band <= 0:
+            return found
+        mask = self.resolver.gains.axis_mask
+        moved = [toward_mid(self.arm, x, target, mask, self.band) for x in found]
+        return [m for m, x in zip(moved, found, strict=True) if m is not x] + found

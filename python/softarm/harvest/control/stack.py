@@ -160,7 +160,10 @@ def build_control_stack(
     # controller keeps the lagging arm's way to each command clear with it.
     clearance = Clearance(inputs.model, canes, cfg.grasp_offset)
     controller = _controller(cfg, inputs, canes, clearance, actuator)
-    planner = ModelIK(planning_resolver(inputs.model), cfg, seed=inputs.seed, clearance=clearance)
+    planner = ModelIK(
+        planning_resolver(inputs.model), cfg, seed=inputs.seed, clearance=clearance,
+        band=cfg.plan_band,
+    )  # fmt: skip
     return ControlStack(actuator, controller, planner, clearance)
 
 
