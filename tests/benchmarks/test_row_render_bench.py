@@ -5,7 +5,9 @@ with the full one, on the same world; with the small map on the same row whose
 small renders draw the ground on MuJoCo's finest grid (200 x 200 quads, as before
 renderer.SMALL_RENDER_GROUND_GRID); with the small map on the same world drawing
 the bush's canes as their capsules (as before softarm.sim.render.cane_mesh); and with
-the ground plane in the sun's depth pass (as before renderer.BushRenderer._draw)."""
+the ground plane in the sun's depth pass (as before renderer.BushRenderer._draw); and
+the window as the arm drawn over the row kept from one whole render
+(softarm.sim.render.window_composite, off in the harvest)."""
 
 from __future__ import annotations
 
@@ -152,3 +154,17 @@ def test_row_small_render_stepped_casters(benchmark, row: Any, view: str) -> Non
     finally:
         module.shadow_casters = chosen
     assert image.ndim == 3
+
+
+def test_row_composited_window(benchmark, row: Any) -> None:  # type: ignore[no-untyped-def]
+    """The C1 window as the arm drawn over the row kept from one whole render
+    (softarm.sim.render.window_composite, off in the harvest), the kept row drawn once
+    before the rounds; against ``test_row_small_render[c1_window-small]``, the window
+    drawn whole."""
+    from softarm.sim.render.window_composite import CompositedWindows
+
+    windows = CompositedWindows(row.renderer)
+    origin = _window_origin(row)
+    windows.render(origin, WINDOW)  # the row kept
+    image = benchmark(lambda: (_anew(row.renderer), windows.render(origin, WINDOW))[1])
+    assert image is not None and image.ndim == 3 and windows.scene.drawn == 1

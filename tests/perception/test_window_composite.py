@@ -41,6 +41,7 @@ def _world(look: str, shadows: bool = True) -> Any:
             bush, cams.T_base_c1, cams.model(1), cams.model(2), cams.T_ee_c2, cams.T_ee_cube,
             cams.T_base_tag, BASE_TAG_ID, cams.base_tag, cams.cube_marker,
             RowLook.named(look, SEED), shadows=shadows, marker_body="frustum",
+            composited_windows=True,
         )  # fmt: skip
     except RenderUnavailableError as exc:
         pytest.skip(str(exc))

@@ -122,9 +122,6 @@ def test_the_row_s_window_is_rendered_with_headroom(sunny_row: Any, monkeypatch:
         return drawn[-1][0]
 
     monkeypatch.setattr(world.renderer, "render_window", spy)
-    # Each window drawn whole (the composited ones are dimmed the same way:
-    # tests/perception/test_window_composite.py compares the two).
-    monkeypatch.setattr(world, "windows", None)
     world.cube_window(T_base_cube)
     effects, world.effects = world.effects, None  # the bush's way: at full light
     try:

@@ -9,6 +9,8 @@ window) draws small, at the full map's texel pitch, about what it sees
 of it (:mod:`softarm.sim.render.culling`), and a small colour render draws the row's
 bush canes as merged meshes of fewer triangles (:mod:`softarm.sim.render.cane_mesh`).
 In the small renders the row's ground plane casts no shadow (:meth:`BushRenderer._draw`).
+C1's marker windows can be drawn as the arm over the row kept from one whole render
+(:mod:`softarm.sim.render.window_composite`; off by default).
 Lens distortion is applied afterwards (:mod:`softarm.sim.render.distortion`).
 """
 

@@ -101,9 +101,11 @@ class RenderedBush:
         shadows: in the row, the sun casts shadows (a shadow map; off: cheaper).
         marker_body: the body carrying the tags C1 tracks
             (:data:`~softarm.vision.marker_body.MARKER_BODIES`).
-        composited_windows: in the row, C1's marker windows are the arm drawn over
+        composited_windows: in the row, C1's marker windows drawn as the arm over
             the row kept from an earlier render
-            (:mod:`softarm.sim.render.window_composite`; off: each drawn whole).
+            (:mod:`softarm.sim.render.window_composite`); off (the default): each
+            drawn whole. Off because a harvest's CPU per simulated second is the same
+            either way (BENCHMARKS.md, "The daylight row") while the pixels differ.
     """
 
     def __init__(
@@ -123,7 +125,7 @@ class RenderedBush:
         n_sections: int = 3,
         shadows: bool = True,
         marker_body: str = SIMULATED_BODY,
-        composited_windows: bool = True,
+        composited_windows: bool = False,
     ) -> None:
         self.bush = bush
         self.look = look or BushLook.random(bush.seed)
@@ -239,8 +241,9 @@ class RenderedBush:
         """The ``side``-pixel square of C1's left eye around ``centre`` (px, clamped into
         the frame), with lens distortion, as an :class:`ImageCrop` that detectors read in
         full-frame coordinates. Only the pinhole pixels the window needs are rendered
-        (:meth:`BushRenderer.render_window`; in the row the arm over the row kept,
-        :mod:`softarm.sim.render.window_composite`); they equal the full frame's. ``share``:
+        (:meth:`BushRenderer.render_window`; with ``composited_windows`` the arm over
+        the row kept, :mod:`softarm.sim.render.window_composite`); they equal the full
+        frame's. ``share``:
         the lights' strength it is drawn with, its camera's exposure scaled back
         (:mod:`softarm.sim.render.headroom`)."""
         w, h = self.stereo.left.image_size or (0, 0)
