@@ -171,3 +171,11 @@ def test_distance_training_is_deterministic_and_adds_the_output_to_a_trained_net
         str(tmp_path / "out"),
     )
     assert done.returncode == 0 and "ok" in done.stdout, done.stderr
+
+
+def test_a_part_without_a_hill_is_no_fruit() -> None:
+    owner = np.zeros((H, W), np.int32)
+    owner[BIG] = 1
+    flat = np.where(BIG, 0.3, 0.0).astype(np.float32)  # fruit-coloured, no fruit's shape
+    assert distance_pieces(BIG, flat) == []
+    assert len(distance_pieces(BIG, distance_target(owner))) == 1
