@@ -28,8 +28,8 @@ __all__ = ["DISTANCE_LEVEL", "FLOOD_STEP", "MIN_MARKER", "distance_pieces", "flo
 #: each fruit's hill; the trained network's hills reach 0.6-0.7, not 1). This,
 #: MIN_MARKER and DROP_HILLLESS were chosen on the validation renders only (dataset seed
 #: 100300, sun, overcast, dusk, 20 images each): levels 0.35-0.45 kept more fruit pieces
-#: that are no fruit (precision with both checks down to 0.87-0.95), 0.55 lost a third of
-#: the ripe fruit whose hills stay under it.
+#: that are no fruit (precision with both checks down to 0.87-0.95), 0.55 lost a fifth to
+#: a quarter of the ripe fruit found at 0.5 (hills that stay under it).
 DISTANCE_LEVEL = 0.5
 #: Fewest pixels of a marker (network px): a smaller one is a bump of a hill, not a fruit
 #: (1 and 4 kept more false pieces; 8 and 12 lost small fruit).
