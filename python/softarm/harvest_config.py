@@ -102,12 +102,12 @@ class HarvestConfig:
         lead_cap: the most pre-compensation gain ``k`` of the regulators' lag (the
             regulators are told ``q + k (q - ŷ)``, within the safety layer's rate limit
             and pressure range; ``softarm._core.lead_gain``, docs/control.md §6); 0: no lead.
-        plan_band: the placement planner moves each configuration it solves along its
-            pose's null space to raise the least room of any actuator to its limits, up to
-            this fraction of the range (``softarm.harvest.control.mid_band``; 0.5: as far
-            as the pose allows; 0: as the resolver leaves it): a regulator driven towards
-            0 or 70 psi cannot be driven harder, and one channel near a limit sets the
-            time of a whole move on a slow plant (docs/harvest.md).
+        plan_band: with it above 0, the placement planner moves each configuration it
+            solves along its pose's null space to raise the least room of any actuator to
+            its limits, up to this fraction of the range (``softarm.harvest.control.
+            mid_band``; 0.5: as far as the pose allows). Off (0) by default: on the slow
+            plant's fresh seeds 13 of 20 were slower with it, its quicker placement lost
+            to fine positioning (docs/harvest.md, "Pre-grasp poses off the limits").
     """
 
     period: float = 0.05
@@ -141,7 +141,7 @@ class HarvestConfig:
     handover_tolerance: float = 0.001
     lead_cap: float = 1.5
     transport_margin: float = 0.01
-    plan_band: float = 0.5
+    plan_band: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",

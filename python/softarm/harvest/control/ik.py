@@ -12,10 +12,12 @@ With known canes (curve obstacles, as in the planning paper) a solution is kept 
 the model arm clears them by ``margin`` all along the straight actuator-space ramp to it,
 along the final approach to the berry and at the grasp.
 
-Each solution is first moved along its pose's null space so that the actuator nearest a
-limit has as much room as the pose allows (``band``, :mod:`.mid_band`): a regulator driven
-towards 0 or 70 psi cannot be driven harder, and on a slow plant that one channel sets
-the time of the whole move (docs/harvest.md, "Where the slow plant waits").
+With a ``band`` (``[harvest] plan_band``, off by default), each solution is first moved
+along its pose's null space so that the actuator nearest a limit has as much room as the
+pose allows (:mod:`.mid_band`): a regulator driven towards 0 or 70 psi cannot be driven
+harder, and on a slow plant that one channel sets the time of a move. Measured on the
+slow plant's fresh seeds, it did not make the berries quicker (docs/harvest.md,
+"Pre-grasp poses off the limits").
 """
 
 from __future__ import annotations
