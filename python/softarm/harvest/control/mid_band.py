@@ -28,6 +28,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from softarm import so3
 from softarm._core import SoftArm
 from softarm.checks import FloatArray
 
@@ -64,16 +65,6 @@ def null_projector(jac: FloatArray) -> FloatArray:
     return np.asarray(np.eye(jac.shape[1]) - v @ v.T, dtype=np.float64)
 
 
-def _log_so3(r: FloatArray) -> FloatArray:
-    """The rotation vector of ``r`` (3, 3), as the resolver's ``log_so3`` (angles < π)."""
-    cos = float(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0))
-    angle = float(np.arccos(cos))
-    w = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    if angle < 1e-9:
-        return 0.5 * w
-    return np.asarray(angle / (2.0 * np.sin(angle)) * w, dtype=np.float64)
-
-
 def task_error(
     arm: SoftArm, q: FloatArray, target: FloatArray, mask: Sequence[bool]
 ) -> tuple[FloatArray, FloatArray]:
@@ -81,7 +72,7 @@ def task_error(
     resolver's eq. 20 controls it) and its Jacobian's rows, at ``q``."""
     pose, jac = arm.forward_jacobian(q)
     e_p = target[:3, 3] - pose[:3, 3]
-    e_w = _log_so3(target[:3, :3] @ pose[:3, :3].T)
+    e_w = so3.log(target[:3, :3] @ pose[:3, :3].T)
     rows = [0, 1, 2] + [3 + i for i in range(3) if mask[i]]
     err = np.concatenate([e_p, e_w])[rows]
     return np.asarray(err, dtype=np.float64), np.asarray(jac[rows], dtype=np.float64)
