@@ -20,6 +20,9 @@ comparison on the same poses. ``--look L`` measures it in the daylight row
 marker body B instead of the paper's cube (:mod:`softarm.vision.marker_body`);
 ``--without noise jpeg blur`` (any of them) renders the row's windows with those
 parts of the camera model off, to tell which of them the error comes from;
+``--frames N`` renders each pose's window N times, the camera model's noise drawn anew
+each time, and adds the error of the mean of the N positions (what of the error is the
+frame's own, which a filter over still frames would average down);
 ``--by-angle`` prints the figures by approach angle as well (:data:`ANGLE_BINS`: the
 angle between C1's line of sight and the paper cube's best-facing tag, whichever body
 is drawn), ``--json FILE`` writes them all, ``--into FILE`` puts them into FILE with
@@ -74,6 +77,10 @@ class Pose:
     angle: float
     share: float
     consistent: bool
+    #: With ``frames`` > 1: every frame's error (mm, the frames found) and the error of
+    #: the mean of their positions (None: none found).
+    frame_errors: tuple[float, ...] = ()
+    mean_error: float | None = None
 
 
 def track_cubes(
@@ -83,14 +90,18 @@ def track_cubes(
     look: str | None = None,
     body: str = "cube",
     without: tuple[str, ...] = (),
+    frames: int = 1,
 ) -> dict[str, Any]:
     """Position errors (mm) of the marker body ``body`` tracked in C1 over ``poses`` arm
     poses per seed, the share of poses where it was found, the mean time (ms) to render
     a window (its renderer made; the harvest makes one per size once) and its mean side
     (px); ``look``: in the daylight row with that look family (``--world row``), drawn
     from each seed, with the camera model's parts ``without`` (:data:`CAMERA_PARTS`) off.
-    ``"by_angle"`` holds the same by approach angle (:func:`by_angle`)."""
-    found, seconds, sides = _tracked(seeds, poses, side, look, body, without)
+    ``"by_angle"`` holds the same by approach angle (:func:`by_angle`). ``frames`` > 1
+    renders each pose's window that many times (the row's camera model draws its noise
+    anew each time) and adds :func:`over_frames`' figures: how much of the error is the
+    frame's own, which a tracker's filter over still frames would average down."""
+    found, seconds, sides = _tracked(seeds, poses, side, look, body, without, frames)
     errors = [p.error for p in found if p.error is not None]
     unhidden = [p.error for p in found if p.error is not None and p.share >= UNHIDDEN]
     hidden = [p.error for p in found if p.error is not None and p.share < UNHIDDEN]
@@ -110,6 +121,24 @@ def track_cubes(
         "window_ms": 1e3 * seconds / max(len(found), 1),
         "mean_side_px": float(np.mean(sides)) if sides else float("nan"),
         "by_angle": by_angle(found),
+        **(over_frames(found) if frames > 1 else {}),
+    }
+
+
+def over_frames(found: list[Pose]) -> dict[str, Any]:
+    """Over the poses tracked in several frames each: the median and p95 (mm) of every
+    frame's error, of the error of the mean of each pose's positions, and the median of
+    each pose's spread (the largest less the smallest of its frames' errors)."""
+    single = [e for p in found for e in p.frame_errors]
+    means = [p.mean_error for p in found if p.mean_error is not None]
+    spreads = [max(p.frame_errors) - min(p.frame_errors) for p in found if p.frame_errors]
+    return {
+        "frames_found": len(single),
+        "median_frame_mm": _median(single),
+        "p95_frame_mm": _p95(single),
+        "median_mean_of_frames_mm": _median(means),
+        "p95_mean_of_frames_mm": _p95(means),
+        "median_spread_mm": _median(spreads),
     }
 
 
@@ -161,6 +190,7 @@ def _tracked(
     look: str | None,
     body: str,
     without: tuple[str, ...] = (),
+    frames: int = 1,
 ) -> tuple[list[Pose], float, list[int]]:
     """Every pose tracked, the seconds spent rendering windows and the windows' sides."""
     import softarm
@@ -207,9 +237,31 @@ def _tracked(
                 error = 1e3 * float(np.linalg.norm(est.T_camera_cube[:3, 3] - T_c1_cube[:3, 3]))
             angle = float(paper.view_angles(T_c1_cube, tuple(sorted(paper.markers))).min())
             share = world.renderer.visible_share("c1_left", faces)
-            out.append(Pose(error, angle, share, est is not None and est.consistent))
+            pose = Pose(error, angle, share, est is not None and est.consistent)
+            if frames > 1:
+                positions = [] if est is None else [est.T_camera_cube[:3, 3]]
+                for _ in range(frames - 1):
+                    again = _window(world, T_base_ee @ cams.T_ee_cube, side)
+                    more = tracked.estimate(
+                        detector.detect(again, world.stereo.left), world.stereo.left
+                    )
+                    positions += [] if more is None else [more.T_camera_cube[:3, 3]]
+                pose = _with_frames(pose, positions, T_c1_cube[:3, 3])
+            out.append(pose)
         world.close()
     return out, seconds, sides
+
+
+def _with_frames(pose: Pose, positions: list[Any], truth: Any) -> Pose:
+    """``pose`` with the errors (mm) of ``positions`` (each frame's found, m) from
+    ``truth`` and the error of their mean."""
+    from dataclasses import replace
+
+    if not positions:
+        return pose
+    errors = tuple(1e3 * float(np.linalg.norm(p - truth)) for p in positions)
+    mean = 1e3 * float(np.linalg.norm(np.mean(positions, axis=0) - truth))
+    return replace(pose, frame_errors=errors, mean_error=mean)
 
 
 def _median(values: list[float]) -> float:
@@ -251,11 +303,18 @@ def main(argv: list[str] | None = None) -> int:
         "--without", nargs="+", choices=tuple(CAMERA_PARTS), default=(),
         help="the row's camera model without these parts",
     )  # fmt: skip
+    p.add_argument(
+        "--frames", type=int, default=1, help="windows rendered at each pose (noise drawn anew)"
+    )
     p.add_argument("--json", metavar="FILE", help="write the figures as JSON to FILE")
     p.add_argument("--into", metavar="FILE", help="put the figures into the JSON file FILE")
     args = p.parse_args(argv)
     without = tuple(args.without)
-    result = track_cubes(args.seeds, args.poses, args.side, args.look, args.marker_body, without)
+    if args.frames < 1:
+        p.error(f"--frames must be at least 1, got {args.frames}")
+    result = track_cubes(
+        args.seeds, args.poses, args.side, args.look, args.marker_body, without, args.frames
+    )
     if without:
         result["without"] = list(without)
     if args.into:
