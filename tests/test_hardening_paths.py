@@ -184,7 +184,7 @@ def test_image_headers_are_read_without_decoding() -> None:
     assert image_header(data.tobytes()) == (6, 5, 8)
     for junk in (b"", b"\x89PNG\r\n\x1a\n", b"\xff\xd8\xff", b"II*\x00\xff\xff\xff\xff", b"GIF8"):
         assert image_header(junk) is None
-        with pytest.raises(InputError, match="not a PNG, JPEG, BMP or TIFF"):
+        with pytest.raises(InputError, match="not a PNG, JPEG, BMP, TIFF or WebP"):
             decode_image(junk, "frame")
 
 

@@ -203,7 +203,7 @@ def test_detect_on_a_file_that_is_no_image_is_one_line(
     bad.write_text("hello")
     assert main(["detect", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "not an image OpenCV can read" in err[0]
+    assert len(err) == 1 and "not a PNG, JPEG, BMP, TIFF or WebP image" in err[0]
 
 
 def test_detect_with_depth_of_another_size_is_one_line(

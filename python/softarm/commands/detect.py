@@ -19,7 +19,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p = sub.add_parser(
         "detect",
         help="find the berries in one photo (printed, and drawn with --out)",
-        description="Runs the berry detector on IMAGE (any format OpenCV reads) and prints "
+        description="Runs the berry detector on IMAGE (PNG, JPEG, BMP, TIFF or WebP) and prints "
         "each berry: its stage, score, centre and radius in pixels, and with --depth its "
         "position in the camera frame. --depth is a 16-bit PNG in millimetres or a .npy in "
         "metres, aligned with IMAGE; --camera a camera file (softarm JSON, OpenCV or ROS "
@@ -59,15 +59,20 @@ def run(args: argparse.Namespace) -> int:
     import numpy.typing as npt
 
     from softarm.errors import InputError
+    from softarm.files.images import read_image
+    from softarm.perception._inputs import MAX_FRAME_PIXELS
     from softarm.perception.detector.choice import detector
     from softarm.perception.detector.draw import draw_detections, write_image
     from softarm.perception.detector.evaluate import read_depth
     from softarm.perception.detector.scoring import stage_of_detection
     from softarm.vision.camera_model import CameraModel
 
-    image = cast(npt.NDArray[np.uint8] | None, cv2.imread(str(args.image), cv2.IMREAD_COLOR))
-    if image is None:
-        raise InputError(f"IMAGE {args.image}: not an image OpenCV can read")
+    # Bytes to OpenCV, never the path (a name that is not UTF-8 crashes cv2.imread), and
+    # the header's size checked before anything is decoded.
+    image = cast(
+        npt.NDArray[np.uint8],
+        read_image(args.image, "IMAGE", cv2.IMREAD_COLOR, max_pixels=MAX_FRAME_PIXELS),
+    )
     h, w = image.shape[:2]
     camera = (
         CameraModel.load(args.camera) if args.camera is not None

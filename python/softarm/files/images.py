@@ -7,7 +7,7 @@ fault. And ``imread`` decodes whatever size the header claims: a 1 MB PNG of
 file (:func:`~softarm.files.read.open_regular`: a regular file of bounded size), the
 header's size is checked against :data:`MAX_PIXELS` and :data:`MAX_DECODED_BYTES` before
 ``cv2.imdecode`` runs, and an image is written by ``cv2.imencode`` into a buffer that
-Python writes. Only PNG, JPEG, BMP and TIFF are read (the formats whose header is
+Python writes. Only PNG, JPEG, BMP, TIFF and WebP are read (the formats whose header is
 checked here); every failure is one line naming the file.
 
 ``cv2`` is imported by the functions that need it, so this leaf stays cheap to import.
@@ -53,8 +53,8 @@ _JPEG_SOF = set(range(0xC0, 0xD0)) - {0xC4, 0xC8, 0xCC}
 
 
 def image_header(data: bytes) -> tuple[int, int, int] | None:
-    """(width, height, bytes per pixel decoded) from a PNG, JPEG, BMP or TIFF header, or
-    None when ``data`` starts as none of them (or its header is cut short)."""
+    """(width, height, bytes per pixel decoded) from a PNG, JPEG, BMP, TIFF or WebP header,
+    or None when ``data`` starts as none of them (or its header is cut short)."""
     try:
         if data.startswith(_PNG):
             w, h, depth, colour = struct.unpack(">IIBB", data[16:26])
@@ -66,6 +66,8 @@ def image_header(data: bytes) -> tuple[int, int, int] | None:
             return abs(w), abs(h), 4
         if data[:4] in (b"II*\x00", b"MM\x00*"):
             return _tiff(data)
+        if data[:4] == b"RIFF" and data[8:12] == b"WEBP":
+            return _webp(data)
     except struct.error:  # a header cut short
         return None
     return None
@@ -91,6 +93,25 @@ def _jpeg(data: bytes) -> tuple[int, int, int] | None:
             return None
         at += 2 + struct.unpack(">H", data[at + 2 : at + 4])[0]
     return None
+
+
+def _webp(data: bytes) -> tuple[int, int, int] | None:
+    """The canvas of a WebP file's first chunk (RFC 9649): VP8X's 24-bit sizes less one,
+    VP8L's 14-bit sizes less one after its signature byte, VP8's 14-bit sizes after the
+    key frame's start code; 4 bytes a pixel (an alpha channel may come with any)."""
+    chunk = data[12:16]
+    if chunk == b"VP8X":
+        w = int.from_bytes(data[24:27], "little") + 1
+        h = int.from_bytes(data[27:30], "little") + 1
+    elif chunk == b"VP8L" and data[20:21] == b"\x2f":
+        (bits,) = struct.unpack("<I", data[21:25])
+        w, h = (bits & 0x3FFF) + 1, ((bits >> 14) & 0x3FFF) + 1
+    elif chunk == b"VP8 " and data[23:26] == b"\x9d\x01\x2a":
+        w, h = struct.unpack("<HH", data[26:30])
+        w, h = w & 0x3FFF, h & 0x3FFF
+    else:
+        return None
+    return w, h, 4
 
 
 def _tiff(data: bytes) -> tuple[int, int, int] | None:
@@ -130,7 +151,7 @@ def decode_image(
 
     header = image_header(data)
     if header is None:
-        raise error(f"cannot read {name}: not a PNG, JPEG, BMP or TIFF image")
+        raise error(f"cannot read {name}: not a PNG, JPEG, BMP, TIFF or WebP image")
     w, h, per_pixel = header
     if w == 0 or h == 0:  # refused here: libpng would print its own warnings
         raise error(f"cannot read {name}: its header says {w} x {h} pixels")

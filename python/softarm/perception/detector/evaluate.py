@@ -20,6 +20,8 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import InputError
+from softarm.files.images import read_image
+from softarm.perception._inputs import MAX_FRAME_PIXELS
 from softarm.perception.berries import DetectorSettings, _position
 from softarm.perception.detector.choice import BerryDetector
 from softarm.perception.detector.draw import draw_detections, write_image
@@ -32,23 +34,42 @@ __all__ = ["evaluate", "read_depth"]
 
 def read_depth(folder: Path, image: Path, shape: tuple[int, int]) -> npt.NDArray[np.float32] | None:
     """The depth (m, NaN unknown) of ``image`` in ``folder``, None when there is none of
-    its size."""
-    for suffix in (".png", ".npy"):
+    its size (or none that reads as a depth image)."""
+    for suffix, reader, per_metre in ((".png", _depth_png, 1000.0), (".npy", _depth_npy, 1.0)):
         path = folder / (image.stem + suffix)
         if not path.is_file():
             continue
-        if suffix == ".npy":
-            depth = np.load(path).astype(np.float32)
-        else:
-            raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-            if raw is None or raw.dtype != np.uint16:
-                continue
-            depth = raw.astype(np.float32) / 1000.0
-        if depth.shape != shape:
+        raw = reader(path)
+        if raw is None:
+            continue
+        if raw.shape != shape:
             return None
+        depth = np.array(raw, np.float32) / np.float32(per_metre)
         depth[~np.isfinite(depth) | (depth <= 0)] = np.nan
         return cast(npt.NDArray[np.float32], depth)
     return None
+
+
+def _depth_png(path: Path) -> npt.NDArray[Any] | None:
+    """A 16-bit PNG's millimetres, read as every image is (:mod:`softarm.files.images`:
+    bytes to OpenCV, the header's size checked first); None when it is no such image."""
+    try:
+        raw = read_image(path, "depth", cv2.IMREAD_UNCHANGED, max_pixels=MAX_FRAME_PIXELS)
+    except InputError:
+        return None
+    return raw if raw.dtype == np.uint16 and raw.ndim == 2 else None
+
+
+def _depth_npy(path: Path) -> npt.NDArray[Any] | None:
+    """A ``.npy`` of metres, mapped before it is read (its shape is checked before its
+    bytes are): a 2-D array of numbers, else None (no pickles, no broken files)."""
+    try:
+        raw = np.load(path, mmap_mode="r", allow_pickle=False)
+    except (OSError, ValueError, EOFError):
+        return None
+    if not isinstance(raw, np.ndarray) or raw.ndim != 2 or raw.dtype.kind not in "fiu":
+        return None
+    return raw
 
 
 def _camera(item: LabelledImage, camera: CameraModel | None) -> CameraModel:
@@ -104,9 +125,18 @@ def evaluate(
         raise InputError(f"labels {labels}: none of its images is in {images}")
     tally, per_image = Tally(), list[dict[str, Any]]()
     for item in items:
-        image = cast(npt.NDArray[np.uint8] | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
-        if image is None:
-            per_image.append({"image": item.path.name, "error": "unreadable"})
+        try:  # bytes to OpenCV, never the path; the header's size checked first
+            image = cast(
+                npt.NDArray[np.uint8],
+                read_image(item.path, "image", cv2.IMREAD_COLOR, max_pixels=MAX_FRAME_PIXELS),
+            )
+        except InputError as exc:
+            per_image.append({"image": item.path.name, "error": str(exc)})
+            continue
+        if image.shape[:2] != (item.height, item.width):  # the labels' masks would not fit
+            h, w = image.shape[:2]
+            size = f"is {w} x {h} pixels, its labels say {item.width} x {item.height}"
+            per_image.append({"image": item.path.name, "error": size})
             continue
         cam = _camera(item, camera)
         d = None if depth is None else read_depth(Path(depth), item.path, image.shape[:2])

@@ -25,6 +25,8 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import InputError
+from softarm.files.images import read_image
+from softarm.perception._inputs import MAX_FRAME_PIXELS
 
 __all__ = ["FRUIT_STAGES", "LabelledImage", "LabelledObject", "read_coco", "stage_of"]
 
@@ -108,8 +110,11 @@ class LabelledImage:
         name = self.record.get("instance_file")
         if not isinstance(name, str):
             return None
-        image = cv2.imread(str(self.folder / name), cv2.IMREAD_UNCHANGED)
-        if image is None or image.shape[:2] != (self.height, self.width):
+        try:  # bytes to OpenCV, never the path; the header's size checked first
+            image = read_image(self.folder / name, "instance file", cv2.IMREAD_UNCHANGED)
+        except InputError:
+            return None
+        if image.shape[:2] != (self.height, self.width):
             return None
         return np.asarray(image, np.uint16)
 
@@ -254,7 +259,14 @@ def _images(
         path = _find(folder, name)
         if path is None:
             continue
+        width, height = int(r["width"]), int(r["height"])
+        if width <= 0 or height <= 0 or width * height > MAX_FRAME_PIXELS:
+            # Its masks are drawn at this size: a made-up size must not allocate them.
+            raise ValueError(
+                f"image {name!r} is {width} x {height} pixels; an image has 1 to "
+                f"{MAX_FRAME_PIXELS} pixels"
+            )
         yield LabelledImage(
-            path, int(r["width"]), int(r["height"]), r,
+            path, width, height, r,
             tuple(by_image.get(int(r["id"]), [])), stages, label_folder,
         )  # fmt: skip

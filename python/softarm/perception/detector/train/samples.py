@@ -21,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softarm.errors import InputError
+from softarm.files.images import read_image
 from softarm.perception.detector.labels import LabelledImage, read_coco
 from softarm.perception.detector.network import CLASSES, MAX_SIDE
 from softarm.perception.detector.train.distance_target import distance_target
@@ -112,8 +113,11 @@ def boundary_target(
 def _sample(
     item: LabelledImage, max_side: int, zoom: float, boundary: bool = False, distance: bool = False
 ) -> Sample | None:
-    image = cast(_U8 | None, cv2.imread(str(item.path), cv2.IMREAD_COLOR))
-    if image is None or image.shape[:2] != (item.height, item.width):
+    try:  # bytes to OpenCV, never the path; the header's size checked first
+        image = cast(_U8, read_image(item.path, "image", cv2.IMREAD_COLOR))
+    except InputError:
+        return None
+    if image.shape[:2] != (item.height, item.width):
         return None
     h, w = image.shape[:2]
     scale = min(1.0, max_side / max(h, w))
