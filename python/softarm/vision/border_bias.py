@@ -23,6 +23,7 @@ normal, is ``-d * (2 * cells - 2) / cells``.
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 import cv2
 import numpy as np
@@ -59,6 +60,7 @@ def border_bias(
     cells: int,
     offsets: FloatArray,
     outward: FloatArray,
+    locate: Callable[[FloatArray, FloatArray, FloatArray], FloatArray] | None = None,
 ) -> float:
     """The marker's edge bias (px, towards the paper; negative: towards the ink), from
     its border's inner edge, shrunk by SHRINK_SE standard errors; 0 when it cannot be
@@ -82,6 +84,8 @@ def border_bias(
     white = fall > _WHITE_SHARE * _quantile(np.abs(fall), 0.9)
     mid = 0.5 * (offsets[1:] + offsets[:-1])
     measured = (grad @ mid) / np.where(white, -fall, 1.0)
+    if locate is not None and np.any(white):
+        measured[white] = locate(prof[white], offsets, measured[white])
     usable = white & (np.abs(measured) < offsets[-1])
     if usable.sum() < MIN_INNER_PROFILES:
         return 0.0

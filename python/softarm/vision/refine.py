@@ -27,6 +27,7 @@ import numpy.typing as npt
 from softarm.vision._checks import FloatArray
 from softarm.vision.border_bias import border_bias
 from softarm.vision.camera_model import CameraModel
+from softarm.vision.edge_fit import fit_edges
 
 _STEP = 0.25  # px between profile samples across an edge
 _MAX_REACH = 4.0  # px: the widest half-profile across an edge
@@ -45,6 +46,10 @@ CLIP_HIGH = 254.5
 #: The share of a marker's profile samples that must be clipped for the bias to be
 #: measured (a crushed ink or a saturated paper clips 1-30 % of them on the row).
 CLIPPED_SHARE = 0.002
+#: Each profile's edge fitted by a blurred step (:mod:`softarm.vision.edge_fit`) instead
+#: of the gradient's centroid, on markers whose profiles read no clipped pixel (a
+#: clipped one keeps the centroid and the border's bias).
+EDGE_FIT = False
 #: Pixels beyond the corners' bounding box that one pass of the refinement reads (the
 #: half-profile, one for the bilinear neighbour, one for rounding).
 READ_MARGIN = int(_MAX_REACH) + 2
@@ -147,6 +152,10 @@ def _refined(
     good = ok_edge & (np.abs(shift) < reach)
     if np.any(np.bincount(side[good], minlength=4) < 4):
         return None
+    clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
+    unclipped = clipped < CLIPPED_SHARE * prof[good].size
+    if EDGE_FIT:
+        shift[good] = fit_edges(prof[good], offsets, shift[good])[0]
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
     fit = _fit_lines_trimmed if robust else _fit_lines
@@ -154,8 +163,7 @@ def _refined(
     pix = _corners(centre, direction, camera, quad, max_shift)
     if pix is None:
         return None
-    clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
-    if clipped < CLIPPED_SHARE * prof[good].size:
+    if unclipped:
         return pix  # nothing clipped (a stray noisy pixel aside): the centroid is unbiased
     # Ink to quiet zone along each side's normal: the sign of its profiles' step.
     step = np.sign(np.bincount(side, np.sign(wsum[good]), 4))
@@ -181,7 +189,8 @@ def _unbiased(
     moved back by the bias the marker's border measures
     (:func:`~softarm.vision.border_bias.border_bias`); ``pix`` when it measures none or
     the moved corners fail."""
-    bias = border_bias(crop, crop_origin, pix, cells, offsets, outward)
+    locate = _fitted if EDGE_FIT else None
+    bias = border_bias(crop, crop_origin, pix, cells, offsets, outward, locate)
     if bias == 0.0:
         return pix
     # Every edge point of a side moved alike moves its line, not its direction. A shift
@@ -248,3 +257,8 @@ def _fit_lines_trimmed(
     if np.any(np.bincount(side[keep], minlength=4) < 4):
         return centre, direction
     return _fit_lines(points[keep], side[keep])
+
+
+def _fitted(profiles: FloatArray, offsets: FloatArray, start: FloatArray) -> FloatArray:
+    """The border's inner edges located as the outer ones are (:func:`fit_edges`)."""
+    return fit_edges(profiles, offsets, start)[0]
