@@ -41,7 +41,7 @@ def add_split_touching(p: argparse.ArgumentParser) -> None:
         "--split-touching",
         action="store_true",
         help="split fruit that touch at the necks of their shape (more of a cluster's fruit "
-        "found, some precision lost; docs/perception.md, 'Splitting touching fruit')",
+        "found, some precision lost; docs/perception-candidates.md, 'Splitting touching fruit')",
     )
 
 

@@ -87,7 +87,7 @@ class DetectorSettings:
     #: distance map (:mod:`softarm.perception.detector.touching`) where True, else at the
     #: network's centre heatmap peaks. An option: on the held-out sets it found more ripe
     #: fruit in every look of the row but cost precision in the bush world
-    #: (docs/perception.md, "Splitting touching fruit").
+    #: (docs/perception-candidates.md, "Splitting touching fruit").
     split_touching: bool = False
     #: The colour rule's ripe blobs split the same way before the shape tests, where
     #: True (an option: more ripe fruit found, precision lost in sun and dusk).

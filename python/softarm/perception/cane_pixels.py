@@ -147,7 +147,7 @@ def matched_disparity(
     thinned and thinned out can fail the fit's evidence. But a tie does not say which
     side is right: of the pixels the rule returns there, about as many lie beyond the
     range (30–48 % in the row) as are near canes' pixels matched right (28–35 %), and
-    with it the far budget is less precise (docs/perception.md, "Ties between the range
+    with it the far budget is less precise (docs/perception-candidates.md, "Ties between the range
     and beyond")."""
     if match_far is None or match_far <= depth_range[1]:
         return stereo_disparity(left, right, rect, mask, depth_range, smoothness)
