@@ -23,6 +23,8 @@ parts of the camera model off, to tell which of them the error comes from;
 ``--frames N`` renders each pose's window N times, the camera model's noise drawn anew
 each time, and adds the error of the mean of the N positions (what of the error is the
 frame's own, which a filter over still frames would average down);
+``--edge-fit`` locates the markers' edges by the blurred-step fit instead of the
+gradient's centroid (``softarm.vision.refine.EDGE_FIT``, :mod:`softarm.vision.edge_fit`);
 ``--by-angle`` prints the figures by approach angle as well (:data:`ANGLE_BINS`: the
 angle between C1's line of sight and the paper cube's best-facing tag, whichever body
 is drawn), ``--json FILE`` writes them all, ``--into FILE`` puts them into FILE with
@@ -91,6 +93,7 @@ def track_cubes(
     body: str = "cube",
     without: tuple[str, ...] = (),
     frames: int = 1,
+    edge_fit: bool = False,
 ) -> dict[str, Any]:
     """Position errors (mm) of the marker body ``body`` tracked in C1 over ``poses`` arm
     poses per seed, the share of poses where it was found, the mean time (ms) to render
@@ -100,14 +103,24 @@ def track_cubes(
     ``"by_angle"`` holds the same by approach angle (:func:`by_angle`). ``frames`` > 1
     renders each pose's window that many times (the row's camera model draws its noise
     anew each time) and adds :func:`over_frames`' figures: how much of the error is the
-    frame's own, which a tracker's filter over still frames would average down."""
-    found, seconds, sides = _tracked(seeds, poses, side, look, body, without, frames)
+    frame's own, which a tracker's filter over still frames would average down.
+    ``edge_fit``: the edges located by the blurred-step fit (``refine.EDGE_FIT``) for
+    this call."""
+    from softarm.vision import refine
+
+    kept = refine.EDGE_FIT
+    refine.EDGE_FIT = edge_fit
+    try:
+        found, seconds, sides = _tracked(seeds, poses, side, look, body, without, frames)
+    finally:
+        refine.EDGE_FIT = kept
     errors = [p.error for p in found if p.error is not None]
     unhidden = [p.error for p in found if p.error is not None and p.share >= UNHIDDEN]
     hidden = [p.error for p in found if p.error is not None and p.share < UNHIDDEN]
     trusted = [p.error for p in found if p.error is not None and p.consistent]
     return {
         "body": body,
+        "edge": "fit" if edge_fit else "centroid",
         "poses": len(found),
         "found": len(errors),
         "median_mm": _median(errors),
@@ -306,6 +319,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--frames", type=int, default=1, help="windows rendered at each pose (noise drawn anew)"
     )
+    p.add_argument(
+        "--edge-fit", action="store_true", help="edges by the blurred-step fit, not the centroid"
+    )
     p.add_argument("--json", metavar="FILE", help="write the figures as JSON to FILE")
     p.add_argument("--into", metavar="FILE", help="put the figures into the JSON file FILE")
     args = p.parse_args(argv)
@@ -313,7 +329,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.frames < 1:
         p.error(f"--frames must be at least 1, got {args.frames}")
     result = track_cubes(
-        args.seeds, args.poses, args.side, args.look, args.marker_body, without, args.frames
+        args.seeds,
+        args.poses,
+        args.side,
+        args.look,
+        args.marker_body,
+        without,
+        args.frames,
+        args.edge_fit,
     )
     if without:
         result["without"] = list(without)
