@@ -108,6 +108,9 @@ class HarvestConfig:
             mid_band``; 0.5: as far as the pose allows). Off (0) by default: on the slow
             plant's fresh seeds 13 of 20 were slower with it, its quicker placement lost
             to fine positioning (docs/harvest.md, "Pre-grasp poses off the limits").
+        play_skip: with it above 0, a channel whose fine-positioning command has moved
+            the same way for this many periods inside the lag model's play band is put at
+            the band's edge (``softarm.harvest.machine.stages.play_skip``); 0: off.
     """
 
     period: float = 0.05
@@ -142,6 +145,7 @@ class HarvestConfig:
     lead_cap: float = 1.5
     transport_margin: float = 0.01
     plan_band: float = 0.0
+    play_skip: int = 0
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
@@ -173,7 +177,9 @@ class HarvestConfig:
             and abs(float(np.linalg.norm(a)) - 1.0) <= 1e-9
         ):
             raise ParameterError(f"approach must be a unit vector (3 numbers), got {a!r}")
-        for name, least in (("settle_steps", 1), ("reapproaches", 0), ("fine_window", 2)):
+        for name, least in (
+            ("settle_steps", 1), ("reapproaches", 0), ("fine_window", 2), ("play_skip", 0),
+        ):  # fmt: skip
             n = getattr(self, name)
             if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < least:
                 raise ParameterError(f"{name} must be an integer >= {least}, got {n!r}")

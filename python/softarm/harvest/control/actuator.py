@@ -117,6 +117,14 @@ class SafeActuator:
         self._catch_up()
         return self._model.arm_in_flight()
 
+    def play_band(self) -> tuple[FloatArray, FloatArray] | None:
+        """The lag model's play output now and its band widths (m; None without a lag
+        model): a channel commanded within half a width of its output does not move."""
+        if self._model is None:
+            return None
+        self._catch_up()
+        return self._model.play_band()
+
     def send(self, q: FloatArray) -> FloatArray:
         """Command elongations ``q`` (m); returns :attr:`sent`. A NaN raises before
         anything is sent."""

@@ -119,6 +119,11 @@ class MeasurementModel:
         """What the measured pose reflects now (m): ŷ."""
         return np.asarray(self._filter.q) if self._filter is not None else self._arm.copy()
 
+    def play_band(self) -> tuple[FloatArray, FloatArray]:
+        """The play's output now and its band widths (m): a command within half a width of
+        the output moves nothing."""
+        return self._arm.copy(), self._play.copy()
+
     def advance(self, drive: FloatArray) -> None:
         """One period with ``drive`` (m, the regulators' command, boost included) held."""
         if self._regulators is not None:

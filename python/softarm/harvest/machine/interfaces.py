@@ -150,3 +150,7 @@ class PressureActuator(Protocol):
         """The motion (m) the arm will still make towards the last q sent, by a lag model
         of the actuators; None when there is none (the arm is taken to be there)."""
         ...
+
+    def play_band(self) -> tuple[FloatArray, FloatArray] | None:
+        """The lag model's play output now and its band widths (m); None without one."""
+        ...

@@ -22,6 +22,7 @@ from softarm.harvest.machine.stages.end_rules import (
 )
 from softarm.harvest.machine.stages.goal import Aim, Progress, ServoGoal
 from softarm.harvest.machine.stages.jumps import JumpCounter
+from softarm.harvest.machine.stages.play_skip import PlaySkip
 from softarm.harvest.machine.states import HarvestState
 from softarm.harvest.machine.targets import grasp_point, pointing_error, tool_pose
 
@@ -45,6 +46,7 @@ class BerryLoop:
         watch.excuse_berry(start)  # the open-loop ramp needed no berry
         progress = Progress(start)
         jumps = None if goal.give_up is None else JumpCounter()
+        skip = self._play_skip(stage)
         last: Aim | None = None  # this stage's last measured aim
         while True:
             try:
@@ -67,14 +69,29 @@ class BerryLoop:
             if ended is not None:
                 return ended
             if jumps is not None:
-                self._count_jump(jumps, seen, aim, axis, goal.distance)
+                self._count_jump(jumps, seen, aim, axis, goal.distance, skip is not None)
                 jumpy(self.link, stage, seen, q, aim, jumps.jumps, goal)
             q_next, saturated = self._loop_step(q, aim.goal, seen.pose)
+            if skip is not None:
+                q_next = self._skip_play(skip, q, q_next, seen.t)
             progress.update(seen.t, aim.error, saturated, self.link.cfg.stall_progress)
             if progress.stalled(seen.t, self.link.cfg.stall_time):
                 return stalled(self.link, stage, seen, q, axis, aim, goal)
             watch.log_step(stage, seen, q_next, aim.goal, (aim.error, aim.pointing), saturated)
             q = self.link.hold(q_next)  # goes on from what was sent
+
+    def _play_skip(self, stage: HarvestState) -> PlaySkip | None:
+        """Fine positioning's :class:`PlaySkip` with ``[harvest] play_skip`` set."""
+        periods = self.link.cfg.play_skip
+        return PlaySkip(periods) if periods and stage is HarvestState.FINE_POSITIONING else None
+
+    def _skip_play(self, skip: PlaySkip, q: FloatArray, q_next: FloatArray, t: float) -> FloatArray:
+        """``q_next`` with the channels creeping through the play moved to its edge (logged
+        as ``play_skip``)."""
+        moved, channels = skip.step(q, q_next, self.link.actuator.play_band())
+        if channels:
+            self.link.log.event("play_skip", t=t, channels=channels)
+        return moved
 
     def _aim(self, seen: Observation, axis: FloatArray, distance: float) -> Aim:
         """The grasp point, not the end-effector origin, is servoed onto its goal
@@ -88,16 +105,23 @@ class BerryLoop:
         return Aim(goal, error, pointing_error(seen.pose, axis))
 
     def _count_jump(
-        self, jumps: JumpCounter, seen: Observation, aim: Aim, axis: FloatArray, distance: float
-    ) -> None:
+        self, jumps: JumpCounter, seen: Observation, aim: Aim, axis: FloatArray, distance: float,
+        through_play: bool = False,
+    ) -> None:  # fmt: skip
         """Give ``jumps`` this step's measured offset of the grasp point from its goal and
         where the model puts the grasp point at the lag model's q (the q sent less the
-        motion in flight); a jump is logged (``measurement_jump``)."""
+        motion in flight; ``through_play``: the lag model's play output, where the
+        regulators' pressure is not yet the arm's: a command moved across the band by
+        :class:`PlaySkip` moves the pressure, not the arm); a jump is logged
+        (``measurement_jump``)."""
         assert seen.pose is not None and seen.fix is not None
         offset = self.link.cfg.grasp_offset
         point = seen.fix.position - (distance - offset) * axis
         flight = self.link.actuator.in_flight()
         q_arm = self.link.actuator.sent - (0.0 if flight is None else flight)
+        band = self.link.actuator.play_band() if through_play else None
+        if band is not None:
+            q_arm = band[0]
         model = grasp_point(self.link.controller.model_pose(q_arm), offset)
         before = jumps.jumps
         residual = jumps.see(grasp_point(seen.pose, offset) - point, model)
