@@ -38,6 +38,13 @@ ITERATIONS = 4
 #: The ramp's blur (px) a fit may end with: narrower is a single noisy sample, wider no
 #: edge the profile can fix; a profile fitted outside is refused.
 BLUR_RANGE = (0.15, 3.0)
+#: The fitted ramp, ``COVER`` blurs to either side of the edge, must lie within the
+#: profile: where one level is not seen (a detection's line off the edge by half a
+#: pixel on a +-2 px profile) the fit extrapolates it and trades it for the edge's
+#: position (on the bush's small tags 0.3 px off the centroid, either way).
+COVER = 2.5
+#: A fitted step under this many times the fit's rms residual is noise, not an edge.
+MIN_STEP = 4.0
 _SQRT_2PI = float(np.sqrt(2.0 * np.pi))
 
 
@@ -48,8 +55,9 @@ def fit_edges(
 ) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
     """The edge's offset on each of the (N, m) ``profiles`` sampled at ``offsets`` (m,
     px), fitted by a blurred step from ``start`` (N, px: the centroid's), and which fits
-    converged to an edge within the profile (``|c| <`` the profile's reach, blur within
-    :data:`BLUR_RANGE`); a refused profile keeps ``start``."""
+    converged to an edge whose ramp lies within the profile (``|c| + COVER * s`` within
+    its reach, blur within :data:`BLUR_RANGE`, a step over :data:`MIN_STEP` times the
+    residual); a refused profile keeps ``start``."""
     y = np.asarray(profiles, dtype=np.float64)
     x = np.asarray(offsets, dtype=np.float64)[None, :]
     reach = float(np.max(np.abs(offsets)))
@@ -87,7 +95,10 @@ def fit_edges(
         c = c + np.clip(step[:, 0], -0.5, 0.5)
         s = np.clip(s + np.clip(step[:, 1], -0.2 * s, 0.2 * s), 0.5 * BLUR_RANGE[0], 4.0)
         a, b = a + step[:, 2], b + step[:, 3]
-    ok = (np.abs(c) < reach) & (s >= BLUR_RANGE[0]) & (s <= BLUR_RANGE[1]) & np.isfinite(c)
+    residual = y - (a[:, None] + b[:, None] * ndtr((x - c[:, None]) / s[:, None]))
+    rms = np.sqrt(np.mean(residual * residual, axis=1))
+    ok = (np.abs(c) + COVER * s <= reach) & (s >= BLUR_RANGE[0]) & (s <= BLUR_RANGE[1])
+    ok &= np.abs(b) > MIN_STEP * rms
     return np.where(ok, c, begin), ok
 
 

@@ -20,6 +20,8 @@ are fitted again.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import cv2
 import numpy as np
 import numpy.typing as npt
@@ -154,7 +156,8 @@ def _refined(
         return None
     clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
     unclipped = clipped < CLIPPED_SHARE * prof[good].size
-    if EDGE_FIT:
+    fitted = EDGE_FIT
+    if fitted:
         shift[good] = fit_edges(prof[good], offsets, shift[good])[0]
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
@@ -170,7 +173,10 @@ def _refined(
     if np.any(step == 0):
         return pix
     outward = normals * step[:, None]
-    return _unbiased(crop, lo, pix, cells, offsets, outward, centre, direction, camera, max_shift)
+    locate = _fitted if fitted else None
+    return _unbiased(
+        crop, lo, pix, cells, offsets, outward, centre, direction, camera, max_shift, locate
+    )
 
 
 def _unbiased(
@@ -184,12 +190,13 @@ def _unbiased(
     direction: FloatArray,
     camera: CameraModel,
     max_shift: float,
+    locate: Callable[[FloatArray, FloatArray, FloatArray], FloatArray] | None = None,
 ) -> FloatArray:
     """The corners ``pix`` with the sides' lines (normalised: ``centre``, ``direction``)
     moved back by the bias the marker's border measures
     (:func:`~softarm.vision.border_bias.border_bias`); ``pix`` when it measures none or
-    the moved corners fail."""
-    locate = _fitted if EDGE_FIT else None
+    the moved corners fail. ``locate``: how the border's inner edges are located (as
+    the outer ones were: :func:`_fitted`, or None for the centroid)."""
     bias = border_bias(crop, crop_origin, pix, cells, offsets, outward, locate)
     if bias == 0.0:
         return pix
