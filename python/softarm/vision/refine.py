@@ -16,6 +16,12 @@ millimetre or more in a marker body's pose. Where a marker's profiles read clipp
 pixels, that bias is measured on the marker's own black border
 (:mod:`softarm.vision.border_bias`) and the edges are moved back by it before the lines
 are fitted again.
+
+``EDGE_FIT`` (off) locates each profile's edge by a least-squares blurred-step fit
+instead (:mod:`softarm.vision.edge_fit`), the border's inner edges too where the bias
+is measured: under a camera's noise and JPEG its spread is under the centroid's, but on
+sharp, clean edges (the bush's renders) it is biased by up to a few hundredths of a
+pixel (docs/perception.md, "The edge by a blurred-step fit").
 """
 
 from __future__ import annotations
@@ -156,8 +162,7 @@ def _refined(
         return None
     clipped = np.count_nonzero((prof[good] <= CLIP_LOW) | (prof[good] >= CLIP_HIGH))
     unclipped = clipped < CLIPPED_SHARE * prof[good].size
-    fitted = EDGE_FIT
-    if fitted:
+    if EDGE_FIT:
         shift[good] = fit_edges(prof[good], offsets, shift[good])[0]
     edge = centre_px[good] + shift[good, None] * normal[good]
     side = side[good]
@@ -173,7 +178,7 @@ def _refined(
     if np.any(step == 0):
         return pix
     outward = normals * step[:, None]
-    locate = _fitted if fitted else None
+    locate = _fitted if EDGE_FIT else None  # the inner edges as the outer ones
     return _unbiased(
         crop, lo, pix, cells, offsets, outward, centre, direction, camera, max_shift, locate
     )
