@@ -19,8 +19,12 @@ fix the levels and the ramp's fix ``c``: its Cramer-Rao bound, for pixel-spaced 
 of independent noise, is ``var(c) >= 2 sqrt(pi) s sigma**2 / b**2`` (the Fisher
 information ``sum (b phi(z) / s)**2 / sigma**2 ~ b**2 / (2 sqrt(pi) s sigma**2)``),
 under the centroid's by ``W / (2 sqrt(pi) s)``: about 2-3x in variance for an 8 px
-profile and a 1-1.5 px ramp. For a symmetric edge both are unbiased; the model's
-mismatch with the true ramp is symmetric about the edge and moves ``c`` by little.
+profile and a 1-1.5 px ramp; on a synthetic edge through the row camera's noise and
+JPEG the fit reaches it. The price is the model: the centroid (the gradient's first
+moment) finds the middle of any ramp symmetric about the edge, the fit only of one
+shaped like its model. The bush's rendered tags (clean kinked ramps about 3 px wide, the
+ink at 0) are not, and the fit moves stretches of a side by 0.01-0.04 px there
+(docs/perception.md, "The edge by a blurred-step fit"): hence an option.
 """
 
 from __future__ import annotations
