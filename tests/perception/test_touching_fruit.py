@@ -19,7 +19,8 @@ from softarm.perception.detector.touching import NECK, _distance, disc_seeds, sp
 from softarm.vision.camera_model import CameraModel
 
 CAMERA = CameraModel.ideal(600.0, W, H)
-#: The split is an option (off by default: docs/perception-candidates.md, "Splitting touching fruit").
+#: The split is an option (off by default: docs/perception-candidates.md, "Splitting touching
+#: fruit").
 SPLIT = DetectorSettings(split_touching=True, split_colour_blobs=True)
 
 
