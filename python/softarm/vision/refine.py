@@ -55,8 +55,10 @@ CLIP_HIGH = 254.5
 #: measured (a crushed ink or a saturated paper clips 1-30 % of them on the row).
 CLIPPED_SHARE = 0.002
 #: Each profile's edge fitted by a blurred step (:mod:`softarm.vision.edge_fit`) instead
-#: of the gradient's centroid, on markers whose profiles read no clipped pixel (a
-#: clipped one keeps the centroid and the border's bias).
+#: of the gradient's centroid; on a marker whose profiles read clipped pixels, the
+#: border's inner edges too, so that the bias it measures is the fit's own. Off: on the
+#: bush's clean renders the fit is biased (docs/perception.md, "The edge by a
+#: blurred-step fit").
 EDGE_FIT = False
 #: Pixels beyond the corners' bounding box that one pass of the refinement reads (the
 #: half-profile, one for the bilinear neighbour, one for rounding).
