@@ -107,12 +107,13 @@ class HarvestConfig:
             its limits, up to this fraction of the range (``softarm.harvest.control.
             mid_band``; 0.5: as far as the pose allows). Off (0) by default: on the slow
             plant's fresh seeds 13 of 20 were slower with it, its quicker placement lost
-            to fine positioning (docs/harvest.md, "Pre-grasp poses off the limits").
+            to fine positioning (docs/harvest-candidates.md, "Pre-grasp poses off the limits").
         play_skip: with it above 0, a channel whose fine-positioning command has moved
             the same way for this many periods inside the lag model's play band is put at
             the band's edge (``softarm.harvest.machine.stages.play_skip``); 0: off (the
             default: on the slow plant's fresh seeds 7.32 -> 7.20 s a berry at 5, the
-            nominal plant unchanged; docs/harvest.md, "Fine positioning across the play").
+            nominal plant unchanged; docs/harvest-candidates.md, "Fine positioning across
+            the play").
     """
 
     period: float = 0.05

@@ -16,7 +16,7 @@ and about equally well at the grasp in the bush: C1's ray misses the berry's cen
 weighted by each one's inverse variance there. The harvest does not weigh them (its fix
 stays on C2's ray): in the bush the weighing took the bias's median down and not the
 grasps over 0.5 mm, and on two rows, whose rays' spreads were not measured, more grasps
-ended over 0.5 mm (docs/harvest.md, "The fix weighed between the two rays").
+ended over 0.5 mm (docs/harvest-candidates.md, "The fix weighed between the two rays").
 
 C2's ray reaches the base frame through the tracked end effector (eq. 21), and so
 does the gripper (eq. 22): an error of the cube tracking moves the fix and the

@@ -16,7 +16,7 @@ With a ``band`` (``[harvest] plan_band``, off by default), each solution is firs
 along its pose's null space so that the actuator nearest a limit has as much room as the
 pose allows (:mod:`.mid_band`): a regulator driven towards 0 or 70 psi cannot be driven
 harder, and on a slow plant that one channel sets the time of a move. Measured on the
-slow plant's fresh seeds, it did not make the berries quicker (docs/harvest.md,
+slow plant's fresh seeds, it did not make the berries quicker (docs/harvest-candidates.md,
 "Pre-grasp poses off the limits").
 """
 

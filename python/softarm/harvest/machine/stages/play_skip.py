@@ -7,7 +7,7 @@ width away). The lag model knows the band (docs/control.md §6), so it has nothi
 flight there, and the loop integrates the measured error at its gain: near the berry
 the error is under a millimetre and the command creeps a few hundredths of a psi a
 period through a band of several psi (4.2 s on the slow plant's diagnosis seed 1531,
-docs/harvest.md "Pre-grasp poses off the limits"). Here, once a channel's command has
+docs/harvest-candidates.md "Pre-grasp poses off the limits"). Here, once a channel's command has
 moved the same way for ``periods`` periods in a row while still inside the band, it is
 put at the band's edge in that direction, plus this period's step: what the creep would
 reach, at once. At the edge itself the output does not move, so the jump cannot
