@@ -8,15 +8,21 @@ creep's time without overshoot; a bad value is one typed error naming the key.""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from softarm.errors import ParameterError
+from softarm.harvest import simulate
 from softarm.harvest.control.plant_model import MeasurementModel
 from softarm.harvest.machine.stages.play_skip import PlaySkip
 from softarm.harvest_config import HarvestConfig
 from softarm.sim.hysteresis import PlayHysteresis
+from softarm.sim.plant_file import load_plant_file
 
+SLOW_PLANT = Path(__file__).parents[2] / "examples" / "plants" / "slow_arm.toml"
 W = 0.0024  # a 5 psi band, in elongation (m)
 BAND = (np.zeros(2), np.full(2, W))  # the play output at 0 on both channels
 
@@ -97,3 +103,26 @@ def test_a_loop_through_the_play_reaches_its_goal_sooner_without_overshoot() -> 
 def test_a_bad_play_skip_is_a_typed_error_naming_it(value: object) -> None:
     with pytest.raises(ParameterError, match="play_skip"):
         HarvestConfig(play_skip=value)  # type: ignore[arg-type]
+
+
+def _slow_berry(tmp_path: Path, periods: int) -> tuple[float, set[str]]:
+    """The first berry of bush 1531 on the slow plant (a channel that reversed on the way
+    in creeps through the 5 psi band in fine positioning): its time (s) and the states
+    of the periods in which a channel was put at the band's edge."""
+    log = tmp_path / f"run{periods}.jsonl"
+    config = HarvestConfig(play_skip=periods)
+    plant = load_plant_file(SLOW_PLANT)
+    report = simulate(1, 1531, log=log, plant=plant, config=config, marker_body="frustum")
+    assert report.berries[0].harvested
+    rows = [json.loads(line) for line in log.read_text().splitlines()]
+    state = {r["t"]: r["state"] for r in rows if r["kind"] == "step"}
+    return report.berries[0].duration_s, {state[r["t"]] for r in rows if r["kind"] == "play_skip"}
+
+
+def test_on_the_slow_plant_only_fine_positioning_skips_and_the_berry_is_quicker(
+    tmp_path: Path,
+) -> None:
+    creep, none = _slow_berry(tmp_path, 0)
+    skipped, states = _slow_berry(tmp_path, 5)
+    assert none == set() and states == {"fine_positioning"}
+    assert skipped < creep - 1.0
