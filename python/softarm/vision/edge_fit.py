@@ -75,23 +75,16 @@ def fit_edges(
     spread = np.sum(g * (mid - c[:, None]) ** 2, axis=1) / np.where(total != 0, total, 1.0)
     s = np.sqrt(np.clip(spread, BLUR_RANGE[0] ** 2, 4.0))
     a, b = _levels(y, x, c, s)
-    m = float(y.shape[1])
     for _ in range(ITERATIONS):
         z = (x - c[:, None]) / s[:, None]
         cdf = ndtr(z)
         residual = y - (a[:, None] + b[:, None] * cdf)
         slope = (-b / (_SQRT_2PI * s))[:, None] * np.exp(-0.5 * z * z)  # d f / d c
-        cols = (slope, slope * z, cdf)  # d f / d c, d f / d s, d f / d b; d f / d a = 1
-        normal = np.empty((c.size, 4, 4))
-        rhs = np.empty((c.size, 4))
-        for i, ci in enumerate(cols):
-            k = (0, 1, 3)[i]
-            for j in range(i, 3):
-                normal[:, k, (0, 1, 3)[j]] = normal[:, (0, 1, 3)[j], k] = np.sum(ci * cols[j], 1)
-            normal[:, k, 2] = normal[:, 2, k] = ci.sum(axis=1)
-            rhs[:, k] = np.sum(ci * residual, axis=1)
-        normal[:, 2, 2] = m
-        rhs[:, 2] = residual.sum(axis=1)
+        # The Jacobian (N, m, 4) in (c, s, a, b): d f / d s = slope z, d f / d a = 1,
+        # d f / d b = the ramp; the normal equations J^T J step = J^T r, batched.
+        jac = np.stack((slope, slope * z, np.ones_like(cdf), cdf), axis=2)
+        normal = np.matmul(jac.transpose(0, 2, 1), jac)
+        rhs = np.matmul(jac.transpose(0, 2, 1), residual[:, :, None])[:, :, 0]
         # A little Levenberg damping keeps a flat profile's singular system solvable.
         normal += 1e-6 * np.einsum("nii->ni", normal)[:, :, None] * np.eye(4) + 1e-9 * np.eye(4)
         step = np.linalg.solve(normal, rhs[:, :, None])[:, :, 0]
