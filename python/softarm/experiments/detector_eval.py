@@ -15,7 +15,10 @@ time per image is the detector's alone (one OpenCV thread, median over the folde
 distance map (:data:`SPLIT`; docs/data/detector_eval_touching.json). ``--raw-candidate``
 adds the candidate decoded without its heatmap's fragment rule
 (:mod:`softarm.perception.detector.fragments`) beside it
-(docs/data/detector_eval_fragments*.json)."""
+(docs/data/detector_eval_fragments*.json). ``--split-by-size`` adds each ``+depth``
+candidate with merged fruit split by the size depth expects
+(:mod:`softarm.perception.detector.size_split`) as ``...+depth+size`` rows, in the same
+run (docs/data/detector_eval_size_split.json)."""
 
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ import argparse
 import json
 import time
 from collections.abc import Sequence
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -38,7 +41,17 @@ from softarm.perception.detector.learned import ConfirmedDetector, LearnedDetect
 from softarm.perception.detector.misses import fruit_cases, miss_table
 from softarm.perception.detector.network import STRIDE, boundary_of, distance_of, heatmap_of
 
-__all__ = ["CANDIDATE", "RAW", "SPLIT", "WITH_DEPTH", "candidates", "main", "run", "table"]
+__all__ = [
+    "CANDIDATE",
+    "RAW",
+    "SIZE",
+    "SPLIT",
+    "WITH_DEPTH",
+    "candidates",
+    "main",
+    "run",
+    "table",
+]
 
 _SHOWN = ("precision", "ripe_precision", "recall_ripe", "recall", "stage_right")
 
@@ -104,6 +117,11 @@ SPLIT = DetectorSettings(split_touching=True, split_colour_blobs=True)
 RAW = "cand-raw"
 
 
+#: The suffix of a ``+depth`` candidate's rows with merged fruit split by the size depth
+#: expects (``--split-by-size``: ``DetectorSettings.split_by_size``).
+SIZE = "+size"
+
+
 def _figures(
     det: BerryDetector, folder: Path, with_depth: bool, settings: DetectorSettings | None
 ) -> dict[str, Any]:
@@ -121,11 +139,14 @@ def run(
     max_side: int | None = None,
     settings: DetectorSettings | None = None,
     raw: bool = False,
+    size: bool = False,
 ) -> dict[str, Any]:
     """{condition: {candidate: figures}} with ``ms_per_image``; a ``+depth`` candidate
     reads each folder's ``depth/``; every detector run with ``settings`` (None: the
     default); with ``raw`` and ``weights``, the candidate alone and with both checks
-    also without the fragment rule (rows :data:`RAW` and ``RAW+colour+depth``)."""
+    also without the fragment rule (rows :data:`RAW` and ``RAW+colour+depth``); with
+    ``size``, every ``+depth`` candidate also with ``split_by_size`` (rows
+    ``...+depth`` :data:`SIZE`)."""
     cv2.setNumThreads(1)
     out: dict[str, Any] = {}
     for name, folder in conditions.items():
@@ -140,6 +161,11 @@ def run(
                     det, with_depth = dets[cand]
                     row = RAW + cand[len(CANDIDATE) :]
                     out[name][row] = _figures(det, folder, with_depth, settings)
+        if size:
+            sized = replace(settings or DetectorSettings(), split_by_size=True)
+            for cand, (det, with_depth) in dets.items():
+                if with_depth:
+                    out[name][cand + SIZE] = _figures(det, folder, True, sized)
     return out
 
 
@@ -192,6 +218,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         help="also score the candidate (alone and with both checks) without its heatmap's "
         f"fragment rule, as {RAW} rows",
     )  # fmt: skip
+    p.add_argument(
+        "--split-by-size", action="store_true",
+        help="also score each +depth candidate with merged fruit split by the size its "
+        f"depth expects, as ...+depth{SIZE} rows",
+    )  # fmt: skip
     p.add_argument("--note", default="", help="a line stored with the figures")
     p.add_argument("--out", type=Path, help="JSON file for the figures")
     p.add_argument(
@@ -215,13 +246,14 @@ def main(argv: Sequence[str] | None = None) -> None:
         cv2.setNumThreads(1)
         print(miss_table([c for f in conditions.values() for c in fruit_cases(net, f)]))
         return
-    results = run(conditions, a.weights, a.max_side, settings, a.raw_candidate)
+    results = run(conditions, a.weights, a.max_side, settings, a.raw_candidate, a.split_by_size)
     print(table(results))
     if a.out is not None:
         doc = {
             "note": a.note,
             "folders": {k: str(v) for k, v in conditions.items()},
             "split_touching": a.split_touching,
+            "split_by_size": a.split_by_size,
             # how the candidate's heatmap was trained decides how its peaks are read
             "candidate_heatmap": None if a.weights is None else heatmap_of(a.weights),
             # and the rule that tells its fragments from fruit (None: it has none)

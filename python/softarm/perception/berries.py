@@ -27,6 +27,7 @@ from softarm.errors import VisionError
 from softarm.perception._inputs import bgr_image, depth_metres, instance, instance_or_default
 from softarm.perception.berry_centre import RING, silhouette_centre
 from softarm.perception.detector.depth_check import DepthCheck, rejection
+from softarm.perception.detector.size_split import SizeSplit
 from softarm.perception.detector.touching import disc_seeds, split_discs
 from softarm.vision.camera_model import CameraModel
 
@@ -92,6 +93,12 @@ class DetectorSettings:
     #: The colour rule's ripe blobs split the same way before the shape tests, where
     #: True (an option: more ripe fruit found, precision lost in sun and dusk).
     split_colour_blobs: bool = False
+    #: Where a depth image is given, a blob or instance larger than the largest fruit at
+    #: its depth is cut into the fruit its area and shape say it holds before the depth
+    #: check, instead of being dropped whole (:mod:`softarm.perception.detector.size_split`;
+    #: an option: docs/perception-candidates.md, "Splitting merged fruit by the size depth
+    #: expects").
+    split_by_size: bool = False
     #: What a depth image must say of a detection where one is given
     #: (:mod:`softarm.perception.detector.depth_check`); None: depth only places it.
     depth_check: DepthCheck | None = field(default_factory=DepthCheck)
@@ -233,7 +240,11 @@ def detections_in_masks(
     depth = depth_metres(depth, ripe.shape)
     # Only the ripe class is split: the unripe one holds the yellow-green canes, whose
     # strips split into fruit-sized pieces at every knot and crossing.
-    blobs = _blobs(_close(ripe), s, s.split_colour_blobs) + _blobs(_close(unripe), s, False)
+    sizes = None
+    if depth is not None and s.split_by_size and s.depth_check is not None:
+        sizes = SizeSplit(depth, camera.focal, s.depth_check, s.depth_check.outline_px)
+    ripe_blobs = _blobs(_close(ripe), s, s.split_colour_blobs, sizes)
+    blobs = ripe_blobs + _blobs(_close(unripe), s, False)
     out = []
     for blob in _capped(blobs):
         det = _detection(blob, ripe, unripe, camera, depth, s)
@@ -313,12 +324,16 @@ def _close(mask: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]:
 
 
 def _blobs(
-    mask: npt.NDArray[np.uint8], s: DetectorSettings, split: bool
+    mask: npt.NDArray[np.uint8], s: DetectorSettings, split: bool, sizes: SizeSplit | None = None
 ) -> list[tuple[npt.NDArray[np.int32], float]]:
     """Outer contours of the compact blobs of ``mask``, holes filled, with their areas;
     with ``split``, every blob first divided into one per fruit it holds (a cluster of
-    fruit is neither compact nor disc-like as a whole), each piece then tested."""
+    fruit is neither compact nor disc-like as a whole), each piece then tested; with
+    ``sizes``, a blob larger than a fruit at its depth first cut into the fruit it
+    holds (:mod:`softarm.perception.detector.size_split`), each piece then as a blob."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if sizes is not None:
+        contours = [p for c in contours for p in sizes.contours(cast(_Contour, c))]
     out = []
     for found in contours:
         c = cast(_Contour, found)

@@ -36,6 +36,7 @@ from softarm.perception.detector.fragments import (
     speck,
 )
 from softarm.perception.detector.network import NetworkOutput
+from softarm.perception.detector.size_split import SizeSplit
 from softarm.perception.detector.touching import disc_seeds, split_discs
 from softarm.vision.camera_model import CameraModel
 
@@ -158,11 +159,15 @@ Piece = tuple[npt.NDArray[np.bool_], int, int]
 
 
 def instance_masks(
-    output: NetworkOutput, fruit: npt.NDArray[np.float32], split: bool = False
+    output: NetworkOutput,
+    fruit: npt.NDArray[np.float32],
+    split: bool = False,
+    sizes: SizeSplit | None = None,
 ) -> list[Piece]:
     """The fruit instances at the network's resolution (``fruit``: output.fruit()), fruit
     that touch split at the necks of their part's distance map (``split``) or at the
-    centre heatmap's peaks."""
+    centre heatmap's peaks, and a piece larger than a fruit at its depth cut into the
+    fruit it holds (``sizes``, on the network's grid: :mod:`.size_split`)."""
     rule = PEAK_RULES[output.heatmap]
     fragments = FRAGMENT_RULES.get(output.heatmap)
     binary = cast(_U8, (fruit > FRUIT_THRESHOLD).astype(np.uint8))
@@ -179,9 +184,36 @@ def instance_masks(
         centres = output.centres[y : y + h, x : x + w]
         distance = None if output.distance is None else output.distance[y : y + h, x : x + w]
         for piece in _pieces(part, centres, split, rule, fragments, distance):
-            if np.count_nonzero(piece) >= MIN_PIXELS and not speck(piece, centres, fragments):
-                out.append(grown(piece, x, y, fruit, taken, fragments))
+            for one in [piece] if sizes is None else sizes.pieces(piece, x, y):
+                if np.count_nonzero(one) >= MIN_PIXELS and not speck(one, centres, fragments):
+                    out.append(grown(one, x, y, fruit, taken, fragments))
     return out
+
+
+def _sizes(
+    output: NetworkOutput,
+    camera: CameraModel,
+    depth: npt.NDArray[np.floating] | None,
+    settings: DetectorSettings,
+) -> SizeSplit | None:
+    """The size split on the network's grid (``settings.split_by_size`` with depth and
+    its check): the depth taken at the nearest image pixel (no mixing of a fruit's
+    depth with the background's across its edge), the focal length and the outline's
+    allowance scaled to the grid."""
+    if depth is None or not settings.split_by_size or settings.depth_check is None:
+        return None
+    net_h, net_w = output.centres.shape
+    grid = cast(
+        npt.NDArray[np.float32],
+        cv2.resize(
+            np.ascontiguousarray(depth, np.float32),
+            (net_w, net_h),
+            interpolation=cv2.INTER_NEAREST,
+        ),
+    )
+    scale = net_w / output.size[0]
+    check = settings.depth_check
+    return SizeSplit(grid, camera.focal * scale, check, check.outline_px * scale)
 
 
 def instances(
@@ -195,7 +227,8 @@ def instances(
     :mod:`.depth_check`)."""
     out = []
     fruit = output.fruit()
-    pieces = instance_masks(output, fruit, settings.split_touching)
+    sizes = _sizes(output, camera, depth, settings)
+    pieces = instance_masks(output, fruit, settings.split_touching, sizes)
     if len(pieces) > MAX_BLOBS:  # a patterned frame of specks: the largest, bounded time
         pieces = sorted(pieces, key=lambda p: -int(np.count_nonzero(p[0])))[:MAX_BLOBS]
     for piece in pieces:
