@@ -114,6 +114,11 @@ class HarvestConfig:
             default: on the slow plant's fresh seeds 7.32 -> 7.20 s a berry at 5, the
             nominal plant unchanged; docs/harvest-candidates.md, "Fine positioning across
             the play").
+        near_standoff: with it above 0 (and below ``standoff``), the placement planner
+            first tries a pre-grasp pose this near the grasp pose, with the same cane
+            margins, and falls back on ``standoff`` for a berry where none keeps them;
+            fine positioning and the back-out then have that much less way to go. 0: off
+            (docs/harvest-candidates.md, "A shorter standoff where the plan allows it").
     """
 
     period: float = 0.05
@@ -149,6 +154,7 @@ class HarvestConfig:
     transport_margin: float = 0.01
     plan_band: float = 0.0
     play_skip: int = 0
+    near_standoff: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
@@ -163,6 +169,11 @@ class HarvestConfig:
             value = _real(self, name)
             if not value >= 0:
                 raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
+        near = _real(self, "near_standoff")
+        if not (near == 0.0 or 0.0 < near < self.standoff):
+            raise ParameterError(
+                f"near_standoff must be 0 (off) or in (0, standoff={self.standoff!r}), got {near!r}"
+            )
         band = _real(self, "plan_band")
         if not 0.0 <= band <= 0.5:
             raise ParameterError(f"plan_band must be in [0, 0.5], got {band!r}")

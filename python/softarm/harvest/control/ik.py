@@ -113,6 +113,9 @@ class ModelIK:
         self.fallback: Clearance | None = None
         #: Whether the last plan cleared only the fallback's canes.
         self.fell_back = False
+        #: The pre-grasp distance (m) short of the grasp pose of the last plan:
+        #: ``near_standoff`` where a plan that near keeps the margins, else ``standoff``.
+        self.standoff = config.standoff
         #: Told after each plan whether it fell back (ControlStack.know_canes: the loop
         #: then follows it with the canes it cleared).
         self.on_plan: Callable[[bool], None] | None = None
@@ -202,8 +205,33 @@ class ModelIK:
         room: float,
         ramp: float,
     ) -> list[FloatArray] | None:
+        for standoff in self._standoffs():
+            path = self._path_from(q, berry, current, axis, via, room, ramp, standoff)
+            if path is not None:
+                self.standoff = standoff
+                return path
+        return None
+
+    def _standoffs(self) -> tuple[float, ...]:
+        """The pre-grasp distances to try, nearest first: ``near_standoff`` (when set) saves
+        fine positioning and the back-out part of their way on a slow plant, where the
+        margins allow it; ``standoff`` everywhere else."""
         c = self.cfg
-        pre = approach_pose(current, berry, axis, c.grasp_offset + c.standoff)
+        return (c.near_standoff, c.standoff) if c.near_standoff > 0 else (c.standoff,)
+
+    def _path_from(
+        self,
+        q: FloatArray,
+        berry: FloatArray,
+        current: FloatArray,
+        axis: FloatArray,
+        via: float | None,
+        room: float,
+        ramp: float,
+        standoff: float,
+    ) -> list[FloatArray] | None:
+        c = self.cfg
+        pre = approach_pose(current, berry, axis, c.grasp_offset + standoff)
         grasp = approach_pose(current, berry, axis, c.grasp_offset)
         for q_pre in self.solve(q, pre):
             q_grasp = self.solve(q_pre, grasp, sample=False)
@@ -222,7 +250,7 @@ class ModelIK:
                 if self.clear(q, q_pre, 12, ramp):
                     return [q_pre]
                 continue
-            back = approach_pose(current, berry, axis, c.grasp_offset + c.standoff + via)
+            back = approach_pose(current, berry, axis, c.grasp_offset + standoff + via)
             for q_via in self.solve(q_pre, back, sample=False) + self.solve(q, back):
                 if self.clear(q, q_via, 12, ramp) and self.clear(q_via, q_pre, 6, ramp):
                     return [q_via, q_pre]

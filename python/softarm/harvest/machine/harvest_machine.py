@@ -46,7 +46,7 @@ from softarm.harvest.machine.interfaces import (
 )
 from softarm.harvest.machine.observe import BerryWatch
 from softarm.harvest.machine.outcome import Fault
-from softarm.harvest.machine.reapproach import Reapproach
+from softarm.harvest.machine.reapproach import Attempt, Reapproach
 from softarm.harvest.machine.stages.servo import Servo
 from softarm.harvest.machine.states import FaultReason, HarvestState
 from softarm.harvest.records.bush_map_record import map_record
@@ -120,6 +120,8 @@ class HarvestMachine:
         self.planner = planner
         #: The approach axis of the current berry (a placement planner may tilt it).
         self.axis: FloatArray = self.config.approach_axis
+        #: The pre-grasp distance (m) of the attempt under way (its plan's).
+        self.standoff: float = self.config.standoff
 
     @property
     def q(self) -> FloatArray:
@@ -139,6 +141,7 @@ class HarvestMachine:
         start = self.clock.now()
         watch = BerryWatch(self.vision, self.clock, berry, self.log, self.config.marker_timeout)
         self.axis = self.config.approach_axis
+        self.standoff = self.config.standoff
         servo = self.servo
         self._transition(HarvestState.IDLE, berry, "new berry")
         try:
@@ -156,8 +159,9 @@ class HarvestMachine:
             self._grasp(result)
             self._transition(HarvestState.RETURN_HOME, berry, "grasp finished")
             servo.go_home(
-                watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
-            )
+                watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix,
+                self.standoff,
+            )  # fmt: skip
             if result.harvested:
                 self.gripper.open()  # drop the berry at the rest pose
             self._transition(
@@ -224,9 +228,9 @@ class HarvestMachine:
             c.reapproaches, c.stall_progress, c.grasp_workspace, self.planner is not None
         )
         while True:
-            waypoints, self.axis = self._next_plan(watch, policy)
+            waypoints, self.axis, self.standoff = self._next_plan(watch, policy)
             try:
-                self.servo.place(watch, self.state, self.q, self.axis, waypoints)
+                self.servo.place(watch, self.state, self.q, self.axis, waypoints, self.standoff)
                 self._transition(HarvestState.FINE_POSITIONING, berry, "pre-grasp pose reached")
                 self.servo.fine(
                     watch, self.state, self.q, self.axis, policy.grasp_within(), policy.more()
@@ -235,13 +239,14 @@ class HarvestMachine:
             except Fault as fault:
                 if fault.retreat_from is None:
                     raise
-                why = policy.after(fault, self.axis, waypoints)
+                why = policy.after(fault, self.axis, waypoints, self.standoff)
                 leaving = why or "backing out before the fault"
                 self._transition(HarvestState.RETURN_HOME, berry, f"{leaving}: {fault}")
                 try:
                     self.servo.go_home(
-                        watch, self.state, self.q, self.home, self.axis, waypoints, watch.last_fix
-                    )
+                        watch, self.state, self.q, self.home, self.axis, waypoints,
+                        watch.last_fix, self.standoff,
+                    )  # fmt: skip
                 except Fault as failed:
                     self.log.event("retreat_failed", t=self.clock.now(), detail=str(failed))
                     raise fault from failed
@@ -253,16 +258,16 @@ class HarvestMachine:
 
     def _next_plan(
         self, watch: BerryWatch, policy: Reapproach
-    ) -> tuple[tuple[FloatArray, ...], FloatArray]:
-        """The next attempt's waypoints and axis: the plan of the attempt ``policy``
+    ) -> tuple[tuple[FloatArray, ...], FloatArray, float]:
+        """The next attempt's waypoints, axis and standoff: the plan of the attempt ``policy``
         comes back to; else a new plan along an axis not tried; when a re-approach finds
         none, the nearest earlier attempt inside the gripper's reach, come back to as
         after a last stall (without it the berry is UNREACHABLE); without a planner, the
         configured axis."""
         if policy.back_to is not None:
-            return policy.back_to.waypoints, policy.back_to.axis
+            return self._attempt(policy.back_to)
         if self.planner is None:
-            return (), self.config.approach_axis
+            return (), self.config.approach_axis, self.config.standoff
         try:
             return self.servo.plan(watch, self.q, self.planner, policy.tried)
         except Fault as fault:
@@ -273,7 +278,12 @@ class HarvestMachine:
                 "no_other_axis", t=self.clock.now(), back_to_mm=1e3 * nearest.grasp_error
             )
             policy.back_to = nearest
-            return nearest.waypoints, nearest.axis
+            return self._attempt(nearest)
+
+    def _attempt(self, attempt: Attempt) -> tuple[tuple[FloatArray, ...], FloatArray, float]:
+        """An earlier ``attempt``'s waypoints, axis and standoff, to come back to."""
+        standoff = self.config.standoff if attempt.standoff is None else attempt.standoff
+        return attempt.waypoints, attempt.axis, standoff
 
     def _finish(self, result: BerryResult, watch: BerryWatch, start: float) -> BerryResult:
         """Record what the stages observed, the final state and the time into ``result``."""

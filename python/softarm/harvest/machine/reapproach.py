@@ -19,11 +19,13 @@ __all__ = ["Attempt", "Reapproach"]
 @dataclass(frozen=True)
 class Attempt:
     """An approach that stalled in fine positioning ``grasp_error`` (m) from the berry,
-    inside the gripper's reach: its ``axis`` and placement ``waypoints``, to come back to."""
+    inside the gripper's reach: its ``axis``, placement ``waypoints`` and pre-grasp
+    ``standoff`` (m; None: ``[harvest] standoff``), to come back to."""
 
     grasp_error: float
     axis: FloatArray
     waypoints: tuple[FloatArray, ...]
+    standoff: float | None = None
 
 
 @dataclass
@@ -56,17 +58,21 @@ class Reapproach:
         return self.grasp_workspace
 
     def after(
-        self, fault: Fault, axis: FloatArray, waypoints: tuple[FloatArray, ...]
+        self,
+        fault: Fault,
+        axis: FloatArray,
+        waypoints: tuple[FloatArray, ...],
+        standoff: float | None = None,
     ) -> str | None:
-        """The attempt along ``axis`` (by ``waypoints``) ended in ``fault``: remember it
-        if it stalled nearer than the nearest; why the berry is tried again (a new
-        axis, or back to the nearest attempt), or None when it is not."""
+        """The attempt along ``axis`` (by ``waypoints``, to ``standoff``) ended in
+        ``fault``: remember it if it stalled nearer than the nearest; why the berry is
+        tried again (a new axis, or back to the nearest attempt), or None when it is not."""
         more = self.more()
         stalled = fault.reason is FaultReason.UNREACHABLE
         error = fault.grasp_error
         if stalled and error is not None and error <= self.grasp_workspace:
             if self.nearest is None or error < self.nearest.grasp_error:
-                self.nearest = Attempt(error, axis, waypoints)
+                self.nearest = Attempt(error, axis, waypoints, standoff)
         if stalled and more:
             return "re-approach"
         if stalled and self.back_to is None and self.nearest is not None:

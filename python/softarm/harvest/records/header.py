@@ -78,7 +78,7 @@ UNITS: dict[str, dict[str, str]] = {
     "fault": {"t": "s"},
     "vent": {"t": "s"},
     "plan": {"t": "s", "q": "m (one configuration per waypoint)", "axis": "unit vector",
-             "berry": "m", "fell_back": "-"},
+             "berry": "m", "fell_back": "-", "standoff": "m"},
     "waypoint_handover": {"t": "s", "error": "m"},
     "waypoint_stalled": {"t": "s", "error": "m"},
     "transport_held": {"t": "s", "error": "m"},

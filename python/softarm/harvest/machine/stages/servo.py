@@ -88,11 +88,12 @@ class Servo:
         q: FloatArray,
         planner: PlacementPlanner,
         avoid: Sequence[FloatArray] = (),
-    ) -> tuple[tuple[FloatArray, ...], FloatArray]:
+    ) -> tuple[tuple[FloatArray, ...], FloatArray, float]:
         """INITIAL_PLACEMENT, first: solve the pre-grasp pose (and the approach axis,
         inside the allowed cone, none of ``avoid``) on the model, holding ``q`` until the
-        cube and the berry are seen. Returns the plan's waypoints and its axis; no plan
-        is UNREACHABLE."""
+        cube and the berry are seen. Returns the plan's waypoints, its axis and its
+        pre-grasp distance (m; the planner's ``standoff`` where it has one, else
+        ``[harvest] standoff``); no plan is UNREACHABLE."""
         seen = watch.observe()
         while seen.pose is None or seen.fix is None:
             q = self.link.hold(q)
@@ -101,11 +102,12 @@ class Servo:
         if plan is None:
             raise Fault(FaultReason.UNREACHABLE, "no pre-grasp pose in the approach cone")
         planned, axis = plan
+        standoff = float(getattr(planner, "standoff", self.link.cfg.standoff))
         self.link.log.event(
             "plan", t=seen.t, q=planned, axis=axis, berry=seen.fix.position,
-            fell_back=bool(getattr(planner, "fell_back", False)),
+            fell_back=bool(getattr(planner, "fell_back", False)), standoff=standoff,
         )  # fmt: skip
-        return tuple(planned), axis
+        return tuple(planned), axis, standoff
 
     def place(
         self,
@@ -114,9 +116,10 @@ class Servo:
         q: FloatArray,
         axis: FloatArray,
         waypoints: tuple[FloatArray, ...] = (),
+        standoff: float | None = None,
     ) -> StageOutcome:
-        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` short of the grasp pose,
-        approaching along ``axis``.
+        """INITIAL_PLACEMENT: to the pre-grasp pose, ``standoff`` (m; the plan's, by
+        default ``[harvest] standoff``) short of the grasp pose, approaching along ``axis``.
 
         A plan's ``waypoints`` (:meth:`plan`) are first followed in closed loop
         (:meth:`Transport.follow`, the canes repelling inside the resolver), then the loop closes
@@ -126,8 +129,9 @@ class Servo:
         start = self.link.clock.now()
         for q_way in waypoints:
             q = self.transport.follow(watch, stage, q, q_way, start + c.placement_timeout)
+        pre_grasp = c.standoff if standoff is None else standoff
         placement = ServoGoal(
-            c.grasp_offset + c.standoff, c.placement_tolerance, c.placement_timeout,
+            c.grasp_offset + pre_grasp, c.placement_tolerance, c.placement_timeout,
             placed_on_limit=True, ahead=True,
         )  # fmt: skip
         out = self.berry_loop.run(watch, stage, q, axis, placement)
@@ -168,8 +172,10 @@ class Servo:
         axis: FloatArray,
         waypoints: tuple[FloatArray, ...],
         berry: FloatArray | None,
+        standoff: float | None = None,
     ) -> FloatArray:
-        """RETURN_HOME: back out to the pre-grasp pose (the approach line is free of
+        """RETURN_HOME: back out to the pre-grasp pose, ``standoff`` short of the grasp
+        pose as placed (the approach line is free of
         branches) of the ``berry`` last seen, along ``axis``, ramp back through the
         placement plan's ``waypoints``, then to ``home``. Within
         ``BACK_OUT_AHEAD_WITHIN`` of the pre-grasp pose the back-out ends on where the
@@ -177,8 +183,9 @@ class Servo:
         c = self.link.cfg
         start = self.link.clock.now()
         try:
+            pre_grasp = c.standoff if standoff is None else standoff
             back_out = ServoGoal(
-                c.grasp_offset + c.standoff, c.placement_tolerance, c.home_timeout / 2,
+                c.grasp_offset + pre_grasp, c.placement_tolerance, c.home_timeout / 2,
                 record_errors=False, frozen=berry, ahead=True,
                 ahead_within=BACK_OUT_AHEAD_WITHIN,
             )  # fmt: skip
