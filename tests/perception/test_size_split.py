@@ -26,7 +26,7 @@ from softarm.vision.camera_model import CameraModel
 
 FOCAL = 300.0
 CAMERA = CameraModel.ideal(FOCAL, W, H)
-SIZE_SPLIT = DetectorSettings(split_by_size=True)
+SIZE_SPLIT = DetectorSettings(split_by_size=True, split_colour_by_size=True)
 SURFACE = 0.3  # m: a 13 px outline there is a 13 mm fruit
 
 
@@ -63,6 +63,14 @@ def test_a_pair_of_touching_fruit_is_two_detections_at_their_centres() -> None:
     (xa, ya), (xb, yb) = sorted(d.center for d in found)
     assert abs(xa - 50) <= 1 and abs(xb - 76) <= 1 and abs(ya - 60) <= 1 and abs(yb - 60) <= 1
     assert all(d.position is not None for d in found)
+
+
+def test_each_detector_has_its_own_switch() -> None:
+    image, depth, _ = _pair()
+    # split_by_size is the network's instances', split_colour_by_size the colour rule's.
+    assert detect_berries(image, CAMERA, depth, DetectorSettings(split_by_size=True)) == []
+    colour_only = DetectorSettings(split_colour_by_size=True)
+    assert len(detect_berries(image, CAMERA, depth, colour_only)) == 2
 
 
 def test_a_row_of_three_fruit_is_three_detections() -> None:
@@ -127,6 +135,8 @@ def test_the_network_s_merged_instance_is_split_by_its_size() -> None:
         inside = rho <= radius
         depth[inside] = SURFACE + radius - np.sqrt(radius**2 - rho[inside] ** 2)
     assert instances(_output(small), camera, depth, DetectorSettings()) == []
+    colour_only = DetectorSettings(split_colour_by_size=True)
+    assert instances(_output(small), camera, depth, colour_only) == []
     found = instances(_output(small), camera, depth, SIZE_SPLIT)
     assert len(found) == 2
     xs = sorted(d.center[0] for d in found)

@@ -118,7 +118,8 @@ RAW = "cand-raw"
 
 
 #: The suffix of a ``+depth`` candidate's rows with merged fruit split by the size depth
-#: expects (``--split-by-size``: ``DetectorSettings.split_by_size``).
+#: expects (``--split-by-size``: ``DetectorSettings.split_by_size`` for the network's
+#: instances, ``split_colour_by_size`` for the colour rule's blobs).
 SIZE = "+size"
 
 
@@ -145,8 +146,8 @@ def run(
     reads each folder's ``depth/``; every detector run with ``settings`` (None: the
     default); with ``raw`` and ``weights``, the candidate alone and with both checks
     also without the fragment rule (rows :data:`RAW` and ``RAW+colour+depth``); with
-    ``size``, every ``+depth`` candidate also with ``split_by_size`` (rows
-    ``...+depth`` :data:`SIZE`)."""
+    ``size``, every ``+depth`` candidate also with ``split_by_size`` and
+    ``split_colour_by_size`` (rows ``...+depth`` :data:`SIZE`)."""
     cv2.setNumThreads(1)
     out: dict[str, Any] = {}
     for name, folder in conditions.items():
@@ -162,7 +163,8 @@ def run(
                     row = RAW + cand[len(CANDIDATE) :]
                     out[name][row] = _figures(det, folder, with_depth, settings)
         if size:
-            sized = replace(settings or DetectorSettings(), split_by_size=True)
+            base = settings or DetectorSettings()
+            sized = replace(base, split_by_size=True, split_colour_by_size=True)
             for cand, (det, with_depth) in dets.items():
                 if with_depth:
                     out[name][cand + SIZE] = _figures(det, folder, True, sized)

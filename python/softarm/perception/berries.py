@@ -93,12 +93,15 @@ class DetectorSettings:
     #: The colour rule's ripe blobs split the same way before the shape tests, where
     #: True (an option: more ripe fruit found, precision lost in sun and dusk).
     split_colour_blobs: bool = False
-    #: Where a depth image is given, a blob or instance larger than the largest fruit at
+    #: Where a depth image is given, a network instance larger than the largest fruit at
     #: its depth is cut into the fruit its area and shape say it holds before the depth
     #: check, instead of being dropped whole (:mod:`softarm.perception.detector.size_split`;
     #: an option: docs/perception-candidates.md, "Splitting merged fruit by the size depth
-    #: expects").
+    #: expects": ripe recall up in every look of the row, localisation down).
     split_by_size: bool = False
+    #: The colour rule's ripe blobs cut the same way before the shape tests, where True
+    #: (an option: more ripe fruit found, precision lost in backlight and dusk).
+    split_colour_by_size: bool = False
     #: What a depth image must say of a detection where one is given
     #: (:mod:`softarm.perception.detector.depth_check`); None: depth only places it.
     depth_check: DepthCheck | None = field(default_factory=DepthCheck)
@@ -241,7 +244,7 @@ def detections_in_masks(
     # Only the ripe class is split: the unripe one holds the yellow-green canes, whose
     # strips split into fruit-sized pieces at every knot and crossing.
     sizes = None
-    if depth is not None and s.split_by_size and s.depth_check is not None:
+    if depth is not None and s.split_colour_by_size and s.depth_check is not None:
         sizes = SizeSplit(depth, camera.focal, s.depth_check, s.depth_check.outline_px)
     ripe_blobs = _blobs(_close(ripe), s, s.split_colour_blobs, sizes)
     blobs = ripe_blobs + _blobs(_close(unripe), s, False)

@@ -101,8 +101,22 @@ class SizeSplit:
         k, shown = self.plan(mask, x, y)
         return [mask] if k < 2 else lloyd_pieces(mask, k, shown)
 
+    def least_split_area(self) -> float:
+        """The least area (px) a blob must have to be cut at all: the largest fruit's
+        at the farthest depth the check allows (the smallest that fruit looks), so that
+        the specks of a frame cost no depth look-up."""
+        far = self.check.range_m[1]
+        return float(
+            np.pi
+            * (apparent_radius(self.check.fruit_radius_m[1], far, self.focal_px) + self.outline_px)
+            ** 2
+        )
+
     def contours(self, contour: _Contour) -> list[_Contour]:
         """A blob's outer ``contour`` (image px) as one outline per fruit it holds."""
+        # Its pixels number at most its polygon's area plus its outline's length (Pick).
+        if cv2.contourArea(contour) + len(contour) <= self.least_split_area():
+            return [contour]
         bx, by, bw, bh = cv2.boundingRect(contour)
         filled = np.zeros((bh, bw), np.uint8)
         cv2.drawContours(filled, [contour], -1, 1, thickness=cv2.FILLED, offset=(-bx, -by))
