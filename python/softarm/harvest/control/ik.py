@@ -22,6 +22,7 @@ slow plant's fresh seeds, it did not make the berries quicker (docs/harvest-cand
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -189,27 +190,11 @@ class ModelIK:
         ]
         for room, ramp, vias in passes:
             for via in vias:
-                for axis in axes:
-                    path = self._path(q, berry, current, axis, via, room, ramp)
+                for axis, standoff in itertools.product(axes, self._standoffs()):
+                    path = self._path(q, berry, current, axis, via, room, ramp, standoff)
                     if path is not None:
+                        self.standoff = standoff
                         return path, axis
-        return None
-
-    def _path(
-        self,
-        q: FloatArray,
-        berry: FloatArray,
-        current: FloatArray,
-        axis: FloatArray,
-        via: float | None,
-        room: float,
-        ramp: float,
-    ) -> list[FloatArray] | None:
-        for standoff in self._standoffs():
-            path = self._path_from(q, berry, current, axis, via, room, ramp, standoff)
-            if path is not None:
-                self.standoff = standoff
-                return path
         return None
 
     def _standoffs(self) -> tuple[float, ...]:
@@ -219,7 +204,7 @@ class ModelIK:
         c = self.cfg
         return (c.near_standoff, c.standoff) if c.near_standoff > 0 else (c.standoff,)
 
-    def _path_from(
+    def _path(
         self,
         q: FloatArray,
         berry: FloatArray,
