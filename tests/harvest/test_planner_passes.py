@@ -94,9 +94,10 @@ def test_a_detour_goes_round_a_cane_the_straight_ramps_pass_too_near() -> None:
     mid = rig.model.forward(waypoints[0])[:3, 3] - berry
     assert np.linalg.norm(mid - (mid @ axis) * axis) > 0.01
     # No straight ramp, nor via point, was clear along this axis.
+    ramp, standoff = planner.ramp_margin, c.standoff
     for via in (None, planner.via, 0.5 * planner.via):
-        assert planner._path(q, berry, current, axis, via, 0.0, planner.ramp_margin) is None
-    assert planner._path(q, berry, current, axis, DETOUR, 0.001, planner.ramp_margin)
+        assert planner._path(q, berry, current, axis, via, 0.0, ramp, standoff) is None
+    assert planner._path(q, berry, current, axis, DETOUR, 0.001, ramp, standoff)
     assert any(np.allclose(a, axis) for a in cone_axes(c.approach_axis, c.approach_cone_deg))
 
 
