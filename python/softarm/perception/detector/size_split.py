@@ -28,12 +28,14 @@ touching discs falls at their contact and each centre at its disc's."""
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import cast
 
 import cv2
 import numpy as np
 import numpy.typing as npt
+from scipy.cluster.vq import kmeans2
 
 from softarm.perception.detector.depth_check import MIN_VISIBLE_SHARE, DepthCheck
 from softarm.perception.detector.touching import Seed, _distance, disc_seeds
@@ -47,7 +49,7 @@ MAX_FRUIT = 4
 #: A fruit the shape shows apart is a distance-map peak at least this share of the
 #: smallest fruit's radius deep (a half-visible disc's inscribed radius is half its own).
 SEED_SHARE = 0.5
-#: Lloyd iterations at most (they stop when no pixel changes its centre).
+#: Lloyd iterations (converged ones change nothing).
 ITERATIONS = 20
 _F32 = npt.NDArray[np.float32]
 _Mask = npt.NDArray[np.bool_]
@@ -151,21 +153,15 @@ def _seeds(mask: _Mask, k: int, shown: list[Seed]) -> npt.NDArray[np.float64]:
 
 
 def lloyd_pieces(mask: _Mask, k: int, shown: list[Seed] | None = None) -> list[_Mask]:
-    """``mask`` cut into ``k`` pieces by Lloyd's k-means on its pixel coordinates,
-    started at the fruit ``shown`` apart by its shape and then as :func:`_seeds` says."""
+    """``mask`` cut into ``k`` pieces by Lloyd's k-means on its pixel coordinates
+    (``scipy.cluster.vq.kmeans2``), started at the fruit ``shown`` apart by its shape
+    and then as :func:`_seeds` says."""
     rows, cols = np.nonzero(mask)
     points = np.column_stack([rows, cols]).astype(np.float64)
-    centres = _seeds(mask, k, shown or [])
-    owner = np.full(rows.size, -1, np.intp)
-    for _ in range(ITERATIONS):
-        d2 = ((points[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
-        new = np.argmin(d2, axis=1)
-        if np.array_equal(new, owner):
-            break
-        owner = new
-        for j in range(k):
-            if np.any(owner == j):
-                centres[j] = points[owner == j].mean(axis=0)
+    with warnings.catch_warnings():
+        # A centre left with no pixel keeps its place (its piece is then empty, dropped).
+        warnings.simplefilter("ignore", UserWarning)
+        _, owner = kmeans2(points, _seeds(mask, k, shown or []), ITERATIONS, minit="matrix")
     out = []
     for j in range(k):
         piece = np.zeros_like(mask)
