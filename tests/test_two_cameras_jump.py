@@ -125,3 +125,28 @@ def test_a_non_finite_pose_is_an_error() -> None:
     gate = PoseGate()
     with pytest.raises(NonFiniteError, match="position"):
         gate.accept(0.0, np.array([0.0, math.nan, 0.0]))
+
+
+def test_after_a_stretch_unwatched_the_first_pose_starts_the_track_again() -> None:
+    """Frames looked at more than ``max_gap`` apart: the arm was moved unwatched (the
+    ramp home), and its first pose, 20 cm from the last one, is taken at once."""
+    gate = PoseGate(max_jump=0.03, max_gap=0.25)
+    for k in range(3):
+        gate.looked(k * PERIOD)
+        assert gate.accept(k * PERIOD, np.zeros(3))
+    t = 2 * PERIOD + 1.0
+    gate.looked(t)
+    assert gate.accept(t, np.array([0.2, 0.0, 0.0]))
+    gate.looked(t + PERIOD)
+    assert not gate.accept(t + PERIOD, np.array([0.2, 0.05, 0.0]))  # watched: gated again
+
+
+def test_frames_watched_without_a_pose_keep_the_gate() -> None:
+    """Frames looked at every period that gave no pose (the cube hidden): the arm was
+    watched, and a pose 20 cm off is still a jump."""
+    gate = PoseGate(max_jump=0.03, max_gap=0.25)
+    gate.looked(0.0)
+    assert gate.accept(0.0, np.zeros(3))
+    for k in range(1, 21):
+        gate.looked(k * PERIOD)
+    assert not gate.accept(20 * PERIOD, np.array([0.2, 0.0, 0.0]))

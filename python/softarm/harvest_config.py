@@ -110,15 +110,17 @@ class HarvestConfig:
             to fine positioning (docs/harvest-candidates.md, "Pre-grasp poses off the limits").
         play_skip: with it above 0, a channel whose fine-positioning command has moved
             the same way for this many periods inside the lag model's play band is put at
-            the band's edge (``softarm.harvest.machine.stages.play_skip``); 0: off (the
-            default: on the slow plant's fresh seeds 7.32 -> 7.20 s a berry at 5, the
-            nominal plant unchanged; docs/harvest-candidates.md, "Fine positioning across
-            the play").
-        near_standoff: with it above 0 (and below ``standoff``), the placement planner
-            first tries a pre-grasp pose this near the grasp pose, with the same cane
-            margins, and falls back on ``standoff`` for a berry where none keeps them;
-            fine positioning and the back-out then have that much less way to go. 0: off
-            (docs/harvest-candidates.md, "A shorter standoff where the plan allows it").
+            the band's edge (``softarm.harvest.machine.stages.play_skip``): a slow
+            plant's loop no longer creeps through its regulators' play for seconds; the
+            nominal plant's 1.5 psi band is crossed before it counts. 0: off
+            (docs/harvest.md, "The slow plant's defaults").
+        near_standoff: for a berry fixed by its tag, the placement planner first tries a
+            pre-grasp pose this near the grasp pose (where it is below ``standoff``),
+            with the same cane margins, and falls back on ``standoff`` where none keeps
+            them; fine positioning and the back-out then have that much less way to go.
+            A markerless berry is always planned at ``standoff``: C2's detection needs
+            that way to settle (in the row's sun, nearer, a grasp ended 8 mm off). 0:
+            off (docs/harvest.md, "The slow plant's defaults").
     """
 
     period: float = 0.05
@@ -153,8 +155,8 @@ class HarvestConfig:
     lead_cap: float = 1.5
     transport_margin: float = 0.01
     plan_band: float = 0.0
-    play_skip: int = 0
-    near_standoff: float = 0.0
+    play_skip: int = 5
+    near_standoff: float = 0.03
 
     def __post_init__(self) -> None:
         for name in ("period", "standoff", "placement_tolerance", "fine_tolerance",
@@ -165,15 +167,10 @@ class HarvestConfig:
             if not value > 0:
                 raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
         for name in ("grasp_offset", "stall_progress", "home_elongation", "transport_margin",
-                     "follow_blind_time", "lead_cap", "fine_aim"):  # fmt: skip
+                     "follow_blind_time", "lead_cap", "fine_aim", "near_standoff"):  # fmt: skip
             value = _real(self, name)
             if not value >= 0:
                 raise ParameterError(f"{name} must be finite and >= 0, got {value!r}")
-        near = _real(self, "near_standoff")
-        if not (near == 0.0 or 0.0 < near < self.standoff):
-            raise ParameterError(
-                f"near_standoff must be 0 (off) or in (0, standoff={self.standoff!r}), got {near!r}"
-            )
         band = _real(self, "plan_band")
         if not 0.0 <= band <= 0.5:
             raise ParameterError(f"plan_band must be in [0, 0.5], got {band!r}")

@@ -85,6 +85,8 @@ def test_a_zed2_is_one_device_split_and_the_berries_are_markerless(
         assert isinstance(built.machine.vision, BushVision) and built.markerless
         assert built.machine.vision.model1 is built.c1.stereo.left  # type: ignore[union-attr]
         assert canes_given == [[]]
+        # C2's detection of a markerless berry needs the whole standoff to settle.
+        assert built.machine.planner.near_standoff == 0.0  # type: ignore[union-attr]
         report = built.run(2)  # an empty map: nothing to pick
         assert report.berries == [] and report.stopped is None
     finally:
@@ -101,6 +103,8 @@ def test_a_pair_is_two_devices_and_tags_keep_the_tag_vision(
     try:
         assert opened["opened"] == [4, 5, 1]
         assert not isinstance(built.machine.vision, BushVision) and not built.markerless
+        near = built.machine.planner.near_standoff  # type: ignore[union-attr]
+        assert near == built.machine.config.near_standoff > 0
     finally:
         built.close()
 

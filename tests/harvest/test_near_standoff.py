@@ -18,10 +18,22 @@ from softarm.sim.bush import Bush
 NEAR = 0.035
 
 
-@pytest.mark.parametrize("near", [-0.01, 0.05, 0.06, float("nan")])
-def test_a_near_standoff_not_below_the_standoff_is_refused_by_name(near: float) -> None:
+@pytest.mark.parametrize("near", [-0.01, float("nan"), float("inf")])
+def test_a_negative_or_non_finite_near_standoff_is_refused_by_name(near: float) -> None:
     with pytest.raises(ParameterError, match="near_standoff"):
         HarvestConfig(near_standoff=near)
+
+
+@pytest.mark.parametrize("near", [0.0, 0.05, 0.06])
+def test_a_near_standoff_off_or_not_below_the_standoff_plans_at_the_standoff(
+    near: float,
+) -> None:
+    arm, planner, q, current, berry = _scene(None)
+    planner.near_standoff = near
+    plan = planner.plan(q, berry, current)
+    assert plan is not None and planner.standoff == planner.cfg.standoff
+    distance = _pre_grasp_distance(arm, plan[0], berry)
+    assert distance == pytest.approx(planner.cfg.grasp_offset + planner.cfg.standoff, abs=1e-3)
 
 
 def _scene(
@@ -36,7 +48,9 @@ def _scene(
     q = np.full(arm.n_actuators, 0.0167)  # the harvest's home elongation
     clearance = None
     if cane_side is not None:
-        free = ModelIK(planning_resolver(arm), cfg, seed=0).plan(q, berry, arm.forward(q))
+        free = ModelIK(planning_resolver(arm), cfg, seed=0, near_standoff=NEAR).plan(
+            q, berry, arm.forward(q)
+        )
         assert free is not None
         axis = free[1]
         side = np.cross(axis, [1.0, 0.0, 0.0])
@@ -45,7 +59,7 @@ def _scene(
         centre = berry - 0.03 * axis + cane_side * side
         coeffs = np.column_stack([centre - 0.1 * along, 0.2 * along, np.zeros(3), np.zeros(3)])
         clearance = Clearance(arm, [PolynomialCurve(coeffs, (0.0, 1.0))], cfg.grasp_offset)
-    planner = ModelIK(planning_resolver(arm), cfg, seed=0, clearance=clearance)
+    planner = ModelIK(planning_resolver(arm), cfg, seed=0, clearance=clearance, near_standoff=NEAR)
     return arm, planner, q, arm.forward(q), berry
 
 

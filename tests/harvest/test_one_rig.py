@@ -67,6 +67,7 @@ def _settings(stack: rig.ControlStack) -> dict[str, Any]:
         "planner_gains": p.resolver.gains.as_dict(),
         "planner_config": p.cfg,
         "planner_checks": p.clearance is not None,
+        "near_standoff": p.near_standoff,
         "grasp_offset": stack.clearance.offset,
     }
 

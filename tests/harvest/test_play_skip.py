@@ -106,11 +106,12 @@ def test_a_bad_play_skip_is_a_typed_error_naming_it(value: object) -> None:
 
 
 def _slow_berry(tmp_path: Path, periods: int) -> tuple[float, set[str]]:
-    """The first berry of bush 1531 on the slow plant (a channel that reversed on the way
-    in creeps through the 5 psi band in fine positioning): its time (s) and the states
+    """The first berry of bush 1531 on the slow plant, placed at the 5 cm standoff (a
+    channel that reversed on the way in creeps through the 5 psi band in fine
+    positioning; from the nearer standoff it does not): its time (s) and the states
     of the periods in which a channel was put at the band's edge."""
     log = tmp_path / f"run{periods}.jsonl"
-    config = HarvestConfig(play_skip=periods)
+    config = HarvestConfig(play_skip=periods, near_standoff=0.0)
     plant = load_plant_file(SLOW_PLANT)
     report = simulate(1, 1531, log=log, plant=plant, config=config, marker_body="frustum")
     assert report.berries[0].harvested

@@ -46,7 +46,10 @@ class PoseGate:
             carry the prediction far off the arm.
         max_gap: two accepted positions further apart in time (s) than this give no
             velocity (the arm may have stopped, turned, or been moved meanwhile): the
-            prediction is then the last position, the rule of a still arm.
+            prediction is then the last position, the rule of a still arm. Two frames
+            looked at (:meth:`looked`) further apart than this mean the camera was not
+            watched in between (an open-loop ramp home): the next position starts the
+            track again, as the first one did.
     """
 
     def __init__(
@@ -65,6 +68,17 @@ class PoseGate:
         self._last: tuple[float, FloatArray] | None = None
         self._velocity: FloatArray | None = None
         self._rejects = 0
+        self._looked: float | None = None
+
+    def looked(self, time: float) -> None:
+        """A frame at ``time`` (s) was looked at, whether or not it gave a position. After
+        more than ``max_gap`` unwatched the last position says nothing of where the arm
+        is: the harvest moves it open loop, unwatched, by tens of cm (the ramp home), and
+        measured from there its first poses were refused as a jump until ``max_rejects``
+        agreed, two control periods a berry spent waiting (docs/harvest.md)."""
+        if self._looked is not None and time - self._looked > self.max_gap:
+            self._last, self._velocity, self._rejects = None, None, 0
+        self._looked = float(time)
 
     def predicted(self, time: float) -> FloatArray | None:
         """Where the last accepted position and velocity put the point at ``time``; None

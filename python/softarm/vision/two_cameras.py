@@ -169,6 +169,7 @@ class CameraVision:
     def _view_c1(self, time: float) -> tuple[FloatArray | None, FloatArray | None]:
         """C1's frame at ``time``: ``T_c1_ee`` (None when the cube is not seen or the pose
         is an outlier) and the selected berry's tag position in C1 (None if not seen)."""
+        self.gate.looked(time)
         dets = self.detector.detect(_frame(self.frame1, time), self.model1)
         est = self.cube.estimate(dets, self.model1, self._cube_prev)
         berry_c1 = self._berry_c1(dets)

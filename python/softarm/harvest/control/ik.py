@@ -84,6 +84,10 @@ class ModelIK:
             every actuator's range, out of this fraction of it at either end
             (:func:`~softarm.harvest.control.mid_band.toward_mid`), the unmoved solutions
             kept as a fallback; 0: solutions as the resolver leaves them.
+        near_standoff: a pre-grasp distance (m) tried before ``config.standoff`` on every
+            axis and pass; 0 (or not below the standoff): the standoff alone
+            (:func:`~softarm.harvest.control.stack.build_control_stack` gives the config's
+            ``near_standoff`` for berries fixed by their tags).
     """
 
     def __init__(
@@ -99,6 +103,7 @@ class ModelIK:
         via: float = 0.1,
         limit_room: float = 0.001,
         band: float = 0.0,
+        near_standoff: float = 0.0,
     ) -> None:
         self.resolver = resolver
         self.arm = resolver.arm
@@ -109,6 +114,7 @@ class ModelIK:
         self.ramp_margin = ramp_margin
         self.limit_room = limit_room
         self.band = band
+        self.near_standoff = near_standoff
         #: The canes to plan around where no plan clears ``clearance``'s: the ones C1
         #: saw itself, once C2's survey has added its own (ControlStack.know_canes).
         self.fallback: Clearance | None = None
@@ -201,8 +207,8 @@ class ModelIK:
         """The pre-grasp distances to try, nearest first: ``near_standoff`` (when set) saves
         fine positioning and the back-out part of their way on a slow plant, where the
         margins allow it; ``standoff`` everywhere else."""
-        c = self.cfg
-        return (c.near_standoff, c.standoff) if c.near_standoff > 0 else (c.standoff,)
+        near, standoff = self.near_standoff, self.cfg.standoff
+        return (near, standoff) if 0.0 < near < standoff else (standoff,)
 
     def _path(
         self,

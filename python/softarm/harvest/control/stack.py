@@ -152,9 +152,15 @@ def build_control_stack(
     canes: Sequence[PolynomialCurve],
     bank: SafePressureBank,
     now: Callable[[], float],
+    markerless: bool = False,
 ) -> ControlStack:
     """The control stack on ``bank`` (behind its safety layer), timed by ``now``, with
-    ``canes`` (the known obstacles, possibly none) avoided by planner and controller."""
+    ``canes`` (the known obstacles, possibly none) avoided by planner and controller.
+
+    The planner tries ``cfg.near_standoff`` first for berries fixed by their tags. A
+    ``markerless`` harvest's fine positioning is closed on C2's detection of the berry,
+    which needs the whole ``standoff`` to settle: nearer, C2 lost a berry in the row's
+    sun and the grasp ended 8 mm off it (docs/harvest.md, "A nearer pre-grasp pose")."""
     actuator = _actuator(cfg, inputs, bank, now)
     # The model arm's gap to the known canes: the planner checks its plans with it, the
     # controller keeps the lagging arm's way to each command clear with it.
@@ -162,7 +168,7 @@ def build_control_stack(
     controller = _controller(cfg, inputs, canes, clearance, actuator)
     planner = ModelIK(
         planning_resolver(inputs.model), cfg, seed=inputs.seed, clearance=clearance,
-        band=cfg.plan_band,
+        band=cfg.plan_band, near_standoff=0.0 if markerless else cfg.near_standoff,
     )  # fmt: skip
     return ControlStack(actuator, controller, planner, clearance)
 

@@ -5,8 +5,8 @@ Per berry::
     IDLE → INITIAL_PLACEMENT → FINE_POSITIONING → GRASP → RETURN_HOME → DONE
       └──────────────┴────────────────┴────────────┴──────────┴──→ FAULT (vented)
 
-* IDLE: select the berry's tag; ramp to the ready pose; wait until the cube and the berry
-  are both seen.
+* IDLE: select the berry's tag; ramp the command to the ready pose (placement goes on
+  from where the arm is); wait until the cube and the berry are both seen.
 * INITIAL_PLACEMENT: eye-to-hand feedback (eq. 22) drives the gripper to a pre-grasp pose
   ``standoff`` short of the berry, facing it along ``approach``.
 * FINE_POSITIONING: the berry position from the eye-in-hand camera (eq. 21), held while
@@ -147,7 +147,11 @@ class HarvestMachine:
         try:
             self.vision.select(berry)
             idle_deadline = self.clock.now() + self.config.idle_timeout
-            servo.transport.ramp(watch, self.state, self.q, self.home, idle_deadline)
+            # Not settled: placement follows its plan from where the lag model has the
+            # arm, each command's way checked from there (Transport.clear_way), so the
+            # first berry need not wait for the arm to rise from vented (0.2 s a berry
+            # on the slow plant's tag world; docs/harvest.md).
+            servo.transport.ramp(watch, self.state, self.q, self.home, idle_deadline, settle=False)
             servo.wait_visible(watch, self.state, self.q)
             self._transition(HarvestState.INITIAL_PLACEMENT, berry, "cube and berry in view")
             waypoints = self._reach(watch, berry)

@@ -138,13 +138,13 @@ def build_hardware_rig(
             parts = _rig_parts(config, cfg, inputs.model)
             canes = c1.fit_canes(parts, CANE_REACH, _rig_outline(config, inputs.model))
         vision = _vision(config, cfg, dev, stack, c1)
-        control = build_control_stack(cfg, inputs, canes, bank, clock.now)
+        markerless = _markerless(config, c1)
+        control = build_control_stack(cfg, inputs, canes, bank, clock.now, markerless)
         machine = HarvestMachine(
             clock, vision, control.controller, control.actuator, ArduinoGripper(link),
             ArduinoRipenessSensor(link), inputs.model.n_actuators, cfg, log,
             planner=control.planner,
         )  # fmt: skip
-        markerless = _markerless(config, c1)
         survey = None
         if c1 is not None and parts is not None and config.perception is not None:
             if config.perception.survey:

@@ -160,8 +160,9 @@ def _build_sim_rig(
         WorldParts(o, bush, canes, plant, model, cams, parts, clock, recorder, outline)
     )
     stack = build_control_stack(
-        cfg, control_inputs(o, model), list(world.known_canes()), bank, clock.now
-    )
+        cfg, control_inputs(o, model), list(world.known_canes()), bank, clock.now,
+        markerless=o.world is not WorldName.TAGS,
+    )  # fmt: skip
     gripper = world.gripper
     sensor = gripper if recorder is None else RecordedSensor(gripper, recorder)
     machine = HarvestMachine(
