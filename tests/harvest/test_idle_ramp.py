@@ -9,33 +9,15 @@ from typing import Any
 
 import numpy as np
 
-from softarm._core import lead_gain
-from softarm.hardware import SafePressureBank, SimulatedPressureBank
 from softarm.harvest import BerryTarget, HarvestConfig, HarvestLog, HarvestMachine, SafeActuator
 from softarm.harvest.machine.states import HarvestState
 
-from .fakes import (
-    BERRIES,
-    FakeClock,
-    FakeGripper,
-    FakeLocator,
-    FakeRipeness,
-    FakeTracker,
-    FakeVision,
-)
-from .test_stage_ahead import PERIOD, TAU, PredictingController, SlowPlant
+from .fakes import BERRIES, FakeGripper, FakeLocator, FakeRipeness, FakeTracker, FakeVision
+from .test_stage_ahead import PredictingController, slow_actuator
 
 
 def _machine() -> tuple[HarvestMachine, SafeActuator]:
-    clock, plant = FakeClock(), SlowPlant()
-    clock.hooks.append(plant.advance)
-    bank = SafePressureBank(
-        SimulatedPressureBank(plant, channels=3), 70.0, 100.0, 0.5, clock.now,
-        watchdog_thread=False,
-    )  # fmt: skip
-    actuator = SafeActuator(
-        bank, lag=(TAU, PERIOD), now=clock.now, lead=lead_gain(TAU, PERIOD, 1.5)
-    )
+    clock, plant, actuator = slow_actuator()
     locator = FakeLocator(dict(BERRIES))
     machine = HarvestMachine(
         clock, FakeVision(FakeTracker(plant), locator),  # type: ignore[arg-type]

@@ -84,9 +84,9 @@ class OffModel(PredictingController):
         return pose
 
 
-def _slow_rig(
-    off: bool = False,
-) -> tuple[FakeClock, SlowPlant, SafeActuator, Servo, BerryWatch, HarvestLog]:
+def slow_actuator() -> tuple[FakeClock, SlowPlant, SafeActuator]:
+    """A clock, the slow plant it advances, and the safety layer's actuator on it with
+    the plant's lag model and the regulators' lead, as the harvest's stack builds it."""
     clock, plant = FakeClock(), SlowPlant()
     clock.hooks.append(plant.advance)
     bank = SafePressureBank(
@@ -96,6 +96,13 @@ def _slow_rig(
     actuator = SafeActuator(
         bank, lag=(TAU, PERIOD), now=clock.now, lead=lead_gain(TAU, PERIOD, 1.5)
     )
+    return clock, plant, actuator
+
+
+def _slow_rig(
+    off: bool = False,
+) -> tuple[FakeClock, SlowPlant, SafeActuator, Servo, BerryWatch, HarvestLog]:
+    clock, plant, actuator = slow_actuator()
     log, config = HarvestLog(), HarvestConfig()
     controller = (OffModel if off else PredictingController)(actuator)
     servo = Servo(clock, controller, actuator, config, log)
