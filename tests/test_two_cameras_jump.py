@@ -150,3 +150,8 @@ def test_frames_watched_without_a_pose_keep_the_gate() -> None:
     for k in range(1, 21):
         gate.looked(k * PERIOD)
     assert not gate.accept(20 * PERIOD, np.array([0.2, 0.0, 0.0]))
+
+
+def test_a_non_finite_time_looked_at_is_an_error() -> None:
+    with pytest.raises(NonFiniteError, match="time"):
+        PoseGate().looked(math.nan)

@@ -75,7 +75,13 @@ class PoseGate:
         more than ``max_gap`` unwatched the last position says nothing of where the arm
         is: the harvest moves it open loop, unwatched, by tens of cm (the ramp home), and
         measured from there its first poses were refused as a jump until ``max_rejects``
-        agreed, two control periods a berry spent waiting (docs/harvest.md)."""
+        agreed, two control periods a berry spent waiting (docs/harvest.md).
+
+        Raises:
+            NonFiniteError: ``time`` is not finite (as :meth:`accept`).
+        """
+        if not math.isfinite(time):
+            raise NonFiniteError(f"time = {time!r}: must be finite")
         if self._looked is not None and time - self._looked > self.max_gap:
             self._last, self._velocity, self._rejects = None, None, 0
         self._looked = float(time)
